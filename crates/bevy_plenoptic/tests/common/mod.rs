@@ -1,0 +1,88 @@
+//! Headless rendering harness shared by the GPU tests: an app without a window whose camera
+//! renders into an image that is read back to the CPU.
+
+use std::sync::{Arc, Mutex};
+
+use bevy::{
+    camera::RenderTarget,
+    core_pipeline::tonemapping::Tonemapping,
+    prelude::*,
+    render::{
+        gpu_readback::{Readback, ReadbackComplete},
+        render_resource::{TextureFormat, TextureUsages},
+    },
+    window::ExitCondition,
+};
+
+/// Size of the off-screen target.
+pub const WIDTH: u32 = 64;
+/// Size of the off-screen target.
+pub const HEIGHT: u32 = 48;
+
+/// An app on the default plugins with no window, rendering on whatever adapter wgpu finds
+/// (Mesa's lavapipe on CI).
+pub fn headless_app() -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .build(),
+    );
+    app
+}
+
+/// Creates the render target image and returns the camera's target for it.
+pub fn target_image(images: &mut Assets<Image>) -> Handle<Image> {
+    let mut image = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba8Unorm, None);
+    image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+    images.add(image)
+}
+
+/// A 3D camera that renders into `image` with no tonemapping, so colours reach the target
+/// unchanged.
+pub fn camera_into(image: Handle<Image>, transform: Transform) -> impl Bundle {
+    (
+        Camera3d::default(),
+        Camera {
+            clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
+            ..default()
+        },
+        RenderTarget::Image(image.into()),
+        Tonemapping::None,
+        transform,
+    )
+}
+
+/// Runs `app` until the image has been rendered `warmup` times and then read back, returning
+/// RGBA8 pixels row by row. Panics after `max_frames` without a readback.
+pub fn render_and_read(app: &mut App, image: Handle<Image>, warmup: u32, max_frames: u32) -> Vec<u8> {
+    let pixels: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
+    for frame in 0..max_frames {
+        if frame == warmup {
+            let sink = pixels.clone();
+            app.world_mut()
+                .spawn(Readback::texture(image.clone()))
+                .observe(move |event: On<ReadbackComplete>| {
+                    let mut slot = sink.lock().unwrap();
+                    if slot.is_none() {
+                        *slot = Some(event.data.clone());
+                    }
+                });
+        }
+        app.update();
+        if let Some(data) = pixels.lock().unwrap().take() {
+            return data;
+        }
+    }
+    panic!("no readback after {max_frames} frames");
+}
+
+/// The RGBA8 pixel at (x, y).
+pub fn pixel(data: &[u8], x: u32, y: u32) -> [u8; 4] {
+    let i = ((y * WIDTH + x) * 4) as usize;
+    [data[i], data[i + 1], data[i + 2], data[i + 3]]
+}

@@ -1,0 +1,1 @@
+//! plenoptic_pack (being written).

@@ -1,0 +1,1 @@
+//! plenoptic_scene (being written).

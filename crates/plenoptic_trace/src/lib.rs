@@ -1,0 +1,1 @@
+//! plenoptic_trace (being written).

@@ -1,0 +1,20 @@
+//! # plenoptic
+//!
+//! An embeddable streaming walk-through runtime. A scene author bakes an animated glTF scene
+//! offline into a *radiance pack*; a Bevy app adds [`bevy_plenoptic::PlenopticPlugin`] and gets
+//! globally illuminated frames for any camera position inside the baked view space at any
+//! time of the animation.
+//!
+//! This facade re-exports the workspace crates:
+//!
+//! | crate | holds |
+//! |---|---|
+//! | [`pack`] | the radiance pack file format |
+//! | [`scene`] | the scene model, glTF import, animation, bake recipes |
+//! | [`trace`] | BVHs, cameras, id-images, the multi-stage and reference renderers |
+//! | [`bevy`] | the Bevy plugin |
+
+pub use bevy_plenoptic as bevy;
+pub use plenoptic_pack as pack;
+pub use plenoptic_scene as scene;
+pub use plenoptic_trace as trace;
