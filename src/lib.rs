@@ -14,6 +14,7 @@
 //! | [`trace`] | BVHs, cameras, id-images, the multi-stage and reference renderers |
 //! | [`bevy`] | the Bevy plugin |
 
+#[cfg(feature = "bevy")]
 pub use bevy_plenoptic as bevy;
 pub use plenoptic_pack as pack;
 pub use plenoptic_scene as scene;
