@@ -1,2 +1,2 @@
-//! Benchmark being written.
+//! Placeholder (being written).
 fn main() {}
