@@ -1,0 +1,519 @@
+//! [`PackReader`]: opens a pack by reading header, manifest and directory only, validates them,
+//! and reads single chunks on demand by byte range.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use crate::bytes::{ByteReader, checksum};
+use crate::directory::{ChunkEntry, ChunkKind, DIRECTORY_ROW_LEN, NO_BASE_VIEW};
+use crate::error::{ChunkRef, PackError, Result, Section};
+use crate::header::{HEADER_LEN, Header};
+use crate::ktx::inspect_cube;
+use crate::manifest::{MAX_MANIFEST_BYTES, Manifest};
+use crate::proxy::{
+    AnimationTracks, ProxyMesh, decode_proxy_mesh, decode_tracks, proxy_header, tracks_header,
+};
+use crate::range_image::{
+    DISTANCE_FORMATS, DistanceCube, NORMAL_FORMATS, NormalCube, OBJECT_ID_FORMATS, ObjectIdCube,
+    RADIANCE_FORMATS, RadianceCube, RangeImage, decode_distance, decode_normal, decode_object_id,
+    decode_radiance,
+};
+use crate::volume::{
+    VolumeBlock, block_header, connectivity_header, decode_connectivity, decode_volume_block,
+};
+use crate::writer::{MAX_CHUNK_LENGTH, MAX_CHUNKS};
+
+/// Positional reads from a shared source.
+trait Source: Send + Sync {
+    fn read_exact_at(&self, buf: &mut [u8], offset: u64) -> std::io::Result<()>;
+}
+
+struct FileSource(#[cfg(unix)] File, #[cfg(not(unix))] Mutex<File>);
+
+impl Source for FileSource {
+    #[cfg(unix)]
+    fn read_exact_at(&self, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+        std::os::unix::fs::FileExt::read_exact_at(&self.0, buf, offset)
+    }
+    #[cfg(not(unix))]
+    fn read_exact_at(&self, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+        let mut f = self
+            .0
+            .lock()
+            .map_err(|_| std::io::Error::other("poisoned"))?;
+        f.seek(SeekFrom::Start(offset))?;
+        f.read_exact(buf)
+    }
+}
+
+struct StreamSource<R>(Mutex<R>);
+
+impl<R: Read + Seek + Send> Source for StreamSource<R> {
+    fn read_exact_at(&self, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+        let mut r = self
+            .0
+            .lock()
+            .map_err(|_| std::io::Error::other("reader mutex poisoned"))?;
+        r.seek(SeekFrom::Start(offset))?;
+        r.read_exact(buf)
+    }
+}
+
+/// A decoded chunk of any kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Chunk {
+    /// A radiance cube.
+    Radiance(RadianceCube),
+    /// A distance cube.
+    Distance(DistanceCube),
+    /// An object-id cube.
+    ObjectId(ObjectIdCube),
+    /// A normal cube.
+    Normal(NormalCube),
+    /// A temporal-volume block.
+    Volume(VolumeBlock),
+    /// Tetrahedra over a volume block.
+    Connectivity {
+        /// Samples in the block the indices refer to.
+        sample_count: u32,
+        /// Tetrahedra (indices in the block's stored order).
+        tetrahedra: Vec<[u32; 4]>,
+    },
+    /// A proxy mesh.
+    ProxyMesh(ProxyMesh),
+    /// The animation tracks.
+    Tracks(AnimationTracks),
+}
+
+/// The uncompressed length a chunk's own header declares (validating that header).
+pub(crate) fn declared_uncompressed_length(kind: ChunkKind, bytes: &[u8]) -> Result<u64> {
+    Ok(match kind {
+        ChunkKind::RadianceCube => inspect_cube(bytes, &RADIANCE_FORMATS)?.uncompressed_length,
+        ChunkKind::DistanceCube => inspect_cube(bytes, &DISTANCE_FORMATS)?.uncompressed_length,
+        ChunkKind::ObjectIdCube => inspect_cube(bytes, &OBJECT_ID_FORMATS)?.uncompressed_length,
+        ChunkKind::NormalCube => inspect_cube(bytes, &NORMAL_FORMATS)?.uncompressed_length,
+        ChunkKind::VolumeBlock => block_header(bytes)?.3,
+        ChunkKind::VolumeConnectivity => connectivity_header(bytes)?.2,
+        ChunkKind::ProxyMesh => proxy_header(bytes)?.4,
+        ChunkKind::AnimationTracks => tracks_header(bytes)?.1,
+        ChunkKind::Unknown(_) => {
+            return Err(PackError::input(
+                "unknown chunk kinds must be added with add_raw_chunk",
+            ));
+        }
+    })
+}
+
+/// Random-access reader of a pack. `Send + Sync`: chunks may be read from many threads at once
+/// (files use positional reads; other sources a mutex around seek + read).
+pub struct PackReader {
+    source: Box<dyn Source>,
+    path: PathBuf,
+    file_length: u64,
+    header: Header,
+    manifest: Manifest,
+    entries: Vec<ChunkEntry>,
+    index: HashMap<(ChunkKind, u32, u32), usize>,
+}
+
+impl std::fmt::Debug for PackReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PackReader")
+            .field("path", &self.path)
+            .field("file_length", &self.file_length)
+            .field("header", &self.header)
+            .field("chunks", &self.entries.len())
+            .finish()
+    }
+}
+
+impl PackReader {
+    /// Opens the pack at `path`, reading and validating header, manifest and directory.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref().to_path_buf();
+        let file = File::open(&path).map_err(|e| PackError::io(&path, e))?;
+        let len = file.metadata().map_err(|e| PackError::io(&path, e))?.len();
+        #[cfg(unix)]
+        let source = FileSource(file);
+        #[cfg(not(unix))]
+        let source = FileSource(Mutex::new(file));
+        Self::from_source(Box::new(source), len, path)
+    }
+
+    /// Opens a pack from any seekable source (a `Cursor<Vec<u8>>`, a network range reader...).
+    pub fn from_reader<R: Read + Seek + Send + 'static>(mut reader: R) -> Result<Self> {
+        let len = reader
+            .seek(SeekFrom::End(0))
+            .map_err(|e| PackError::io("", e))?;
+        Self::from_source(
+            Box::new(StreamSource(Mutex::new(reader))),
+            len,
+            PathBuf::new(),
+        )
+    }
+
+    fn read_at(&self, offset: u64, len: u64) -> Result<Vec<u8>> {
+        read_range(&*self.source, &self.path, self.file_length, offset, len)
+    }
+
+    fn from_source(source: Box<dyn Source>, file_length: u64, path: PathBuf) -> Result<Self> {
+        let mut head = [0u8; HEADER_LEN as usize];
+        if file_length < HEADER_LEN {
+            return Err(PackError::Truncated {
+                expected: HEADER_LEN,
+                actual: file_length,
+            });
+        }
+        source
+            .read_exact_at(&mut head, 0)
+            .map_err(|e| PackError::io(&path, e))?;
+        let header = Header::parse(&head)?;
+        if header.file_length > file_length {
+            return Err(PackError::Truncated {
+                expected: header.file_length,
+                actual: file_length,
+            });
+        }
+        if header.file_length < file_length {
+            return Err(PackError::TrailingData {
+                expected: header.file_length,
+                actual: file_length,
+            });
+        }
+        // Sections: manifest then directory, both after the header and inside the file.
+        if header.manifest_length > MAX_MANIFEST_BYTES {
+            return Err(PackError::CountTooLarge {
+                what: "manifest bytes",
+                count: header.manifest_length,
+                max: MAX_MANIFEST_BYTES,
+            });
+        }
+        let max_rows = (file_length / DIRECTORY_ROW_LEN).min(MAX_CHUNKS);
+        if header.directory_count > max_rows {
+            return Err(PackError::CountTooLarge {
+                what: "directory rows",
+                count: header.directory_count,
+                max: max_rows,
+            });
+        }
+        let manifest_range = (header.manifest_offset, header.manifest_length);
+        let directory_range = (
+            header.directory_offset,
+            header.directory_count * DIRECTORY_ROW_LEN,
+        );
+        for (section, (off, len)) in [
+            (Section::Manifest, manifest_range),
+            (Section::Directory, directory_range),
+        ] {
+            let inside =
+                off >= HEADER_LEN && off.checked_add(len).is_some_and(|e| e <= file_length);
+            if !inside || overlaps(manifest_range, directory_range) {
+                return Err(PackError::SectionOutOfBounds {
+                    section,
+                    offset: off,
+                    length: len,
+                });
+            }
+        }
+        let read = |(off, len): (u64, u64)| read_range(&*source, &path, file_length, off, len);
+        let manifest_bytes = read(manifest_range)?;
+        let actual = checksum(&manifest_bytes);
+        if actual != header.manifest_checksum {
+            return Err(PackError::SectionChecksumMismatch {
+                section: Section::Manifest,
+                expected: header.manifest_checksum,
+                actual,
+            });
+        }
+        let directory_bytes = read(directory_range)?;
+        let actual = checksum(&directory_bytes);
+        if actual != header.directory_checksum {
+            return Err(PackError::SectionChecksumMismatch {
+                section: Section::Directory,
+                expected: header.directory_checksum,
+                actual,
+            });
+        }
+        let manifest = Manifest::from_json(&manifest_bytes)?;
+
+        let mut r = ByteReader::new(&directory_bytes, |reason| PackError::InvalidManifest {
+            reason,
+        });
+        let mut entries = Vec::with_capacity(header.directory_count as usize);
+        for i in 0..header.directory_count as usize {
+            entries.push(ChunkEntry::read(&mut r, i)?);
+        }
+        let index = validate_entries(
+            &entries,
+            &manifest,
+            file_length,
+            manifest_range,
+            directory_range,
+        )?;
+        Ok(PackReader {
+            source,
+            path,
+            file_length,
+            header,
+            manifest,
+            entries,
+            index,
+        })
+    }
+
+    /// The header.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// The manifest.
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// The directory rows.
+    pub fn entries(&self) -> &[ChunkEntry] {
+        &self.entries
+    }
+
+    /// Length of the pack in bytes.
+    pub fn file_length(&self) -> u64 {
+        self.file_length
+    }
+
+    /// The directory index of the chunk at `(kind, base_view, key)`, if there is one.
+    pub fn find(&self, kind: ChunkKind, base_view: u32, key: u32) -> Option<usize> {
+        self.index.get(&(kind, base_view, key)).copied()
+    }
+
+    fn entry(&self, index: usize) -> Result<(ChunkEntry, ChunkRef)> {
+        let e = *self.entries.get(index).ok_or(PackError::NoSuchChunk {
+            index,
+            count: self.entries.len(),
+        })?;
+        Ok((e, e.chunk_ref(index)))
+    }
+
+    /// Reads chunk `index`'s stored bytes (exactly its byte range) and verifies the checksum.
+    pub fn chunk_bytes(&self, index: usize) -> Result<Vec<u8>> {
+        let (e, chunk) = self.entry(index)?;
+        let bytes = self.read_at(e.offset, e.length)?;
+        let actual = checksum(&bytes);
+        if actual != e.checksum {
+            return Err(PackError::ChecksumMismatch {
+                chunk,
+                expected: e.checksum,
+                actual,
+            });
+        }
+        Ok(bytes)
+    }
+
+    /// Reads, verifies and decodes chunk `index`.
+    pub fn chunk(&self, index: usize) -> Result<Chunk> {
+        let (e, chunk) = self.entry(index)?;
+        let bytes = self.chunk_bytes(index)?;
+        let declared = declared_uncompressed_length(e.kind, &bytes).map_err(|err| match err {
+            PackError::InvalidInput { .. } => PackError::UnknownChunkKind { chunk },
+            other => other.in_chunk(chunk),
+        })?;
+        if declared != e.uncompressed_length {
+            return Err(PackError::UncompressedLengthMismatch {
+                chunk,
+                expected: e.uncompressed_length,
+                actual: declared,
+            });
+        }
+        let decoded = match e.kind {
+            ChunkKind::RadianceCube => decode_radiance(&bytes).map(Chunk::Radiance),
+            ChunkKind::DistanceCube => decode_distance(&bytes).map(Chunk::Distance),
+            ChunkKind::ObjectIdCube => decode_object_id(&bytes).map(Chunk::ObjectId),
+            ChunkKind::NormalCube => decode_normal(&bytes).map(Chunk::Normal),
+            ChunkKind::VolumeBlock => decode_volume_block(&bytes).map(Chunk::Volume),
+            ChunkKind::VolumeConnectivity => {
+                decode_connectivity(&bytes).map(|(sample_count, tetrahedra)| Chunk::Connectivity {
+                    sample_count,
+                    tetrahedra,
+                })
+            }
+            ChunkKind::ProxyMesh => decode_proxy_mesh(&bytes).map(Chunk::ProxyMesh),
+            ChunkKind::AnimationTracks => decode_tracks(&bytes).map(Chunk::Tracks),
+            ChunkKind::Unknown(_) => return Err(PackError::UnknownChunkKind { chunk }),
+        };
+        decoded.map_err(|err| err.in_chunk(chunk))
+    }
+
+    fn get(&self, kind: ChunkKind, base_view: u32, key: u32) -> Result<Chunk> {
+        let i = self
+            .find(kind, base_view, key)
+            .ok_or(PackError::ChunkNotFound {
+                kind,
+                base_view,
+                key,
+            })?;
+        self.chunk(i)
+    }
+
+    /// The radiance cube of `base_view` at time key `key`.
+    pub fn radiance(&self, base_view: u32, key: u32) -> Result<RadianceCube> {
+        match self.get(ChunkKind::RadianceCube, base_view, key)? {
+            Chunk::Radiance(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The distance cube of `base_view` at time key `key`.
+    pub fn distance(&self, base_view: u32, key: u32) -> Result<DistanceCube> {
+        match self.get(ChunkKind::DistanceCube, base_view, key)? {
+            Chunk::Distance(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The object-id cube of `base_view` at time key `key`.
+    pub fn object_id(&self, base_view: u32, key: u32) -> Result<ObjectIdCube> {
+        match self.get(ChunkKind::ObjectIdCube, base_view, key)? {
+            Chunk::ObjectId(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The normal cube of `base_view` at time key `key`.
+    pub fn normal(&self, base_view: u32, key: u32) -> Result<NormalCube> {
+        match self.get(ChunkKind::NormalCube, base_view, key)? {
+            Chunk::Normal(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// All four cubes of `base_view` at time key `key`.
+    pub fn range_image(&self, base_view: u32, key: u32) -> Result<RangeImage> {
+        Ok(RangeImage {
+            radiance: self.radiance(base_view, key)?,
+            distance: self.distance(base_view, key)?,
+            object_id: self.object_id(base_view, key)?,
+            normal: self.normal(base_view, key)?,
+        })
+    }
+
+    /// The volume block of `base_view` in time bucket `bucket`.
+    pub fn volume_block(&self, base_view: u32, bucket: u32) -> Result<VolumeBlock> {
+        match self.get(ChunkKind::VolumeBlock, base_view, bucket)? {
+            Chunk::Volume(b) => Ok(b),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The tetrahedra of `base_view`'s block in `bucket`, if the pack has them.
+    pub fn connectivity(&self, base_view: u32, bucket: u32) -> Result<Vec<[u32; 4]>> {
+        match self.get(ChunkKind::VolumeConnectivity, base_view, bucket)? {
+            Chunk::Connectivity { tetrahedra, .. } => Ok(tetrahedra),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The proxy mesh of object `object_id`.
+    pub fn proxy_mesh(&self, object_id: u32) -> Result<ProxyMesh> {
+        match self.get(ChunkKind::ProxyMesh, NO_BASE_VIEW, object_id)? {
+            Chunk::ProxyMesh(m) => Ok(m),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The animation tracks.
+    pub fn tracks(&self) -> Result<AnimationTracks> {
+        match self.get(ChunkKind::AnimationTracks, NO_BASE_VIEW, 0)? {
+            Chunk::Tracks(t) => Ok(t),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+}
+
+fn read_range(
+    source: &dyn Source,
+    path: &Path,
+    file_length: u64,
+    offset: u64,
+    len: u64,
+) -> Result<Vec<u8>> {
+    let end = offset.checked_add(len).filter(|&e| e <= file_length);
+    if end.is_none() || len > MAX_CHUNK_LENGTH {
+        return Err(PackError::Truncated {
+            expected: offset.saturating_add(len),
+            actual: file_length,
+        });
+    }
+    let mut buf = vec![0u8; len as usize];
+    source.read_exact_at(&mut buf, offset).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            PackError::Truncated {
+                expected: offset + len,
+                actual: file_length,
+            }
+        } else {
+            PackError::io(path, e)
+        }
+    })?;
+    Ok(buf)
+}
+
+fn overlaps(a: (u64, u64), b: (u64, u64)) -> bool {
+    a.1 > 0 && b.1 > 0 && a.0 < b.0.saturating_add(b.1) && b.0 < a.0.saturating_add(a.1)
+}
+
+fn validate_entries(
+    entries: &[ChunkEntry],
+    manifest: &Manifest,
+    file_length: u64,
+    manifest_range: (u64, u64),
+    directory_range: (u64, u64),
+) -> Result<HashMap<(ChunkKind, u32, u32), usize>> {
+    let mut index = HashMap::with_capacity(entries.len());
+    for (i, e) in entries.iter().enumerate() {
+        let chunk = e.chunk_ref(i);
+        let inside = e.offset >= HEADER_LEN
+            && e.offset
+                .checked_add(e.length)
+                .is_some_and(|end| end <= file_length)
+            && e.length <= MAX_CHUNK_LENGTH;
+        let range = (e.offset, e.length);
+        if !inside || overlaps(range, manifest_range) || overlaps(range, directory_range) {
+            return Err(PackError::ChunkOutOfBounds {
+                chunk,
+                offset: e.offset,
+                length: e.length,
+                limit: file_length,
+            });
+        }
+        if e.base_view != NO_BASE_VIEW && e.base_view as usize >= manifest.base_views.len() {
+            return Err(PackError::UnknownBaseView {
+                chunk,
+                base_view: e.base_view,
+                count: manifest.base_views.len(),
+            });
+        }
+        if let Some(prev) = index.insert((e.kind, e.base_view, e.key), i) {
+            return Err(PackError::DuplicateChunk {
+                a: entries[prev].chunk_ref(prev),
+                b: chunk,
+            });
+        }
+    }
+    let mut order: Vec<usize> = (0..entries.len())
+        .filter(|&i| entries[i].length > 0)
+        .collect();
+    order.sort_unstable_by_key(|&i| entries[i].offset);
+    for w in order.windows(2) {
+        let (a, b) = (&entries[w[0]], &entries[w[1]]);
+        if a.offset + a.length > b.offset {
+            return Err(PackError::OverlappingChunks {
+                a: a.chunk_ref(w[0]),
+                b: b.chunk_ref(w[1]),
+            });
+        }
+    }
+    Ok(index)
+}
