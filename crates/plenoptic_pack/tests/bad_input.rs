@@ -1,0 +1,274 @@
+//! Bad packs: each kind of damage gives its own error, naming the chunk where there is one.
+
+mod common;
+
+use std::io::Cursor;
+
+use common::*;
+use plenoptic_pack::*;
+
+fn small_pack() -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.pack");
+    write_small_pack(&path);
+    std::fs::read(path).unwrap()
+}
+
+fn open(bytes: Vec<u8>) -> Result<PackReader> {
+    PackReader::from_reader(Cursor::new(bytes))
+}
+
+fn header(bytes: &[u8]) -> Header {
+    Header::parse(bytes[..128].try_into().unwrap()).unwrap()
+}
+
+/// Edits directory row `row` (byte offset `field` inside the 48-byte row) and fixes up the
+/// directory and header checksums so that only the edit is wrong.
+fn edit_row(bytes: &mut [u8], row: usize, field: usize, value: u64, width: usize) {
+    let mut h = header(bytes);
+    let at = h.directory_offset as usize + row * 48 + field;
+    bytes[at..at + width].copy_from_slice(&value.to_le_bytes()[..width]);
+    let dir = &bytes[h.directory_offset as usize..][..h.directory_count as usize * 48];
+    h.directory_checksum = checksum(dir);
+    bytes[..128].copy_from_slice(&h.to_bytes());
+}
+
+fn rewrite_header(bytes: &mut [u8], f: impl FnOnce(&mut Header)) {
+    let mut h = header(bytes);
+    f(&mut h);
+    bytes[..128].copy_from_slice(&h.to_bytes());
+}
+
+#[test]
+fn truncated_file() {
+    let mut b = small_pack();
+    let len = b.len() as u64;
+    b.truncate(b.len() - 10);
+    match open(b).unwrap_err() {
+        PackError::Truncated { expected, actual } => {
+            assert_eq!((expected, actual), (len, len - 10))
+        }
+        e => panic!("{e}"),
+    }
+    assert!(matches!(
+        open(vec![0; 20]).unwrap_err(),
+        PackError::Truncated { expected: 128, actual: 20 }
+    ));
+}
+
+#[test]
+fn wrong_magic() {
+    let mut b = small_pack();
+    b[..8].copy_from_slice(b"NOTAPACK");
+    assert!(matches!(open(b).unwrap_err(), PackError::BadMagic(m) if &m == b"NOTAPACK"));
+}
+
+#[test]
+fn unknown_major_version() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.version_major = 2);
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::UnsupportedVersion { major: 2, supported: 1, .. }
+    ));
+}
+
+#[test]
+fn newer_minor_version_opens() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.version_minor = 7);
+    assert_eq!(open(b).unwrap().header().version_minor, 7);
+}
+
+#[test]
+fn header_checksum() {
+    let mut b = small_pack();
+    b[100] ^= 1;
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::SectionChecksumMismatch { section: Section::Header, .. }
+    ));
+}
+
+#[test]
+fn directory_entry_past_eof() {
+    let mut b = small_pack();
+    let len = b.len() as u64;
+    edit_row(&mut b, 3, 16, len - 5, 8);
+    match open(b).unwrap_err() {
+        PackError::ChunkOutOfBounds { chunk, limit, .. } => {
+            assert_eq!(chunk.index, 3);
+            assert_eq!(chunk.kind, ChunkKind::NormalCube);
+            assert_eq!(limit, len);
+        }
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
+fn chunk_overlapping_manifest() {
+    let mut b = small_pack();
+    let h = header(&b);
+    edit_row(&mut b, 0, 16, h.manifest_offset - 10, 8);
+    assert!(matches!(open(b).unwrap_err(), PackError::ChunkOutOfBounds { .. }));
+}
+
+#[test]
+fn overlapping_chunks() {
+    let mut b = small_pack();
+    let h = header(&b);
+    let row0 = h.directory_offset as usize;
+    let off0 = u64::from_le_bytes(b[row0 + 16..row0 + 24].try_into().unwrap());
+    edit_row(&mut b, 1, 16, off0 + 1, 8);
+    match open(b).unwrap_err() {
+        PackError::OverlappingChunks { a, b } => assert_eq!((a.index, b.index), (0, 1)),
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
+fn counts_larger_than_the_file() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.directory_count = 1 << 40);
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::CountTooLarge { what: "directory rows", .. }
+    ));
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.manifest_length = u64::MAX);
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::CountTooLarge { what: "manifest bytes", .. }
+    ));
+}
+
+#[test]
+fn section_out_of_bounds() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.manifest_offset = 3);
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::SectionOutOfBounds { section: Section::Manifest, .. }
+    ));
+}
+
+#[test]
+fn chunk_checksum_mismatch() {
+    let mut b = small_pack();
+    let h = header(&b);
+    // Row 5: the distance cube of base view 0 at time key 1.
+    let row = h.directory_offset as usize + 5 * 48;
+    let off = u64::from_le_bytes(b[row + 16..row + 24].try_into().unwrap()) as usize;
+    b[off + 200] ^= 0x40;
+    let r = open(b).unwrap();
+    match r.chunk(5).unwrap_err() {
+        PackError::ChecksumMismatch { chunk, .. } => {
+            assert_eq!(chunk.index, 5);
+            assert_eq!(chunk.kind, ChunkKind::DistanceCube);
+            assert_eq!(chunk.base_view, 0);
+            assert_eq!(chunk.key, 1);
+        }
+        e => panic!("{e}"),
+    }
+    // Other chunks still read.
+    assert!(r.chunk(0).is_ok());
+}
+
+fn pack_with_raw(kind: ChunkKind, bytes: &[u8]) -> PackReader {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("raw.pack");
+    let mut w = PackWriter::create(&path).unwrap();
+    w.add_raw_chunk(kind, 0, 0, bytes, 6 * 64 * 4, None).unwrap();
+    w.finish(&manifest(1)).unwrap();
+    PackReader::open(&path).unwrap()
+}
+
+#[test]
+fn malformed_ktx2_inside_a_good_chunk() {
+    let good = encode_radiance(&room_image(8, 0.0).radiance, RadianceFormat::Rgb9e5).unwrap();
+    let mut cases: Vec<(&str, Vec<u8>)> = Vec::new();
+    let mut faces = good.clone();
+    faces[36..40].copy_from_slice(&1u32.to_le_bytes());
+    cases.push(("faceCount 1", faces));
+    cases.push(("truncated", good[..good.len() - 7].to_vec()));
+    let mut dfd = good.clone();
+    // texelBlockDimension0 = 255 (would panic ktx2 0.5's DFD parser).
+    let dfd_off = u32::from_le_bytes(good[48..52].try_into().unwrap()) as usize;
+    dfd[dfd_off + 4 + 8 + 4] = 255;
+    cases.push(("DFD", dfd));
+    let mut sc = good.clone();
+    sc[44..48].copy_from_slice(&0u32.to_le_bytes());
+    cases.push(("no supercompression", sc));
+    let mut level = good.clone();
+    level[80 + 8..80 + 16].copy_from_slice(&u64::MAX.to_le_bytes());
+    cases.push(("level length", level));
+    for (what, bytes) in cases {
+        let r = pack_with_raw(ChunkKind::RadianceCube, &bytes);
+        match r.chunk(0).unwrap_err() {
+            PackError::MalformedKtx2 { chunk, reason } => {
+                assert_eq!(chunk.unwrap().kind, ChunkKind::RadianceCube, "{what}: {reason}")
+            }
+            e => panic!("{what}: {e}"),
+        }
+    }
+    // A good KTX2 of the wrong kind's format is malformed for that kind, too.
+    let r = pack_with_raw(ChunkKind::DistanceCube, &good);
+    assert!(matches!(r.chunk(0).unwrap_err(), PackError::MalformedKtx2 { .. }));
+}
+
+#[test]
+fn uncompressed_length_mismatch() {
+    let good = encode_radiance(&room_image(4, 0.0).radiance, RadianceFormat::Rgb9e5).unwrap();
+    let r = pack_with_raw(ChunkKind::RadianceCube, &good); // says 6·64·4, is 6·16·4
+    assert!(matches!(
+        r.chunk(0).unwrap_err(),
+        PackError::UncompressedLengthMismatch { expected: 1536, actual: 384, .. }
+    ));
+}
+
+#[test]
+fn unknown_kind_opens_but_does_not_decode() {
+    let r = pack_with_raw(ChunkKind::Unknown(77), b"future payload");
+    assert_eq!(r.chunk_bytes(0).unwrap(), b"future payload");
+    assert!(matches!(r.chunk(0).unwrap_err(), PackError::UnknownChunkKind { .. }));
+}
+
+#[test]
+fn writer_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("w.pack");
+    let mut w = PackWriter::create(&path).unwrap();
+    let img = room_image(4, 0.0);
+    w.add_range_image(0, 0, &img, CubeFormats::default()).unwrap();
+    assert!(matches!(
+        w.add_range_image(0, 0, &img, CubeFormats::default()).unwrap_err(),
+        PackError::DuplicateChunk { .. }
+    ));
+    assert!(matches!(
+        w.add_chunk(ChunkKind::RadianceCube, 0, 1, b"junk").unwrap_err(),
+        PackError::MalformedKtx2 { chunk: Some(_), .. }
+    ));
+    assert!(matches!(
+        w.add_raw_chunk(ChunkKind::VolumeBlock, 0, 0, b"x", 0, Some(1)).unwrap_err(),
+        PackError::ChecksumMismatch { .. }
+    ));
+    w.add_range_image(5, 0, &img, CubeFormats::default()).unwrap();
+    assert!(matches!(
+        w.finish(&manifest(1)).unwrap_err(),
+        PackError::UnknownBaseView { base_view: 5, .. }
+    ));
+    assert!(!path.exists());
+}
+
+#[test]
+fn bad_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.pack");
+    let mut m = manifest(1);
+    m.bucket_span = 0.0;
+    assert!(PackWriter::create(&path).unwrap().finish(&m).is_err());
+    assert!(matches!(
+        Manifest::from_json(b"{\"units\": 3}").unwrap_err(),
+        PackError::InvalidManifest { .. }
+    ));
+}

@@ -1,0 +1,264 @@
+//! Shared fixtures: a fully populated manifest, smooth synthetic range images and volume
+//! samples, and a small complete pack.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+
+use glam::{Quat, Vec3};
+use plenoptic_pack::*;
+
+/// Deterministic xorshift PRNG.
+pub struct Rng(pub u64);
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.0 = x;
+        x
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n.max(1)
+    }
+    pub fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    pub fn direction(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(self.unit(), self.unit(), self.unit()) * 2.0 - Vec3::ONE;
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+pub fn manifest(base_views: usize) -> Manifest {
+    let mut m = Manifest::new(TimeRange { start: 0.0, end: 2.0 }, 0.5);
+    m.scene_bounds = Aabb {
+        min: Vec3::new(-3.0, 0.0, -4.0),
+        max: Vec3::new(3.0, 2.7, 4.0),
+    };
+    m.view_space = ViewSpace::Rectangle {
+        corners: [
+            Vec3::new(-1.0, 1.6, -1.0),
+            Vec3::new(1.0, 1.6, -1.0),
+            Vec3::new(1.0, 1.6, 1.0),
+            Vec3::new(-1.0, 1.6, 1.0),
+        ],
+    };
+    m.base_views = (0..base_views)
+        .map(|i| BaseView {
+            id: 100 + i as u32,
+            position: Vec3::new(i as f32 * 0.5 - 1.0, 1.6, 0.1 * i as f32),
+            time_keys: vec![0.0, 0.75, 2.0],
+        })
+        .collect();
+    m.objects = vec![
+        ObjectEntry {
+            id: 1,
+            name: "walls".into(),
+            node_path: "/Scene/Room/Walls".into(),
+            motion: Motion::Static,
+            proxy_mesh: Some(1),
+        },
+        ObjectEntry {
+            id: 2,
+            name: "chair".into(),
+            node_path: "/Scene/Room/Chair".into(),
+            motion: Motion::Animated,
+            proxy_mesh: Some(2),
+        },
+    ];
+    m.lights = vec![
+        Light {
+            kind: LightKind::Spot {
+                inner_cone: 0.3,
+                outer_cone: 0.6,
+            },
+            colour: Vec3::new(1.0, 0.9, 0.8),
+            intensity: 800.0,
+            follows_object: Some(2),
+            node_path: Some("/Scene/Lamp".into()),
+        },
+        Light {
+            kind: LightKind::Area {
+                width: 1.2,
+                height: 0.8,
+            },
+            colour: Vec3::ONE,
+            intensity: 12.5,
+            follows_object: None,
+            node_path: None,
+        },
+        Light {
+            kind: LightKind::Directional,
+            colour: Vec3::new(1.0, 0.95, 0.9),
+            intensity: 3.0,
+            follows_object: None,
+            node_path: Some("/Scene/Sun".into()),
+        },
+    ];
+    m.bake = BakeSettings {
+        quality: 0.9,
+        cube_face_size: 16,
+        samples_per_texel: 64,
+        volume_samples_per_view: 10_000,
+        extra: BTreeMap::from([("recipe".to_string(), "room".to_string())]),
+    };
+    m.stats = BakeStatistics {
+        phase_seconds: BTreeMap::from([("range_images".to_string(), 12.345_678_9)]),
+        sample_counts: BTreeMap::from([("camera_rays".to_string(), 123_456_789_012)]),
+        bytes: BTreeMap::from([("radiance".to_string(), 98_765)]),
+    };
+    m
+}
+
+/// A procedural room seen from its centre: analytic distance to an axis-aligned box room, a
+/// few surfaces with their own ids, smooth light falloff and a bright window.
+pub fn room_image(n: u32, phase: f32) -> RangeImage {
+    let half = Vec3::new(3.0, 1.4, 4.0);
+    let mut img = RangeImage::new(n);
+    let mut dist = Vec::new();
+    let mut ids = Vec::new();
+    let mut normals = Vec::new();
+    let mut rad = Vec::new();
+    for i in 0..6 * (n as usize).pow(2) {
+        let d = plenoptic_pack::cube::texel_direction(n, i);
+        // Distance to the room's walls along d.
+        let ratios = half / d.abs().max(Vec3::splat(1e-9));
+        let t = ratios.min_element();
+        let p = d * t;
+        let axis = if ratios.x == t {
+            0
+        } else if ratios.y == t {
+            1
+        } else {
+            2
+        };
+        let mut normal = Vec3::ZERO;
+        normal[axis] = -d[axis].signum();
+        let mut id = 1 + axis as u32 * 2 + (d[axis] > 0.0) as u32;
+        let mut dist_v = t;
+        // A box (table) in front: a depth discontinuity.
+        let table_t = (0.9 - 0.0) / d.z.max(1e-6);
+        let q = d * table_t;
+        if d.z > 0.2 && q.x.abs() < 0.6 && q.y < -0.2 && q.y > -0.8 {
+            dist_v = table_t;
+            id = 9;
+            normal = -Vec3::Z;
+        }
+        let light = Vec3::new(0.5 + phase, 1.2, 0.0);
+        let hit = d * dist_v;
+        let falloff = 2.0 / (1.0 + (hit - light).length_squared());
+        let albedo = Vec3::new(0.6 + 0.05 * id as f32, 0.55, 0.5 - 0.03 * id as f32);
+        let mut r = albedo * falloff;
+        // A bright window on the +X wall.
+        if axis == 0 && d.x > 0.0 && p.y.abs() < 0.5 && p.z.abs() < 1.0 {
+            r = Vec3::new(40.0, 38.0, 35.0);
+            id = 20;
+        }
+        dist.push(dist_v);
+        ids.push(id);
+        normals.push(normal);
+        rad.push(r);
+    }
+    img.radiance.texels = rad;
+    img.distance.texels = dist;
+    img.object_id.texels = ids;
+    img.normal.texels = normals;
+    img
+}
+
+pub fn volume_samples(count: usize, t0: f32, t1: f32, seed: u64) -> Vec<VolumeSample> {
+    let mut rng = Rng(seed | 1);
+    (0..count)
+        .map(|i| VolumeSample {
+            direction: rng.direction(),
+            t: t0 + (t1 - t0) * rng.unit(),
+            radiance: Vec3::new(rng.unit() * 10.0, rng.unit(), rng.unit() * 0.1),
+            distance: 0.5 + rng.unit() * 8.0,
+            normal: rng.direction(),
+            object_id: (i % 7) as u32,
+            radius: 0.001 + rng.unit() * 0.05,
+        })
+        .collect()
+}
+
+pub fn proxy_mesh(object_id: u32, with_normals: bool) -> ProxyMesh {
+    ProxyMesh {
+        object_id,
+        positions: vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.5, 0.0),
+            Vec3::new(0.25, 0.125, -3.5),
+        ],
+        indices: vec![0, 1, 2, 2, 1, 3],
+        normals: with_normals.then(|| vec![Vec3::Z, Vec3::Z, Vec3::Y, -Vec3::X]),
+    }
+}
+
+pub fn tracks() -> AnimationTracks {
+    AnimationTracks {
+        objects: vec![
+            ObjectTracks {
+                object_id: 2,
+                translation: Some(Track {
+                    interpolation: Interpolation::Linear,
+                    times: vec![0.0, 1.0, 2.0],
+                    values: vec![Vec3::ZERO, Vec3::new(0.5, 0.0, 0.25), Vec3::X],
+                }),
+                rotation: Some(Track {
+                    interpolation: Interpolation::CubicSpline,
+                    times: vec![0.0, 2.0],
+                    values: vec![
+                        Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+                        Quat::IDENTITY,
+                        Quat::from_xyzw(0.0, 0.1, 0.0, 0.0),
+                        Quat::from_xyzw(0.0, 0.2, 0.0, 0.0),
+                        Quat::from_rotation_y(1.0),
+                        Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+                    ],
+                }),
+                scale: None,
+            },
+            ObjectTracks {
+                object_id: 3,
+                translation: None,
+                rotation: None,
+                scale: Some(Track {
+                    interpolation: Interpolation::Step,
+                    times: vec![0.5],
+                    values: vec![Vec3::splat(2.0)],
+                }),
+            },
+        ],
+    }
+}
+
+/// Writes a small pack with every chunk kind to `path`; returns the manifest.
+pub fn write_small_pack(path: &std::path::Path) -> Manifest {
+    let m = manifest(2);
+    let mut w = PackWriter::create(path).unwrap();
+    for v in 0..2u32 {
+        for k in 0..2u32 {
+            w.add_range_image(v, k, &room_image(8, k as f32 * 0.3), CubeFormats::default())
+                .unwrap();
+        }
+        let s = volume_samples(64, 0.0, 0.5, 7 + v as u64);
+        let tets: Vec<[u32; 4]> = (0..20u32).map(|i| [i, i + 1, i + 2, i + 3]).collect();
+        w.add_volume_block(v, 0, (0.0, 0.5), &s, Some(&tets)).unwrap();
+    }
+    w.add_proxy_mesh(&proxy_mesh(1, true)).unwrap();
+    w.add_proxy_mesh(&proxy_mesh(2, false)).unwrap();
+    w.add_tracks(&tracks()).unwrap();
+    w.finish(&m).unwrap();
+    m
+}
+
+/// Reads and decodes every chunk; returns how many decoded.
+pub fn read_all(r: &PackReader) -> usize {
+    (0..r.entries().len()).filter(|&i| r.chunk(i).is_ok()).count()
+}
