@@ -57,6 +57,9 @@ pub mod reader;
 pub mod volume;
 pub mod writer;
 
+/// The glam this crate's types use (the workspace's one glam).
+pub use glam;
+
 pub use cube::{direction_to_face_uv, face_uv_to_direction};
 pub use directory::{ChunkEntry, ChunkKind, NO_BASE_VIEW};
 pub use error::{ChunkRef, PackError, Result, Section};
