@@ -1,0 +1,152 @@
+//! The per-sample stage of multi-stage rendering (thesis §5.3.5, where *Radiance* computed
+//! direct and specular light and read indirect diffuse light from the ambient file).
+//!
+//! Radiance leaving a hit towards the viewer =
+//! emission
+//! + direct light from punctual lights (one shadow ray each) and emissive triangles
+//!   (`shadow_samples` shadow rays: soft shadows), through the full BSDF
+//! + diffuse albedo × ambient-field irradiance / π
+//! + specular reflection and refraction traced recursively up to `max_specular_depth`
+//!   (one ray for ideal lobes, `glossy_samples` GGX samples for rough ones at the first hit).
+//!
+//! Emitters found by glossy rays and by light sampling are combined with the power heuristic;
+//! the diffuse lobe sees emitters through light sampling only.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::AmbientField;
+use crate::accel::{PlacedScene, Ray};
+use crate::camera::{Camera, CubeCamera};
+use crate::image::Image;
+use crate::light::estimate_direct;
+use crate::material::{Bsdf, Lobes, SurfaceProps};
+use crate::render::{RadianceSample, render_camera};
+use crate::sampling::{Sampler, power_heuristic};
+
+/// Settings of the [`MultiStageRenderer`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MultiStageSettings {
+    /// Samples per pixel (anti-aliasing and the noise of soft shadows and glossy rays).
+    pub samples_per_pixel: u32,
+    /// Shadow rays towards emissive triangles per hit; soft-shadow noise falls as 1/√n.
+    pub shadow_samples: u32,
+    /// GGX rays for a rough specular lobe at the first hit (deeper hits use one).
+    pub glossy_samples: u32,
+    /// Largest number of specular bounces traced.
+    pub max_specular_depth: u32,
+    /// Seed of the random streams.
+    pub seed: u64,
+}
+
+impl Default for MultiStageSettings {
+    fn default() -> Self {
+        Self {
+            samples_per_pixel: 8,
+            shadow_samples: 4,
+            glossy_samples: 2,
+            max_specular_depth: 4,
+            seed: 0,
+        }
+    }
+}
+
+/// The multi-stage renderer over one ambient field.
+#[derive(Debug, Clone, Copy)]
+pub struct MultiStageRenderer<'f> {
+    /// Settings.
+    pub settings: MultiStageSettings,
+    field: &'f AmbientField,
+}
+
+impl<'f> MultiStageRenderer<'f> {
+    /// A renderer reading indirect light from `field` (which should have been gathered for the
+    /// same time, or interpolated to it with [`AmbientField::lerp`]).
+    pub fn new(settings: MultiStageSettings, field: &'f AmbientField) -> Self {
+        Self { settings, field }
+    }
+
+    /// Radiance along one ray with the first hit's auxiliary data; the function the baker
+    /// calls per temporal-volume sample.
+    pub fn sample(&self, placed: &PlacedScene<'_>, ray: &Ray, sampler: &mut Sampler) -> RadianceSample {
+        let mut out = RadianceSample::MISS;
+        out.radiance = self.shade(placed, ray, sampler, 0, None, &mut |hit| {
+            out = RadianceSample::first_hit(hit, ray);
+        });
+        out
+    }
+
+    fn shade(
+        &self,
+        placed: &PlacedScene<'_>,
+        ray: &Ray,
+        s: &mut Sampler,
+        depth: u32,
+        prev_pdf: Option<f32>,
+        on_hit: &mut dyn FnMut(&crate::Hit),
+    ) -> Vec3 {
+        let Some(hit) = placed.intersect(ray) else {
+            return Vec3::ZERO;
+        };
+        on_hit(&hit);
+        let scene = placed.scene();
+        let props = SurfaceProps::at(scene, &hit);
+        let mut l = Vec3::ZERO;
+        let le = props.emission(&hit);
+        if le != Vec3::ZERO {
+            let w = match prev_pdf {
+                None => 1.0,
+                Some(p) => power_heuristic(p, placed.lights().emissive_pdf(ray.origin, &hit)),
+            };
+            l += le * w;
+        }
+        let wo = -ray.direction;
+        let bsdf = Bsdf::new(&props, &hit, wo);
+        if !bsdf.is_delta(Lobes::All) {
+            let n = self.settings.shadow_samples.max(1);
+            l += estimate_direct(placed, &hit, &bsdf, Lobes::All, Some(Lobes::Specular), n, s);
+        }
+        let albedo = bsdf.diffuse_albedo();
+        if albedo != Vec3::ZERO {
+            l += albedo * self.field.irradiance_at(hit.object, hit.triangle, hit.barycentrics) / PI;
+        }
+        if depth < self.settings.max_specular_depth && bsdf.has(Lobes::Specular) {
+            let rough = !bsdf.is_delta(Lobes::Specular);
+            let count = if rough && depth == 0 {
+                self.settings.glossy_samples.max(1)
+            } else {
+                1
+            };
+            let mut sum = Vec3::ZERO;
+            for _ in 0..count {
+                let u_lobe = s.next_f32();
+                let u = s.next_2d();
+                let Some(bs) = bsdf.sample(u_lobe, u, Lobes::Specular) else {
+                    continue;
+                };
+                let next = Ray::new(hit.offset_origin(bs.wi), bs.wi);
+                let pdf = (!bs.delta).then_some(bs.pdf);
+                sum += bs.weight * self.shade(placed, &next, s, depth + 1, pdf, &mut |_| {});
+            }
+            l += sum / count as f32;
+        }
+        l
+    }
+
+    /// Renders a pinhole (or any) camera.
+    pub fn render(&self, placed: &PlacedScene<'_>, camera: &(impl Camera + ?Sized)) -> Image<RadianceSample> {
+        render_camera(camera, self.settings.samples_per_pixel, self.settings.seed, |ray, s, _| {
+            self.sample(placed, ray, s)
+        })
+    }
+
+    /// Renders the six faces of a cube camera in KTX2 layer order (+X, −X, +Y, −Y, +Z, −Z).
+    pub fn render_cube(&self, placed: &PlacedScene<'_>, cube: &CubeCamera) -> [Image<RadianceSample>; 6] {
+        cube.faces().map(|face| {
+            let seed = self.settings.seed ^ (0x51ed_270b_u64.wrapping_mul(face.face.index() as u64 + 1));
+            render_camera(&face, self.settings.samples_per_pixel, seed, |ray, s, _| {
+                self.sample(placed, ray, s)
+            })
+        })
+    }
+}

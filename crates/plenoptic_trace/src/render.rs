@@ -1,0 +1,96 @@
+//! What both renderers return per sample, and the pixel loop they share.
+
+use glam::{Vec2, Vec3};
+use plenoptic_scene::{NO_OBJECT, ObjectId};
+
+use crate::accel::{Hit, Ray};
+use crate::camera::Camera;
+use crate::image::Image;
+use crate::sampling::Sampler;
+
+/// Radiance along one ray with what the first hit tells about the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadianceSample {
+    /// Linear RGB radiance arriving along the ray.
+    pub radiance: Vec3,
+    /// Distance to the first hit; infinite for a miss.
+    pub distance: f32,
+    /// Object of the first hit; [`NO_OBJECT`] for a miss.
+    pub object: ObjectId,
+    /// Shading normal of the first hit facing the ray; zero for a miss.
+    pub normal: Vec3,
+}
+
+impl RadianceSample {
+    /// A miss: no radiance (scenes have no environment), infinite distance.
+    pub const MISS: Self = Self {
+        radiance: Vec3::ZERO,
+        distance: f32::INFINITY,
+        object: NO_OBJECT,
+        normal: Vec3::ZERO,
+    };
+
+    pub(crate) fn first_hit(hit: &Hit, ray: &Ray) -> Self {
+        let n = if hit.shading_normal.dot(ray.direction) > 0.0 {
+            -hit.shading_normal
+        } else {
+            hit.shading_normal
+        };
+        Self {
+            radiance: Vec3::ZERO,
+            distance: hit.distance,
+            object: hit.object,
+            normal: n,
+        }
+    }
+}
+
+/// Renders `camera` with `spp` jittered samples per pixel: radiance is the mean, the auxiliary
+/// fields come from a ray through the pixel centre. Sample k of pixel i draws from
+/// `Sampler::new(seed, i, k)`, so the image is the same for any thread count.
+pub fn render_camera<C, F>(camera: &C, spp: u32, seed: u64, f: F) -> Image<RadianceSample>
+where
+    C: Camera + ?Sized,
+    F: Fn(&Ray, &mut Sampler, bool) -> RadianceSample + Sync,
+{
+    let (w, h) = camera.resolution();
+    let spp = spp.max(1);
+    Image::render(w, h, |x, y| {
+        let pixel = u64::from(y) * u64::from(w) + u64::from(x);
+        let mut sum = Vec3::ZERO;
+        let mut aux = RadianceSample::MISS;
+        let mut any = false;
+        for k in 0..spp {
+            let mut s = Sampler::new(seed, pixel, u64::from(k));
+            let offset = if k == 0 { Vec2::splat(0.5) } else { s.next_2d() };
+            let Some(ray) = camera.ray(x, y, offset) else {
+                continue;
+            };
+            any = true;
+            let r = f(&ray, &mut s, k == 0);
+            if k == 0 {
+                aux = r;
+            }
+            sum += r.radiance;
+        }
+        if !any {
+            return RadianceSample::MISS;
+        }
+        RadianceSample {
+            radiance: sum / spp as f32,
+            ..aux
+        }
+    })
+}
+
+impl Image<RadianceSample> {
+    /// The radiance channel.
+    pub fn radiance(&self) -> Image<Vec3> {
+        self.map(|s| s.radiance)
+    }
+
+    /// The object-id channel.
+    pub fn objects(&self) -> Image<ObjectId> {
+        self.map(|s| s.object)
+    }
+}

@@ -1,0 +1,388 @@
+//! Small scene construction helpers for tests, examples and benchmarks: meshes (quads, boxes,
+//! spheres), materials and a builder that assembles a [`Scene`] directly, plus the furnished
+//! room used to compare the renderers.
+//!
+//! (Scenes from files come from `plenoptic_scene`'s importer; this is only for programmatic
+//! test scenes.)
+
+use glam::{Quat, Vec2, Vec3, Vec4};
+use plenoptic_scene::{
+    Interpolation, Key, Light, LightKind, Material, Mesh, Node, Object, ObjectId, Scene, Track,
+    Trs, TrsTrack,
+};
+use std::f32::consts::PI;
+
+/// A quad of `size` in the XZ plane, centred, facing +Y.
+pub fn quad(size: Vec2) -> Mesh {
+    let (hx, hz) = (size.x * 0.5, size.y * 0.5);
+    Mesh {
+        positions: vec![
+            Vec3::new(-hx, 0.0, -hz),
+            Vec3::new(-hx, 0.0, hz),
+            Vec3::new(hx, 0.0, hz),
+            Vec3::new(hx, 0.0, -hz),
+        ],
+        normals: vec![Vec3::Y; 4],
+        uvs: vec![Vec2::ZERO, Vec2::Y, Vec2::ONE, Vec2::X],
+        tangents: Vec::new(),
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
+/// An axis-aligned box of `size`, centred, with outward faces (24 vertices, flat normals).
+pub fn cuboid(size: Vec3) -> Mesh {
+    let h = size * 0.5;
+    let mut mesh = Mesh::default();
+    for axis in 0..3 {
+        for sign in [1.0f32, -1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            let u = Vec3::from_array(std::array::from_fn(|i| if i == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+            let v = n.cross(u);
+            let base = mesh.positions.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                mesh.positions.push((n + u * a + v * b) * h);
+                mesh.normals.push(n);
+                mesh.uvs.push(Vec2::new((a + 1.0) * 0.5, (b + 1.0) * 0.5));
+            }
+            mesh.triangles.push([base, base + 1, base + 2]);
+            mesh.triangles.push([base, base + 2, base + 3]);
+        }
+    }
+    mesh
+}
+
+/// A UV sphere of `radius` with `segments` around and `rings` from pole to pole, outward.
+pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
+    let (segments, rings) = (segments.max(3), rings.max(2));
+    let mut mesh = Mesh::default();
+    for r in 0..=rings {
+        let theta = PI * r as f32 / rings as f32;
+        for s in 0..=segments {
+            let phi = 2.0 * PI * s as f32 / segments as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            mesh.positions.push(n * radius);
+            mesh.normals.push(n);
+            mesh.uvs
+                .push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+        }
+    }
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * row + s;
+            let b = a + row;
+            if r != 0 {
+                mesh.triangles.push([a, b, a + 1]);
+            }
+            if r != rings - 1 {
+                mesh.triangles.push([a + 1, b, b + 1]);
+            }
+        }
+    }
+    mesh
+}
+
+/// The mesh turned inside out: winding and normals reversed.
+pub fn inverted(mut mesh: Mesh) -> Mesh {
+    for t in &mut mesh.triangles {
+        t.swap(1, 2);
+    }
+    for n in &mut mesh.normals {
+        *n = -*n;
+    }
+    mesh
+}
+
+/// A pure Lambertian material of albedo `color` (metallic 0, roughness 1, IOR 1 so that the
+/// dielectric Fresnel layer vanishes: exactly albedo/π).
+pub fn diffuse(color: Vec3) -> Material {
+    Material {
+        name: "diffuse".into(),
+        base_color: color.extend(1.0),
+        metallic: 0.0,
+        roughness: 1.0,
+        ior: 1.0,
+        ..Material::default()
+    }
+}
+
+/// A dielectric with a GGX coat of `roughness` (IOR 1.5) over a Lambertian base.
+pub fn plastic(color: Vec3, roughness: f32) -> Material {
+    Material {
+        name: "plastic".into(),
+        base_color: color.extend(1.0),
+        metallic: 0.0,
+        roughness,
+        ..Material::default()
+    }
+}
+
+/// A metal of reflectance `color` and `roughness` (0 = mirror).
+pub fn metal(color: Vec3, roughness: f32) -> Material {
+    Material {
+        name: "metal".into(),
+        base_color: color.extend(1.0),
+        metallic: 1.0,
+        roughness,
+        ..Material::default()
+    }
+}
+
+/// A clear dielectric (transmission 1) of index `ior` and `roughness`.
+pub fn glass(ior: f32, roughness: f32) -> Material {
+    Material {
+        name: "glass".into(),
+        base_color: Vec4::ONE,
+        metallic: 0.0,
+        roughness,
+        transmission: 1.0,
+        ior,
+        ..Material::default()
+    }
+}
+
+/// A black Lambertian emitter of radiance `radiance` (front faces).
+pub fn emitter(radiance: Vec3) -> Material {
+    Material {
+        name: "emitter".into(),
+        emissive: radiance,
+        ..diffuse(Vec3::ZERO)
+    }
+}
+
+/// Assembles a [`Scene`] directly: one root node per object or light.
+#[derive(Debug, Clone, Default)]
+pub struct SceneBuilder {
+    scene: Scene,
+}
+
+impl SceneBuilder {
+    /// Adds a material; returns its index.
+    pub fn material(&mut self, material: Material) -> usize {
+        self.scene.materials.push(material);
+        self.scene.materials.len() - 1
+    }
+
+    /// Adds an object with its own mesh, placed by `trs`.
+    pub fn object_trs(&mut self, name: &str, mesh: Mesh, material: usize, trs: Trs) -> ObjectId {
+        self.scene.meshes.push(mesh);
+        let node = self.node(name, trs);
+        self.scene.objects.push(Object {
+            name: name.into(),
+            node_path: format!("/{name}"),
+            node,
+            mesh: self.scene.meshes.len() - 1,
+            material,
+        });
+        (self.scene.objects.len() - 1) as ObjectId
+    }
+
+    /// Adds an object translated to `position`.
+    pub fn object(&mut self, name: &str, mesh: Mesh, material: usize, position: Vec3) -> ObjectId {
+        self.object_trs(
+            name,
+            mesh,
+            material,
+            Trs {
+                translation: position,
+                ..Trs::default()
+            },
+        )
+    }
+
+    /// Animates object `id` linearly through `keys` of (time, translation).
+    pub fn animate_translation(&mut self, id: ObjectId, keys: &[(f32, Vec3)]) {
+        let node = self.scene.objects[id as usize].node;
+        self.scene.nodes[node].track = Some(TrsTrack {
+            translation: Some(Track {
+                interpolation: Interpolation::Linear,
+                keys: keys
+                    .iter()
+                    .map(|&(time, value)| Key {
+                        time,
+                        value,
+                        in_tangent: Vec3::ZERO,
+                        out_tangent: Vec3::ZERO,
+                    })
+                    .collect(),
+            }),
+            rotation: None,
+            scale: None,
+        });
+    }
+
+    /// Adds a point light of `intensity` (glTF candela) and `color` at `position`.
+    pub fn point_light(&mut self, position: Vec3, color: Vec3, intensity: f32) -> usize {
+        let node = self.node(
+            "light",
+            Trs {
+                translation: position,
+                ..Trs::default()
+            },
+        );
+        self.scene.lights.push(Light {
+            name: format!("light{}", self.scene.lights.len()),
+            kind: LightKind::Point,
+            color,
+            intensity,
+            range: None,
+            node,
+        });
+        self.scene.lights.len() - 1
+    }
+
+    fn node(&mut self, name: &str, rest: Trs) -> usize {
+        self.scene.nodes.push(Node {
+            name: name.into(),
+            parent: None,
+            rest,
+            track: None,
+        });
+        self.scene.nodes.len() - 1
+    }
+
+    /// The scene.
+    pub fn build(self) -> Scene {
+        self.scene
+    }
+}
+
+/// Rotation taking +Y to `normal`.
+fn facing(normal: Vec3) -> Quat {
+    let n = normal.normalize();
+    if n.dot(Vec3::Y) < -0.999 {
+        return Quat::from_rotation_x(PI);
+    }
+    Quat::from_rotation_arc(Vec3::Y, n)
+}
+
+/// Index of the animated object in [`furnished_room`].
+pub const ROOM_ANIMATED_OBJECT: &str = "sliding_box";
+
+/// A furnished room, 4 m × 2.6 m × 5 m (x ∈ [−2, 2], y ∈ [0, 2.6], z ∈ [−2.5, 2.5]): red and
+/// green side walls, white floor, back wall and ceiling, a 1 m² ceiling light panel, a table
+/// (top and four legs), two boxes, a plastic, a rough metal and a mirror sphere, and a box
+/// that slides along x from t = 0 to t = 2 s. About 3k triangles. A good camera:
+/// [`room_camera`].
+pub fn furnished_room() -> Scene {
+    let mut b = SceneBuilder::default();
+    let white = b.material(plastic(Vec3::splat(0.75), 0.9));
+    let red = b.material(plastic(Vec3::new(0.7, 0.12, 0.1), 0.9));
+    let green = b.material(plastic(Vec3::new(0.15, 0.6, 0.15), 0.9));
+    let wood = b.material(plastic(Vec3::new(0.45, 0.28, 0.15), 0.6));
+    let blue = b.material(plastic(Vec3::new(0.2, 0.3, 0.7), 0.4));
+    let gold = b.material(metal(Vec3::new(0.95, 0.75, 0.4), 0.3));
+    let mirror = b.material(metal(Vec3::splat(0.9), 0.0));
+    let light = b.material(emitter(Vec3::new(12.0, 11.0, 9.5)));
+    let wall = |b: &mut SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3, mat| {
+        b.object_trs(
+            name,
+            quad(size),
+            mat,
+            Trs {
+                translation: pos,
+                rotation: facing(n),
+                scale: Vec3::ONE,
+            },
+        );
+    };
+    wall(&mut b, "floor", Vec2::new(4.0, 5.0), Vec3::ZERO, Vec3::Y, white);
+    wall(&mut b, "ceiling", Vec2::new(4.0, 5.0), Vec3::new(0.0, 2.6, 0.0), -Vec3::Y, white);
+    // The quad's extent is (x, z) before rotation; for walls rotate it about the normal.
+    b.object_trs(
+        "back_wall",
+        quad(Vec2::new(4.0, 2.6)),
+        white,
+        Trs {
+            translation: Vec3::new(0.0, 1.3, -2.5),
+            rotation: facing(Vec3::Z),
+            scale: Vec3::ONE,
+        },
+    );
+    b.object_trs(
+        "front_wall",
+        quad(Vec2::new(4.0, 2.6)),
+        white,
+        Trs {
+            translation: Vec3::new(0.0, 1.3, 2.5),
+            rotation: facing(-Vec3::Z),
+            scale: Vec3::ONE,
+        },
+    );
+    b.object_trs(
+        "left_wall",
+        quad(Vec2::new(2.6, 5.0)),
+        red,
+        Trs {
+            translation: Vec3::new(-2.0, 1.3, 0.0),
+            rotation: facing(Vec3::X),
+            scale: Vec3::ONE,
+        },
+    );
+    b.object_trs(
+        "right_wall",
+        quad(Vec2::new(2.6, 5.0)),
+        green,
+        Trs {
+            translation: Vec3::new(2.0, 1.3, 0.0),
+            rotation: facing(-Vec3::X),
+            scale: Vec3::ONE,
+        },
+    );
+    wall(
+        &mut b,
+        "light_panel",
+        Vec2::new(1.0, 1.0),
+        Vec3::new(0.0, 2.59, -0.5),
+        -Vec3::Y,
+        light,
+    );
+    b.object("table_top", cuboid(Vec3::new(1.6, 0.06, 0.9)), wood, Vec3::new(0.3, 0.75, -1.0));
+    for (dx, dz) in [(-0.72, -0.38), (0.72, -0.38), (-0.72, 0.38), (0.72, 0.38)] {
+        b.object(
+            "table_leg",
+            cuboid(Vec3::new(0.06, 0.72, 0.06)),
+            wood,
+            Vec3::new(0.3 + dx, 0.36, -1.0 + dz),
+        );
+    }
+    b.object_trs(
+        "tall_box",
+        cuboid(Vec3::new(0.5, 1.2, 0.5)),
+        white,
+        Trs {
+            translation: Vec3::new(-1.3, 0.6, -1.6),
+            rotation: Quat::from_rotation_y(0.35),
+            scale: Vec3::ONE,
+        },
+    );
+    b.object("blue_box", cuboid(Vec3::new(0.4, 0.4, 0.4)), blue, Vec3::new(0.6, 0.98, -1.1));
+    b.object("plastic_sphere", uv_sphere(0.3, 32, 16), blue, Vec3::new(-0.8, 0.3, 0.2));
+    b.object("gold_sphere", uv_sphere(0.2, 32, 16), gold, Vec3::new(-0.1, 0.98, -0.9));
+    b.object("mirror_sphere", uv_sphere(0.35, 32, 16), mirror, Vec3::new(1.3, 0.35, 0.3));
+    let slider = b.object(
+        ROOM_ANIMATED_OBJECT,
+        cuboid(Vec3::splat(0.35)),
+        red,
+        Vec3::new(-0.5, 0.175, 1.0),
+    );
+    b.animate_translation(
+        slider,
+        &[(0.0, Vec3::new(-1.2, 0.175, 1.0)), (2.0, Vec3::new(0.8, 0.175, 0.6))],
+    );
+    b.point_light(Vec3::new(1.2, 2.0, 1.5), Vec3::new(1.0, 0.9, 0.8), 1.5);
+    b.build()
+}
+
+/// A camera for [`furnished_room`] near the front wall looking at the table.
+pub fn room_camera(width: u32, height: u32) -> crate::Result<crate::PinholeCamera> {
+    crate::PinholeCamera::look_at(
+        Vec3::new(0.0, 1.4, 2.3),
+        Vec3::new(0.0, 0.9, -1.0),
+        Vec3::Y,
+        1.05,
+        width,
+        height,
+    )
+}
