@@ -166,3 +166,51 @@ impl TrsTrack {
         .reduce(|(a0, b0), (a1, b1)| (a0.min(a1), b0.max(b1)))
     }
 }
+
+impl<T: Animatable> Track<T> {
+    /// A step track from `(time, value)` keys.
+    pub fn step(keys: impl IntoIterator<Item = (f32, T)>) -> Self {
+        Self::simple(Interpolation::Step, keys)
+    }
+
+    /// A linear track (spherical linear for rotations) from `(time, value)` keys.
+    pub fn linear(keys: impl IntoIterator<Item = (f32, T)>) -> Self {
+        Self::simple(Interpolation::Linear, keys)
+    }
+
+    /// A cubic-spline track from `(time, in_tangent, value, out_tangent)` keys, the order glTF
+    /// stores them in.
+    pub fn cubic_spline(keys: impl IntoIterator<Item = (f32, T, T, T)>) -> Self {
+        Self {
+            interpolation: Interpolation::CubicSpline,
+            keys: keys
+                .into_iter()
+                .map(|(time, in_tangent, value, out_tangent)| Key {
+                    time,
+                    value,
+                    in_tangent,
+                    out_tangent,
+                })
+                .collect(),
+        }
+    }
+
+    fn simple(interpolation: Interpolation, keys: impl IntoIterator<Item = (f32, T)>) -> Self {
+        Self {
+            interpolation,
+            keys: keys
+                .into_iter()
+                .map(|(time, value)| {
+                    // The zero of T: any value with weight zero.
+                    let zero = T::combine([(value, 0.0); 4]);
+                    Key {
+                        time,
+                        value,
+                        in_tangent: zero,
+                        out_tangent: zero,
+                    }
+                })
+                .collect(),
+        }
+    }
+}

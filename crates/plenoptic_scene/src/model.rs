@@ -276,6 +276,27 @@ impl Scene {
         self.node_transform(self.objects[id as usize].node, t)
     }
 
+    /// The first object named `name` (node name, `#k` suffix for multi-primitive meshes).
+    pub fn object_by_name(&self, name: &str) -> Option<ObjectId> {
+        self.objects
+            .iter()
+            .position(|o| o.name == name)
+            .map(|i| i as ObjectId)
+    }
+
+    /// The first node named `name`.
+    pub fn node_by_name(&self, name: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.name == name)
+    }
+
+    /// The number of triangles over all objects (a mesh drawn twice counts twice).
+    pub fn triangle_count(&self) -> usize {
+        self.objects
+            .iter()
+            .map(|o| self.meshes[o.mesh].triangles.len())
+            .sum()
+    }
+
     /// Whether node `node` or one of its ancestors is animated.
     pub fn node_is_animated(&self, node: usize) -> bool {
         let mut current = Some(node);
