@@ -104,8 +104,7 @@ impl<'a> Data<'a> {
                 self.err(
                     &element,
                     format!(
-                        "bytes {}..{}+{} outside buffer {} of {} bytes",
-                        view.offset(),
+                        "byteOffset {} + byteLength {} exceeds buffer {} of {} bytes",
                         view.offset(),
                         view.length(),
                         view.buffer().index(),
