@@ -73,7 +73,14 @@ impl PinholeCamera {
     }
 
     /// A camera at `eye` looking at `target` with `up` roughly up.
-    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, yfov: f32, width: u32, height: u32) -> Result<Self> {
+    pub fn look_at(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        yfov: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
         let forward = (target - eye).normalize_or_zero();
         let right = forward.cross(up).normalize_or_zero();
         if forward == Vec3::ZERO || right == Vec3::ZERO {
@@ -210,7 +217,10 @@ impl Camera for CubeFaceCamera {
         let n = self.face_size as f32;
         let s = 2.0 * (x as f32 + offset.x) / n - 1.0;
         let t = 2.0 * (y as f32 + offset.y) / n - 1.0;
-        Some(Ray::new(self.position, self.face.direction(s, t).normalize()))
+        Some(Ray::new(
+            self.position,
+            self.face.direction(s, t).normalize(),
+        ))
     }
 }
 

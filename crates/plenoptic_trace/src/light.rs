@@ -70,7 +70,8 @@ impl LightSet {
             let mesh = &scene.meshes[inst.mesh];
             let has_uv = mesh.uvs.len() == mesh.positions.len();
             for (ti, tri) in mesh.triangles.iter().enumerate() {
-                let [a, b, c] = tri.map(|i| inst.to_world.transform_point3(mesh.positions[i as usize]));
+                let [a, b, c] =
+                    tri.map(|i| inst.to_world.transform_point3(mesh.positions[i as usize]));
                 let cross = (b - a).cross(c - a);
                 let area = 0.5 * cross.length();
                 if area <= 0.0 {
@@ -127,7 +128,13 @@ impl LightSet {
     }
 
     /// Samples a point on the emissive triangles (by area × luminance) as seen from `p`.
-    pub fn sample_emissive(&self, scene: &Scene, p: Vec3, u_pick: f32, u: Vec2) -> Option<LightSample> {
+    pub fn sample_emissive(
+        &self,
+        scene: &Scene,
+        p: Vec3,
+        u_pick: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
         if self.distribution.is_empty() {
             return None;
         }

@@ -196,7 +196,11 @@ pub struct Bsdf {
 impl Bsdf {
     /// The BSDF of `props` at `hit` seen from direction `wo` (unit, pointing away).
     pub fn new(props: &SurfaceProps, hit: &Hit, wo: Vec3) -> Self {
-        let side = if wo.dot(hit.geometric_normal) >= 0.0 { 1.0 } else { -1.0 };
+        let side = if wo.dot(hit.geometric_normal) >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
         let ng = hit.geometric_normal * side;
         let mut n = hit.shading_normal * side;
         // Keep wo above the shading hemisphere (bent normals from normal maps).
@@ -205,7 +209,11 @@ impl Bsdf {
         }
         let frame = Frame::from_normal(n);
         let wo_local = frame.to_local(wo);
-        let eta = if hit.front_face { props.ior } else { 1.0 / props.ior };
+        let eta = if hit.front_face {
+            props.ior
+        } else {
+            1.0 / props.ior
+        };
         let delta = props.roughness < DELTA_ROUGHNESS;
         let alpha = (props.roughness * props.roughness).max(1e-4);
         let m = props.metallic;

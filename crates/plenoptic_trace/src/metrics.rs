@@ -51,5 +51,9 @@ pub fn psnr(test: &Image<Vec3>, reference: &Image<Vec3>) -> f64 {
         })
         .sum();
     let mse = sq / n;
-    if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    }
 }

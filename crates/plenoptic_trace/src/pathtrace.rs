@@ -52,7 +52,12 @@ impl PathTracer {
     }
 
     /// Radiance arriving along `ray` (one path), with the first hit's auxiliary data.
-    pub fn radiance(&self, placed: &PlacedScene<'_>, ray: &Ray, sampler: &mut Sampler) -> RadianceSample {
+    pub fn radiance(
+        &self,
+        placed: &PlacedScene<'_>,
+        ray: &Ray,
+        sampler: &mut Sampler,
+    ) -> RadianceSample {
         let scene = placed.scene();
         let lights = placed.lights();
         let mut out = RadianceSample::MISS;
@@ -84,7 +89,16 @@ impl PathTracer {
             let wo = -ray.direction;
             let bsdf = Bsdf::new(&props, &hit, wo);
             if !bsdf.is_delta(Lobes::All) {
-                l += beta * estimate_direct(placed, &hit, &bsdf, Lobes::All, Some(Lobes::All), 1, sampler);
+                l += beta
+                    * estimate_direct(
+                        placed,
+                        &hit,
+                        &bsdf,
+                        Lobes::All,
+                        Some(Lobes::All),
+                        1,
+                        sampler,
+                    );
             }
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
@@ -108,9 +122,16 @@ impl PathTracer {
     }
 
     /// Renders `camera`: mean radiance per pixel plus the centre ray's auxiliary data.
-    pub fn render(&self, placed: &PlacedScene<'_>, camera: &(impl Camera + ?Sized)) -> Image<RadianceSample> {
-        render_camera(camera, self.settings.samples_per_pixel, self.settings.seed, |ray, s, _| {
-            self.radiance(placed, ray, s)
-        })
+    pub fn render(
+        &self,
+        placed: &PlacedScene<'_>,
+        camera: &(impl Camera + ?Sized),
+    ) -> Image<RadianceSample> {
+        render_camera(
+            camera,
+            self.settings.samples_per_pixel,
+            self.settings.seed,
+            |ray, s, _| self.radiance(placed, ray, s),
+        )
     }
 }

@@ -62,7 +62,11 @@ where
         let mut any = false;
         for k in 0..spp {
             let mut s = Sampler::new(seed, pixel, u64::from(k));
-            let offset = if k == 0 { Vec2::splat(0.5) } else { s.next_2d() };
+            let offset = if k == 0 {
+                Vec2::splat(0.5)
+            } else {
+                s.next_2d()
+            };
             let Some(ray) = camera.ray(x, y, offset) else {
                 continue;
             };

@@ -37,7 +37,9 @@ pub fn cuboid(size: Vec3) -> Mesh {
         for sign in [1.0f32, -1.0] {
             let mut n = Vec3::ZERO;
             n[axis] = sign;
-            let u = Vec3::from_array(std::array::from_fn(|i| if i == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+            let u = Vec3::from_array(std::array::from_fn(|i| {
+                if i == (axis + 1) % 3 { 1.0 } else { 0.0 }
+            }));
             let v = n.cross(u);
             let base = mesh.positions.len() as u32;
             for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
@@ -60,11 +62,17 @@ pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
         let theta = PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = 2.0 * PI * s as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             mesh.positions.push(n * radius);
             mesh.normals.push(n);
-            mesh.uvs
-                .push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+            mesh.uvs.push(Vec2::new(
+                s as f32 / segments as f32,
+                r as f32 / rings as f32,
+            ));
         }
     }
     let row = segments + 1;
@@ -287,8 +295,22 @@ pub fn furnished_room() -> Scene {
             },
         );
     };
-    wall(&mut b, "floor", Vec2::new(4.0, 5.0), Vec3::ZERO, Vec3::Y, white);
-    wall(&mut b, "ceiling", Vec2::new(4.0, 5.0), Vec3::new(0.0, 2.6, 0.0), -Vec3::Y, white);
+    wall(
+        &mut b,
+        "floor",
+        Vec2::new(4.0, 5.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        white,
+    );
+    wall(
+        &mut b,
+        "ceiling",
+        Vec2::new(4.0, 5.0),
+        Vec3::new(0.0, 2.6, 0.0),
+        -Vec3::Y,
+        white,
+    );
     // The quad's extent is (x, z) before rotation; for walls rotate it about the normal.
     b.object_trs(
         "back_wall",
@@ -338,7 +360,12 @@ pub fn furnished_room() -> Scene {
         -Vec3::Y,
         light,
     );
-    b.object("table_top", cuboid(Vec3::new(1.6, 0.06, 0.9)), wood, Vec3::new(0.3, 0.75, -1.0));
+    b.object(
+        "table_top",
+        cuboid(Vec3::new(1.6, 0.06, 0.9)),
+        wood,
+        Vec3::new(0.3, 0.75, -1.0),
+    );
     for (dx, dz) in [(-0.72, -0.38), (0.72, -0.38), (-0.72, 0.38), (0.72, 0.38)] {
         b.object(
             "table_leg",
@@ -357,10 +384,30 @@ pub fn furnished_room() -> Scene {
             scale: Vec3::ONE,
         },
     );
-    b.object("blue_box", cuboid(Vec3::new(0.4, 0.4, 0.4)), blue, Vec3::new(0.6, 0.98, -1.1));
-    b.object("plastic_sphere", uv_sphere(0.3, 32, 16), blue, Vec3::new(-0.8, 0.3, 0.2));
-    b.object("gold_sphere", uv_sphere(0.2, 32, 16), gold, Vec3::new(-0.1, 0.98, -0.9));
-    b.object("mirror_sphere", uv_sphere(0.35, 32, 16), mirror, Vec3::new(1.3, 0.35, 0.3));
+    b.object(
+        "blue_box",
+        cuboid(Vec3::new(0.4, 0.4, 0.4)),
+        blue,
+        Vec3::new(0.6, 0.98, -1.1),
+    );
+    b.object(
+        "plastic_sphere",
+        uv_sphere(0.3, 32, 16),
+        blue,
+        Vec3::new(-0.8, 0.3, 0.2),
+    );
+    b.object(
+        "gold_sphere",
+        uv_sphere(0.2, 32, 16),
+        gold,
+        Vec3::new(-0.1, 0.98, -0.9),
+    );
+    b.object(
+        "mirror_sphere",
+        uv_sphere(0.35, 32, 16),
+        mirror,
+        Vec3::new(1.3, 0.35, 0.3),
+    );
     let slider = b.object(
         ROOM_ANIMATED_OBJECT,
         cuboid(Vec3::splat(0.35)),
@@ -369,7 +416,10 @@ pub fn furnished_room() -> Scene {
     );
     b.animate_translation(
         slider,
-        &[(0.0, Vec3::new(-1.2, 0.175, 1.0)), (2.0, Vec3::new(0.8, 0.175, 0.6))],
+        &[
+            (0.0, Vec3::new(-1.2, 0.175, 1.0)),
+            (2.0, Vec3::new(0.8, 0.175, 0.6)),
+        ],
     );
     b.point_light(Vec3::new(1.2, 2.0, 1.5), Vec3::new(1.0, 0.9, 0.8), 1.5);
     b.build()

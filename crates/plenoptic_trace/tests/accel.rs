@@ -13,7 +13,12 @@ fn six_boxes() -> Scene {
     let m = b.material(shapes::diffuse(Vec3::splat(0.5)));
     let dirs = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
     for (i, d) in dirs.iter().enumerate() {
-        b.object(&format!("box{i}"), shapes::cuboid(Vec3::splat(1.0)), m, *d * 3.0);
+        b.object(
+            &format!("box{i}"),
+            shapes::cuboid(Vec3::splat(1.0)),
+            m,
+            *d * 3.0,
+        );
     }
     b.build()
 }
@@ -21,7 +26,10 @@ fn six_boxes() -> Scene {
 #[test]
 fn empty_scene_is_an_error() {
     let scene = Scene::default();
-    assert!(matches!(SceneAccel::new(&scene), Err(TraceError::EmptyScene)));
+    assert!(matches!(
+        SceneAccel::new(&scene),
+        Err(TraceError::EmptyScene)
+    ));
 }
 
 #[test]
@@ -37,7 +45,12 @@ fn closest_hit_reports_the_surface() {
     let mut b = shapes::SceneBuilder::default();
     let m = b.material(shapes::diffuse(Vec3::ONE));
     b.object("floor", shapes::quad(Vec2::splat(4.0)), m, Vec3::ZERO);
-    b.object("box", shapes::cuboid(Vec3::ONE), m, Vec3::new(0.0, 2.0, 0.0));
+    b.object(
+        "box",
+        shapes::cuboid(Vec3::ONE),
+        m,
+        Vec3::new(0.0, 2.0, 0.0),
+    );
     let scene = b.build();
     let accel = SceneAccel::new(&scene).unwrap();
     let placed = accel.at_time(0.0);
@@ -56,7 +69,11 @@ fn closest_hit_reports_the_surface() {
         .unwrap();
     assert_eq!(hit.object, 0);
     assert!((hit.distance - 5.0).abs() < 1e-5);
-    assert!(hit.uv.abs_diff_eq(Vec2::new(0.75, 0.75), 1e-5), "{}", hit.uv);
+    assert!(
+        hit.uv.abs_diff_eq(Vec2::new(0.75, 0.75), 1e-5),
+        "{}",
+        hit.uv
+    );
     // From below: back face.
     let hit = placed
         .intersect(&Ray::new(Vec3::new(1.0, -1.0, 1.0), Vec3::Y))
@@ -68,7 +85,11 @@ fn closest_hit_reports_the_surface() {
     assert!(!placed.occluded(&r));
     r.tmax = 2.6;
     assert!(placed.occluded(&r));
-    assert!(placed.intersect(&Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::Y)).is_none());
+    assert!(
+        placed
+            .intersect(&Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::Y))
+            .is_none()
+    );
 }
 
 #[test]
@@ -93,7 +114,15 @@ fn pinhole_id_image_and_animation() {
     assert_ne!(*p2.id_image(&look(start)).get(1, 1), slider);
     assert_eq!(*p2.id_image(&look(end)).get(1, 1), slider);
     // A camera outside the room looking away sees nothing.
-    let away = PinholeCamera::look_at(Vec3::new(0.0, 1.0, 10.0), Vec3::new(0.0, 1.0, 20.0), Vec3::Y, 1.0, 4, 4).unwrap();
+    let away = PinholeCamera::look_at(
+        Vec3::new(0.0, 1.0, 10.0),
+        Vec3::new(0.0, 1.0, 20.0),
+        Vec3::Y,
+        1.0,
+        4,
+        4,
+    )
+    .unwrap();
     assert!(p0.id_image(&away).pixels.iter().all(|&id| id == NO_OBJECT));
     scene.objects.clear();
 }
@@ -103,9 +132,17 @@ fn pinhole_id_image_and_animation() {
 fn vulkan_select(d: Vec3) -> (usize, f32, f32) {
     let a = d.abs();
     let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
-        if d.x > 0.0 { (0, -d.z, -d.y, a.x) } else { (1, d.z, -d.y, a.x) }
+        if d.x > 0.0 {
+            (0, -d.z, -d.y, a.x)
+        } else {
+            (1, d.z, -d.y, a.x)
+        }
     } else if a.y >= a.z {
-        if d.y > 0.0 { (2, d.x, d.z, a.y) } else { (3, d.x, -d.z, a.y) }
+        if d.y > 0.0 {
+            (2, d.x, d.z, a.y)
+        } else {
+            (3, d.x, -d.z, a.y)
+        }
     } else if d.z > 0.0 {
         (4, d.x, -d.y, a.z)
     } else {
@@ -127,7 +164,10 @@ fn cube_faces_follow_vulkan() {
             assert!((t * 8.0 - (y as f32 + 0.5)).abs() < 1e-4, "{face:?} t");
         }
     }
-    assert_eq!(CubeFace::PosX.direction(-1.0, -1.0), Vec3::new(1.0, 1.0, 1.0));
+    assert_eq!(
+        CubeFace::PosX.direction(-1.0, -1.0),
+        Vec3::new(1.0, 1.0, 1.0)
+    );
 }
 
 #[test]

@@ -329,7 +329,11 @@ impl<'a> PlacedScene<'a> {
                 let b = ns.cross(t) * sign;
                 let m = sample_texture(&scene.textures[tex.texture], uv);
                 let s = material.normal_scale;
-                let local = Vec3::new((m.x * 2.0 - 1.0) * s, (m.y * 2.0 - 1.0) * s, m.z * 2.0 - 1.0);
+                let local = Vec3::new(
+                    (m.x * 2.0 - 1.0) * s,
+                    (m.y * 2.0 - 1.0) * s,
+                    m.z * 2.0 - 1.0,
+                );
                 ns = (t * local.x + b * local.y + ns * local.z).normalize_or(ns);
             }
         }

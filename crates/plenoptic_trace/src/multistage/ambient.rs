@@ -41,6 +41,12 @@ pub struct AmbientSettings {
     pub passes: u32,
     /// Seed of the random streams.
     pub seed: u64,
+    /// Whether to add the light of the bounces beyond the last pass, assuming they fall off
+    /// geometrically (the "ambient term" of progressive radiosity, Cohen et al. 1988): with
+    /// increments Δ_p between passes and r = |Δ_P| / |Δ_(P−1)|, the field is scaled by
+    /// 1 + (r/(1−r))·|Δ_P|/|E_P| (|·| = summed luminance over points). Exact for a furnace;
+    /// needs two passes or more. Costs nothing.
+    pub extrapolate: bool,
 }
 
 impl AmbientSettings {
@@ -51,6 +57,7 @@ impl AmbientSettings {
             rays_per_point: 64,
             passes: 2,
             seed: 0,
+            extrapolate: true,
         }
     }
 
@@ -61,6 +68,7 @@ impl AmbientSettings {
             rays_per_point: 128,
             passes: 3,
             seed: 0,
+            extrapolate: true,
         }
     }
 
@@ -71,6 +79,7 @@ impl AmbientSettings {
             rays_per_point: 256,
             passes: 4,
             seed: 0,
+            extrapolate: true,
         }
     }
 }
@@ -140,7 +149,11 @@ impl FieldLayout {
                 hi = hi.max(w);
             }
         }
-        let diag = if lo.x.is_finite() { (hi - lo).length() } else { 1.0 };
+        let diag = if lo.x.is_finite() {
+            (hi - lo).length()
+        } else {
+            1.0
+        };
         let h = diag / (4.0 + 60.0 * quality);
         let max_area = h * h * 0.5;
         let min_area = max_area / 16.0;
@@ -151,7 +164,14 @@ impl FieldLayout {
         Ok(Self { objects, quality })
     }
 
-    fn object_layout(scene: &Scene, id: ObjectId, t0: f32, h: f32, max_area: f32, min_area: f32) -> ObjectLayout {
+    fn object_layout(
+        scene: &Scene,
+        id: ObjectId,
+        t0: f32,
+        h: f32,
+        max_area: f32,
+        min_area: f32,
+    ) -> ObjectLayout {
         let object = &scene.objects[id as usize];
         let mesh = &scene.meshes[object.mesh];
         let m = scene.object_transform(id, t0);
@@ -245,7 +265,10 @@ impl FieldLayout {
                 let best = members
                     .iter()
                     .map(|&v| mesh.positions[v as usize])
-                    .min_by(|x, y| x.distance_squared(centroid).total_cmp(&y.distance_squared(centroid)))
+                    .min_by(|x, y| {
+                        x.distance_squared(centroid)
+                            .total_cmp(&y.distance_squared(centroid))
+                    })
                     .unwrap_or(centroid);
                 layout.points.push(GatherPoint {
                     position: best,
@@ -339,7 +362,11 @@ impl AmbientField {
     }
 
     /// Gathers the field on `layout` for the scene placed at `placed.time()`.
-    pub fn compute(placed: &PlacedScene<'_>, layout: Arc<FieldLayout>, settings: &AmbientSettings) -> Self {
+    pub fn compute(
+        placed: &PlacedScene<'_>,
+        layout: Arc<FieldLayout>,
+        settings: &AmbientSettings,
+    ) -> Self {
         let mut field = Self::zero(layout, placed.time());
         let jobs: Vec<(usize, usize)> = field
             .layout
@@ -349,12 +376,16 @@ impl AmbientField {
             .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
             .collect();
         let rays = settings.rays_per_point.max(1);
+        // Summed luminance of the previous two fields, for the extrapolation.
+        let mut sums = [0.0f64; 2];
+        let mut increments = [0.0f64; 2];
         for pass in 0..settings.passes.max(1) {
             let values: Vec<Vec3> = jobs
                 .par_iter()
                 .enumerate()
                 .map(|(index, &(o, p))| {
-                    let mut s = Sampler::new(settings.seed ^ 0xa3b1_e7c0, index as u64, u64::from(pass));
+                    let mut s =
+                        Sampler::new(settings.seed ^ 0xa3b1_e7c0, index as u64, u64::from(pass));
                     field.gather(placed, o as ObjectId, p, rays, pass > 0, &mut s)
                 })
                 .collect();
@@ -363,11 +394,37 @@ impl AmbientField {
                 next.irradiance[o][p] = v;
             }
             field = next;
+            let sum = field.luminance_sum();
+            increments = [increments[1], sum - sums[1]];
+            sums = [sums[1], sum];
+        }
+        if settings.extrapolate && settings.passes >= 2 && increments[0] > 0.0 && sums[1] > 0.0 {
+            let r = (increments[1] / increments[0]).clamp(0.0, 0.95);
+            let scale = 1.0 + r / (1.0 - r) * increments[1].max(0.0) / sums[1];
+            for v in field.irradiance.iter_mut().flatten() {
+                *v *= scale as f32;
+            }
         }
         field
     }
 
-    fn gather(&self, placed: &PlacedScene<'_>, object: ObjectId, point: usize, rays: u32, bounce: bool, s: &mut Sampler) -> Vec3 {
+    fn luminance_sum(&self) -> f64 {
+        self.irradiance
+            .iter()
+            .flatten()
+            .map(|&v| f64::from(crate::image::luminance(v)))
+            .sum()
+    }
+
+    fn gather(
+        &self,
+        placed: &PlacedScene<'_>,
+        object: ObjectId,
+        point: usize,
+        rays: u32,
+        bounce: bool,
+        s: &mut Sampler,
+    ) -> Vec3 {
         let Some(inst) = placed.instance(object) else {
             return Vec3::ZERO;
         };
@@ -386,12 +443,18 @@ impl AmbientField {
             };
             let props = SurfaceProps::at(scene, &hit);
             let bsdf = Bsdf::new(&props, &hit, -d);
-            let albedo = bsdf.diffuse_albedo();
-            if albedo == Vec3::ZERO {
+            if !bsdf.has(Lobes::All) {
                 continue;
             }
-            let mut l = estimate_direct(placed, &hit, &bsdf, Lobes::Diffuse, None, 1, s);
+            let mut l = estimate_direct(placed, &hit, &bsdf, Lobes::All, None, 1, s);
             if bounce {
+                // One-sample estimate of the directional albedo of the non-delta lobes (diffuse
+                // and glossy), applied to the previous pass's irradiance as if it were diffuse.
+                let u_lobe = s.next_f32();
+                let albedo = match bsdf.sample(u_lobe, s.next_2d(), Lobes::All) {
+                    Some(b) if !b.delta => b.weight,
+                    _ => Vec3::ZERO,
+                };
                 l += albedo * self.irradiance_at(hit.object, hit.triangle, hit.barycentrics) / PI;
             }
             sum += l;
@@ -454,8 +517,16 @@ impl AmbientField {
         let mut sq = 0.0f64;
         let mut sum = 0.0f64;
         let mut n = 0usize;
-        for (x, y) in self.irradiance.iter().flatten().zip(other.irradiance.iter().flatten()) {
-            let (lx, ly) = (crate::image::luminance(*x) as f64, crate::image::luminance(*y) as f64);
+        for (x, y) in self
+            .irradiance
+            .iter()
+            .flatten()
+            .zip(other.irradiance.iter().flatten())
+        {
+            let (lx, ly) = (
+                crate::image::luminance(*x) as f64,
+                crate::image::luminance(*y) as f64,
+            );
             sq += (lx - ly).powi(2);
             sum += lx;
             n += 1;

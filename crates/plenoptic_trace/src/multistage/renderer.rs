@@ -5,7 +5,7 @@
 //! emission
 //! + direct light from punctual lights (one shadow ray each) and emissive triangles
 //!   (`shadow_samples` shadow rays: soft shadows), through the full BSDF
-//! + diffuse albedo × ambient-field irradiance / π
+//! + diffuse directional albedo × ambient-field irradiance / π
 //! + specular reflection and refraction traced recursively up to `max_specular_depth`
 //!   (one ray for ideal lobes, `glossy_samples` GGX samples for rough ones at the first hit).
 //!
@@ -68,7 +68,12 @@ impl<'f> MultiStageRenderer<'f> {
 
     /// Radiance along one ray with the first hit's auxiliary data; the function the baker
     /// calls per temporal-volume sample.
-    pub fn sample(&self, placed: &PlacedScene<'_>, ray: &Ray, sampler: &mut Sampler) -> RadianceSample {
+    pub fn sample(
+        &self,
+        placed: &PlacedScene<'_>,
+        ray: &Ray,
+        sampler: &mut Sampler,
+    ) -> RadianceSample {
         let mut out = RadianceSample::MISS;
         out.radiance = self.shade(placed, ray, sampler, 0, None, &mut |hit| {
             out = RadianceSample::first_hit(hit, ray);
@@ -106,9 +111,18 @@ impl<'f> MultiStageRenderer<'f> {
             let n = self.settings.shadow_samples.max(1);
             l += estimate_direct(placed, &hit, &bsdf, Lobes::All, Some(Lobes::Specular), n, s);
         }
-        let albedo = bsdf.diffuse_albedo();
-        if albedo != Vec3::ZERO {
-            l += albedo * self.field.irradiance_at(hit.object, hit.triangle, hit.barycentrics) / PI;
+        if bsdf.has(Lobes::Diffuse) {
+            // One-sample estimate of the Lambertian lobe's directional albedo (its Fresnel
+            // factor depends on the incident direction).
+            let u_lobe = s.next_f32();
+            let albedo = bsdf
+                .sample(u_lobe, s.next_2d(), Lobes::Diffuse)
+                .map_or(Vec3::ZERO, |b| b.weight);
+            l += albedo
+                * self
+                    .field
+                    .irradiance_at(hit.object, hit.triangle, hit.barycentrics)
+                / PI;
         }
         if depth < self.settings.max_specular_depth && bsdf.has(Lobes::Specular) {
             let rough = !bsdf.is_delta(Lobes::Specular);
@@ -134,16 +148,28 @@ impl<'f> MultiStageRenderer<'f> {
     }
 
     /// Renders a pinhole (or any) camera.
-    pub fn render(&self, placed: &PlacedScene<'_>, camera: &(impl Camera + ?Sized)) -> Image<RadianceSample> {
-        render_camera(camera, self.settings.samples_per_pixel, self.settings.seed, |ray, s, _| {
-            self.sample(placed, ray, s)
-        })
+    pub fn render(
+        &self,
+        placed: &PlacedScene<'_>,
+        camera: &(impl Camera + ?Sized),
+    ) -> Image<RadianceSample> {
+        render_camera(
+            camera,
+            self.settings.samples_per_pixel,
+            self.settings.seed,
+            |ray, s, _| self.sample(placed, ray, s),
+        )
     }
 
     /// Renders the six faces of a cube camera in KTX2 layer order (+X, −X, +Y, −Y, +Z, −Z).
-    pub fn render_cube(&self, placed: &PlacedScene<'_>, cube: &CubeCamera) -> [Image<RadianceSample>; 6] {
+    pub fn render_cube(
+        &self,
+        placed: &PlacedScene<'_>,
+        cube: &CubeCamera,
+    ) -> [Image<RadianceSample>; 6] {
         cube.faces().map(|face| {
-            let seed = self.settings.seed ^ (0x51ed_270b_u64.wrapping_mul(face.face.index() as u64 + 1));
+            let seed =
+                self.settings.seed ^ (0x51ed_270b_u64.wrapping_mul(face.face.index() as u64 + 1));
             render_camera(&face, self.settings.samples_per_pixel, seed, |ray, s, _| {
                 self.sample(placed, ray, s)
             })

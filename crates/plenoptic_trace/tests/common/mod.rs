@@ -6,7 +6,11 @@ use plenoptic_trace::{Image, image::luminance};
 
 /// Mean and standard error of the mean of the per-pixel luminance.
 pub fn mean_and_se(img: &Image<Vec3>) -> (f64, f64) {
-    let v: Vec<f64> = img.pixels.iter().map(|&c| f64::from(luminance(c))).collect();
+    let v: Vec<f64> = img
+        .pixels
+        .iter()
+        .map(|&c| f64::from(luminance(c)))
+        .collect();
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
