@@ -45,6 +45,7 @@ pub mod builder;
 pub mod error;
 pub mod import;
 pub mod model;
+pub mod recipe;
 mod util;
 
 pub use anim::{Interpolation, Key, Track, TrsTrack};

@@ -2,6 +2,12 @@
 //! arithmetic is in the comments), for every interpolation mode, before the first and after
 //! the last key, and for a child under an animated parent.
 
+#![allow(
+    clippy::excessive_precision,
+    reason = "hand-computed constants, written to 8 digits"
+)]
+use std::f32::consts::FRAC_1_SQRT_2;
+
 use glam::{Quat, Vec3};
 use plenoptic_scene::builder::{MaterialDesc, NodeDesc, SceneBuilder, shapes};
 use plenoptic_scene::{Interpolation, Scene, Track};
@@ -154,7 +160,7 @@ fn cubic_spline_rotation_is_normalised() {
                 (
                     1.0,
                     zero,
-                    Quat::from_xyzw(0.0, 0.0, 0.70710678, 0.70710678),
+                    Quat::from_xyzw(0.0, 0.0, FRAC_1_SQRT_2, FRAC_1_SQRT_2),
                     zero,
                 ),
             ]),
@@ -187,7 +193,7 @@ fn child_under_animated_parent() {
         parent,
         Track::step([
             (0.0, Quat::IDENTITY),
-            (1.0, Quat::from_xyzw(0.0, 0.0, 0.70710678, 0.70710678)),
+            (1.0, Quat::from_xyzw(0.0, 0.0, FRAC_1_SQRT_2, FRAC_1_SQRT_2)),
         ]),
     );
     let scene = b.build_scene().unwrap();

@@ -1,6 +1,12 @@
 //! A small glTF written by hand (not by our builder), in the spirit of Khronos' `Box.gltf`:
 //! an embedded base64 buffer, a node matrix, the extensions plenoptic reads, two scenes.
 
+#![allow(
+    clippy::excessive_precision,
+    reason = "hand-computed constants, written to 8 digits"
+)]
+use std::f32::consts::FRAC_1_SQRT_2;
+
 use glam::{Quat, Vec3, Vec4};
 use plenoptic_scene::{LightKind, load};
 
@@ -72,10 +78,10 @@ fn hand_written_gltf_imports() {
     // The matrix decomposes into scale 2, 90° about y, translation (0, 0, -1).
     let root = scene.nodes[0].rest;
     assert!(root.scale.abs_diff_eq(Vec3::splat(2.0), 1e-6));
-    assert!(
-        root.rotation
-            .abs_diff_eq(Quat::from_xyzw(0.0, 0.70710678, 0.0, 0.70710678), 1e-6)
-    );
+    assert!(root.rotation.abs_diff_eq(
+        Quat::from_xyzw(0.0, FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2),
+        1e-6
+    ));
     assert!(
         root.translation
             .abs_diff_eq(Vec3::new(0.0, 0.0, -1.0), 1e-6)
