@@ -372,3 +372,36 @@ fn invalid_references_are_validation_errors() {
     doc["nodes"][0]["mesh"] = json!(7);
     expect_error(&doc, &bin, &["nodes[0].mesh"]);
 }
+
+#[test]
+fn sparse_accessors_substitute_and_check_their_indices() {
+    let (mut doc, mut bin) = triangle();
+    let i0 = bin.len();
+    bin.extend([1u8, 0, 0, 0]);
+    let v0 = bin.len();
+    bin.extend(f32_bytes(&[2.0, 0.0, 0.0]));
+    doc["buffers"][0]["byteLength"] = json!(bin.len());
+    let views = doc["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 0, "byteOffset": i0, "byteLength": 1}));
+    views.push(json!({"buffer": 0, "byteOffset": v0, "byteLength": 12}));
+    doc["accessors"][0]["sparse"] = json!({
+        "count": 1,
+        "indices": {"bufferView": 2, "componentType": 5121},
+        "values": {"bufferView": 3}
+    });
+    let scene = try_load(&doc, &bin).unwrap();
+    assert_eq!(scene.meshes[0].positions[1], glam::Vec3::new(2.0, 0.0, 0.0));
+
+    bin[i0] = 9;
+    expect_error(
+        &doc,
+        &bin,
+        &["accessor 0", "sparse index 9 out of range for 3 elements"],
+    );
+    doc["accessors"][0]["sparse"]["count"] = json!(50);
+    expect_error(
+        &doc,
+        &bin,
+        &["accessor 0", "sparse data of 50 elements exceeds"],
+    );
+}

@@ -10,7 +10,7 @@ use crate::error::{Result, SceneError};
 use crate::util::{base64_decode, percent_decode};
 
 /// The most elements an accessor without a buffer view (all zeros, sparse) may declare.
-const MAX_IMPLICIT_COUNT: usize = 1 << 24;
+const MAX_IMPLICIT_COUNT: usize = 1 << 22;
 
 /// What an accessor's data is read for: the file name travels with every error.
 pub(super) struct Data<'a> {
