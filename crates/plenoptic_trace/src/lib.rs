@@ -53,12 +53,16 @@ pub mod render;
 pub mod sampling;
 pub mod shapes;
 
-pub use accel::{Hit, PlacedScene, Ray, SceneAccel};
+pub use accel::{FlatBvh, Hit, PlacedScene, Ray, SceneAccel};
 pub use camera::{
     CUBE_FACES, Camera, CubeCamera, CubeFace, CubeFaceCamera, FisheyeCamera, PinholeCamera,
 };
+/// The glam this crate uses (the workspace's one).
+pub use glam;
 pub use image::Image;
 pub use multistage::{AmbientField, AmbientSettings, MultiStageRenderer, MultiStageSettings};
+/// The obvhs this crate uses.
+pub use obvhs;
 pub use pathtrace::{PathTracer, PathTracerSettings};
 pub use render::RadianceSample;
 

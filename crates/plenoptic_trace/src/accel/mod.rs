@@ -6,8 +6,10 @@
 //! without renormalising the direction, so hit distances stay world distances.
 
 mod blas;
+mod flat;
 
 pub use blas::Blas;
+pub use flat::FlatBvh;
 
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
 use obvhs::{
