@@ -46,7 +46,8 @@ fn vec3(r: &mut ByteReader<'_>) -> Result<Vec3> {
 pub fn encode_proxy_mesh(mesh: &ProxyMesh) -> Result<(Vec<u8>, u64)> {
     let vc = mesh.positions.len();
     let ic = mesh.indices.len();
-    if vc > MAX_PROXY_VERTICES as usize || ic > MAX_PROXY_INDICES as usize || ic % 3 != 0 {
+    if vc > MAX_PROXY_VERTICES as usize || ic > MAX_PROXY_INDICES as usize || !ic.is_multiple_of(3)
+    {
         return Err(PackError::input(format!(
             "proxy mesh with {vc} vertices and {ic} indices (caps {MAX_PROXY_VERTICES}, {MAX_PROXY_INDICES}; indices a multiple of 3)"
         )));
@@ -99,7 +100,7 @@ pub(crate) fn proxy_header(bytes: &[u8]) -> Result<(u32, u32, u32, bool, u64)> {
             max: MAX_PROXY_VERTICES as u64,
         });
     }
-    if ic % 3 != 0 {
+    if !ic.is_multiple_of(3) {
         return Err(r.fail(format!("{ic} indices is not a whole number of triangles")));
     }
     let has_normals = flags == 1;
@@ -287,9 +288,10 @@ pub(crate) fn tracks_header(bytes: &[u8]) -> Result<(u32, u64)> {
     Ok((objects, len))
 }
 
-fn read_track<const N: usize>(
-    r: &mut ByteReader<'_>,
-) -> Result<(u8, Interpolation, Vec<f32>, Vec<[f32; N]>)> {
+/// A decoded track: target, interpolation, times, values.
+type RawTrack<const N: usize> = (u8, Interpolation, Vec<f32>, Vec<[f32; N]>);
+
+fn read_track<const N: usize>(r: &mut ByteReader<'_>) -> Result<RawTrack<N>> {
     let target = r.u8()?;
     let interp =
         Interpolation::from_code(r.u8()?).ok_or_else(|| r.fail("unknown interpolation"))?;

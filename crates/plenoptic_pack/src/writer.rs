@@ -310,10 +310,10 @@ impl PackWriter {
             .map_err(|e| PackError::io(&path, e.error))?;
         // Make the rename itself durable.
         #[cfg(unix)]
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            if let Ok(d) = File::open(parent) {
-                let _ = d.sync_all();
-            }
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty())
+            && let Ok(d) = File::open(parent)
+        {
+            let _ = d.sync_all();
         }
         Ok(path)
     }

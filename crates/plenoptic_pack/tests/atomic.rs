@@ -26,7 +26,11 @@ fn dropped_writer_leaves_nothing() {
         assert!(!path.exists());
     }
     assert!(!path.exists());
-    assert!(files_in(dir.path()).is_empty(), "{:?}", files_in(dir.path()));
+    assert!(
+        files_in(dir.path()).is_empty(),
+        "{:?}",
+        files_in(dir.path())
+    );
 }
 
 #[test]

@@ -52,7 +52,10 @@ fn truncated_file() {
     }
     assert!(matches!(
         open(vec![0; 20]).unwrap_err(),
-        PackError::Truncated { expected: 128, actual: 20 }
+        PackError::Truncated {
+            expected: 128,
+            actual: 20
+        }
     ));
 }
 
@@ -69,7 +72,11 @@ fn unknown_major_version() {
     rewrite_header(&mut b, |h| h.version_major = 2);
     assert!(matches!(
         open(b).unwrap_err(),
-        PackError::UnsupportedVersion { major: 2, supported: 1, .. }
+        PackError::UnsupportedVersion {
+            major: 2,
+            supported: 1,
+            ..
+        }
     ));
 }
 
@@ -86,7 +93,10 @@ fn header_checksum() {
     b[100] ^= 1;
     assert!(matches!(
         open(b).unwrap_err(),
-        PackError::SectionChecksumMismatch { section: Section::Header, .. }
+        PackError::SectionChecksumMismatch {
+            section: Section::Header,
+            ..
+        }
     ));
 }
 
@@ -110,7 +120,10 @@ fn chunk_overlapping_manifest() {
     let mut b = small_pack();
     let h = header(&b);
     edit_row(&mut b, 0, 16, h.manifest_offset - 10, 8);
-    assert!(matches!(open(b).unwrap_err(), PackError::ChunkOutOfBounds { .. }));
+    assert!(matches!(
+        open(b).unwrap_err(),
+        PackError::ChunkOutOfBounds { .. }
+    ));
 }
 
 #[test]
@@ -132,13 +145,19 @@ fn counts_larger_than_the_file() {
     rewrite_header(&mut b, |h| h.directory_count = 1 << 40);
     assert!(matches!(
         open(b).unwrap_err(),
-        PackError::CountTooLarge { what: "directory rows", .. }
+        PackError::CountTooLarge {
+            what: "directory rows",
+            ..
+        }
     ));
     let mut b = small_pack();
     rewrite_header(&mut b, |h| h.manifest_length = u64::MAX);
     assert!(matches!(
         open(b).unwrap_err(),
-        PackError::CountTooLarge { what: "manifest bytes", .. }
+        PackError::CountTooLarge {
+            what: "manifest bytes",
+            ..
+        }
     ));
 }
 
@@ -148,7 +167,10 @@ fn section_out_of_bounds() {
     rewrite_header(&mut b, |h| h.manifest_offset = 3);
     assert!(matches!(
         open(b).unwrap_err(),
-        PackError::SectionOutOfBounds { section: Section::Manifest, .. }
+        PackError::SectionOutOfBounds {
+            section: Section::Manifest,
+            ..
+        }
     ));
 }
 
@@ -178,7 +200,8 @@ fn pack_with_raw(kind: ChunkKind, bytes: &[u8]) -> PackReader {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("raw.pack");
     let mut w = PackWriter::create(&path).unwrap();
-    w.add_raw_chunk(kind, 0, 0, bytes, 6 * 64 * 4, None).unwrap();
+    w.add_raw_chunk(kind, 0, 0, bytes, 6 * 64 * 4, None)
+        .unwrap();
     w.finish(&manifest(1)).unwrap();
     PackReader::open(&path).unwrap()
 }
@@ -206,14 +229,21 @@ fn malformed_ktx2_inside_a_good_chunk() {
         let r = pack_with_raw(ChunkKind::RadianceCube, &bytes);
         match r.chunk(0).unwrap_err() {
             PackError::MalformedKtx2 { chunk, reason } => {
-                assert_eq!(chunk.unwrap().kind, ChunkKind::RadianceCube, "{what}: {reason}")
+                assert_eq!(
+                    chunk.unwrap().kind,
+                    ChunkKind::RadianceCube,
+                    "{what}: {reason}"
+                )
             }
             e => panic!("{what}: {e}"),
         }
     }
     // A good KTX2 of the wrong kind's format is malformed for that kind, too.
     let r = pack_with_raw(ChunkKind::DistanceCube, &good);
-    assert!(matches!(r.chunk(0).unwrap_err(), PackError::MalformedKtx2 { .. }));
+    assert!(matches!(
+        r.chunk(0).unwrap_err(),
+        PackError::MalformedKtx2 { .. }
+    ));
 }
 
 #[test]
@@ -222,7 +252,11 @@ fn uncompressed_length_mismatch() {
     let r = pack_with_raw(ChunkKind::RadianceCube, &good); // says 6·64·4, is 6·16·4
     assert!(matches!(
         r.chunk(0).unwrap_err(),
-        PackError::UncompressedLengthMismatch { expected: 1536, actual: 384, .. }
+        PackError::UncompressedLengthMismatch {
+            expected: 1536,
+            actual: 384,
+            ..
+        }
     ));
 }
 
@@ -230,7 +264,10 @@ fn uncompressed_length_mismatch() {
 fn unknown_kind_opens_but_does_not_decode() {
     let r = pack_with_raw(ChunkKind::Unknown(77), b"future payload");
     assert_eq!(r.chunk_bytes(0).unwrap(), b"future payload");
-    assert!(matches!(r.chunk(0).unwrap_err(), PackError::UnknownChunkKind { .. }));
+    assert!(matches!(
+        r.chunk(0).unwrap_err(),
+        PackError::UnknownChunkKind { .. }
+    ));
 }
 
 #[test]
@@ -239,20 +276,25 @@ fn writer_rejects_bad_input() {
     let path = dir.path().join("w.pack");
     let mut w = PackWriter::create(&path).unwrap();
     let img = room_image(4, 0.0);
-    w.add_range_image(0, 0, &img, CubeFormats::default()).unwrap();
+    w.add_range_image(0, 0, &img, CubeFormats::default())
+        .unwrap();
     assert!(matches!(
-        w.add_range_image(0, 0, &img, CubeFormats::default()).unwrap_err(),
+        w.add_range_image(0, 0, &img, CubeFormats::default())
+            .unwrap_err(),
         PackError::DuplicateChunk { .. }
     ));
     assert!(matches!(
-        w.add_chunk(ChunkKind::RadianceCube, 0, 1, b"junk").unwrap_err(),
+        w.add_chunk(ChunkKind::RadianceCube, 0, 1, b"junk")
+            .unwrap_err(),
         PackError::MalformedKtx2 { chunk: Some(_), .. }
     ));
     assert!(matches!(
-        w.add_raw_chunk(ChunkKind::VolumeBlock, 0, 0, b"x", 0, Some(1)).unwrap_err(),
+        w.add_raw_chunk(ChunkKind::VolumeBlock, 0, 0, b"x", 0, Some(1))
+            .unwrap_err(),
         PackError::ChecksumMismatch { .. }
     ));
-    w.add_range_image(5, 0, &img, CubeFormats::default()).unwrap();
+    w.add_range_image(5, 0, &img, CubeFormats::default())
+        .unwrap();
     assert!(matches!(
         w.finish(&manifest(1)).unwrap_err(),
         PackError::UnknownBaseView { base_view: 5, .. }

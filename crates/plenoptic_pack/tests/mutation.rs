@@ -31,7 +31,11 @@ fn mutated_packs_never_panic() {
             // Flip bytes in the header/metadata and fix the checksums, so the damage gets past
             // them and reaches the validation behind.
             1 | 2 => {
-                let region = if round % 5 == 1 { 8..120 } else { meta_start..b.len() };
+                let region = if round % 5 == 1 {
+                    8..120
+                } else {
+                    meta_start..b.len()
+                };
                 let i = region.start + rng.below((region.end - region.start) as u64) as usize;
                 b[i] = rng.next_u64() as u8;
                 if let Ok(mut h) = Header::parse(b[..128].try_into().unwrap()) {

@@ -18,7 +18,8 @@ fn radiance_rgb9e5_error_bound() {
     // Add extremes: tiny, large, zero, saturated.
     cube.texels[0] = Vec3::new(1e-6, 2e-6, 0.0);
     cube.texels[1] = Vec3::new(60000.0, 1.0, 0.001);
-    let decoded = decode_radiance(&encode_radiance(&cube, RadianceFormat::Rgb9e5).unwrap()).unwrap();
+    let decoded =
+        decode_radiance(&encode_radiance(&cube, RadianceFormat::Rgb9e5).unwrap()).unwrap();
     assert_eq!(decoded.face_size, 16);
     for (a, b) in cube.texels.iter().zip(&decoded.texels) {
         let bound = a.max_element() * 2f32.powi(-9) + 2f32.powi(-24);
@@ -84,11 +85,23 @@ fn ktx2_headers_parse_with_ktx2_crate() {
     let img = room_image(8, 0.0);
     let cases = [
         (encode_radiance(&img.radiance, RadianceFormat::Rgb9e5), 123),
-        (encode_radiance(&img.radiance, RadianceFormat::Rgba16Float), 97),
-        (encode_distance(&img.distance, DistanceFormat::R32Float), 100),
+        (
+            encode_radiance(&img.radiance, RadianceFormat::Rgba16Float),
+            97,
+        ),
+        (
+            encode_distance(&img.distance, DistanceFormat::R32Float),
+            100,
+        ),
         (encode_distance(&img.distance, DistanceFormat::R16Float), 76),
-        (encode_object_id(&img.object_id, ObjectIdFormat::R32Uint), 98),
-        (encode_object_id(&img.object_id, ObjectIdFormat::R16Uint), 74),
+        (
+            encode_object_id(&img.object_id, ObjectIdFormat::R32Uint),
+            98,
+        ),
+        (
+            encode_object_id(&img.object_id, ObjectIdFormat::R16Uint),
+            74,
+        ),
         (encode_normal(&img.normal, NormalFormat::Rg16Snorm), 78),
         (encode_normal(&img.normal, NormalFormat::Rg16Float), 83),
     ];
@@ -146,7 +159,8 @@ fn volume_block_fields() {
 fn volume_order_is_local() {
     // Morton order: consecutive stored samples are mostly close in direction.
     let samples = volume_samples(4000, 0.0, 1.0, 5);
-    let block = decode_volume_block(&encode_volume_block(0.0, 1.0, &samples).unwrap().bytes).unwrap();
+    let block =
+        decode_volume_block(&encode_volume_block(0.0, 1.0, &samples).unwrap().bytes).unwrap();
     let mean = |s: &[VolumeSample]| {
         s.windows(2)
             .map(|w| angle(w[0].direction, w[1].direction))
@@ -232,5 +246,26 @@ fn reader_is_shareable_across_threads() {
         .collect();
     for h in handles {
         assert_eq!(h.join().unwrap(), r.entries().len());
+    }
+}
+
+#[test]
+fn levels_decode_with_ruzstd_as_bevy_does() {
+    use std::io::Read;
+    let img = room_image(16, 0.0);
+    for bytes in [
+        encode_radiance(&img.radiance, RadianceFormat::Rgb9e5).unwrap(),
+        encode_distance(&img.distance, DistanceFormat::R32Float).unwrap(),
+        encode_object_id(&img.object_id, ObjectIdFormat::R32Uint).unwrap(),
+        encode_normal(&img.normal, NormalFormat::Rg16Snorm).unwrap(),
+    ] {
+        let r = ktx2::Reader::new(&bytes[..]).unwrap();
+        let level = r.levels().next().unwrap();
+        let mut cursor = std::io::Cursor::new(level.data);
+        let mut decoder = ruzstd::decoding::StreamingDecoder::new(&mut cursor).unwrap();
+        let mut out = Vec::new();
+        decoder.read_to_end(&mut out).unwrap();
+        assert_eq!(out, zstd::decode_all(level.data).unwrap());
+        assert_eq!(out.len(), 6 * 16 * 16 * 4);
     }
 }

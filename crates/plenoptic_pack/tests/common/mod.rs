@@ -35,7 +35,13 @@ impl Rng {
 }
 
 pub fn manifest(base_views: usize) -> Manifest {
-    let mut m = Manifest::new(TimeRange { start: 0.0, end: 2.0 }, 0.5);
+    let mut m = Manifest::new(
+        TimeRange {
+            start: 0.0,
+            end: 2.0,
+        },
+        0.5,
+    );
     m.scene_bounds = Aabb {
         min: Vec3::new(-3.0, 0.0, -4.0),
         max: Vec3::new(3.0, 2.7, 4.0),
@@ -249,7 +255,8 @@ pub fn write_small_pack(path: &std::path::Path) -> Manifest {
         }
         let s = volume_samples(64, 0.0, 0.5, 7 + v as u64);
         let tets: Vec<[u32; 4]> = (0..20u32).map(|i| [i, i + 1, i + 2, i + 3]).collect();
-        w.add_volume_block(v, 0, (0.0, 0.5), &s, Some(&tets)).unwrap();
+        w.add_volume_block(v, 0, (0.0, 0.5), &s, Some(&tets))
+            .unwrap();
     }
     w.add_proxy_mesh(&proxy_mesh(1, true)).unwrap();
     w.add_proxy_mesh(&proxy_mesh(2, false)).unwrap();
@@ -260,5 +267,7 @@ pub fn write_small_pack(path: &std::path::Path) -> Manifest {
 
 /// Reads and decodes every chunk; returns how many decoded.
 pub fn read_all(r: &PackReader) -> usize {
-    (0..r.entries().len()).filter(|&i| r.chunk(i).is_ok()).count()
+    (0..r.entries().len())
+        .filter(|&i| r.chunk(i).is_ok())
+        .count()
 }
