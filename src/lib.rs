@@ -12,10 +12,14 @@
 //! | [`pack`] | the radiance pack file format |
 //! | [`scene`] | the scene model, glTF import, animation, bake recipes |
 //! | [`trace`] | BVHs, cameras, id-images, the multi-stage and reference renderers |
+//! | [`recon`] | CPU reconstruction and quality metrics |
+//! | [`bake`] | the baker and the `plenoptic` command |
 //! | [`bevy`] | the Bevy plugin |
 
 #[cfg(feature = "bevy")]
 pub use bevy_plenoptic as bevy;
+pub use plenoptic_bake as bake;
 pub use plenoptic_pack as pack;
+pub use plenoptic_recon as recon;
 pub use plenoptic_scene as scene;
 pub use plenoptic_trace as trace;

@@ -1,0 +1,1 @@
+//! 3D Delaunay (being written).

@@ -1,0 +1,3 @@
+//! plenoptic_bake (being written).
+
+pub mod delaunay3;

@@ -1,0 +1,2 @@
+//! The plenoptic command (being written).
+fn main() {}

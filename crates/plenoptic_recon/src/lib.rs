@@ -1,0 +1,1 @@
+//! plenoptic_recon (being written).
