@@ -39,9 +39,15 @@ fn renders_a_frame_and_reads_it_back() {
     assert_eq!(data.len(), (WIDTH * HEIGHT * 4) as usize);
 
     let centre = pixel(&data, WIDTH / 2, HEIGHT / 2);
-    assert!(centre[1] > 240 && centre[0] < 15 && centre[2] < 15, "centre {centre:?}");
+    assert!(
+        centre[1] > 240 && centre[0] < 15 && centre[2] < 15,
+        "centre {centre:?}"
+    );
     let corner = pixel(&data, 1, 1);
-    assert!(corner[0] > 240 && corner[1] < 15 && corner[2] < 15, "corner {corner:?}");
+    assert!(
+        corner[0] > 240 && corner[1] < 15 && corner[2] < 15,
+        "corner {corner:?}"
+    );
 
     // The cube's silhouette: a 1 m cube at 3 m with Bevy's default 45° vertical field of view
     // spans about 1 / (2·(3−0.5)·tan 22.5°) ≈ 48 % of the frame height.
@@ -49,7 +55,10 @@ fn renders_a_frame_and_reads_it_back() {
         .filter(|&y| pixel(&data, WIDTH / 2, y)[1] > 128)
         .count() as f32;
     let fraction = green_rows / HEIGHT as f32;
-    assert!((0.40..0.56).contains(&fraction), "cube covers {fraction} of the height");
+    assert!(
+        (0.40..0.56).contains(&fraction),
+        "cube covers {fraction} of the height"
+    );
 
     assert!(app.world().contains_resource::<PlenopticSettings>());
 }

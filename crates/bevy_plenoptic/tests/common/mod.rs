@@ -59,7 +59,12 @@ pub fn camera_into(image: Handle<Image>, transform: Transform) -> impl Bundle {
 
 /// Runs `app` until the image has been rendered `warmup` times and then read back, returning
 /// RGBA8 pixels row by row. Panics after `max_frames` without a readback.
-pub fn render_and_read(app: &mut App, image: Handle<Image>, warmup: u32, max_frames: u32) -> Vec<u8> {
+pub fn render_and_read(
+    app: &mut App,
+    image: Handle<Image>,
+    warmup: u32,
+    max_frames: u32,
+) -> Vec<u8> {
     let pixels: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
     for frame in 0..max_frames {
         if frame == warmup {

@@ -1,0 +1,167 @@
+//! Range-image chunks of a radiance pack are complete KTX2 files: Bevy's own KTX2 loader
+//! (`bevy_image` with `ktx2` and `zstd_rust`) must open each of the four cube kinds as a cube
+//! `Image` with the texels the baker wrote.
+
+use std::time::Duration;
+
+use bevy::{
+    asset::{AssetPlugin, LoadState, RenderAssetUsages},
+    image::{CompressedImageFormats, ImageSampler, ImageType},
+    prelude::*,
+    render::render_resource::{TextureFormat, TextureViewDimension},
+};
+use plenoptic_pack::{
+    ChunkKind, CubeFormats, CubeImage, Manifest, PackReader, PackWriter, RangeImage, TimeRange,
+    cube::rgb9e5_pack,
+};
+
+const FACE: u32 = 8;
+
+/// A range image with a different value in every texel: radiance and distance vary with the
+/// direction, ids change per face.
+fn range_image() -> RangeImage {
+    RangeImage {
+        radiance: CubeImage::from_fn(FACE, |_, d| {
+            Vec3::new(d.x.abs() * 4.0, d.y.abs(), 0.25 + d.z.abs() * 100.0)
+        }),
+        distance: CubeImage::from_fn(FACE, |i, d| 1.0 + i as f32 * 0.01 + d.x.abs()),
+        object_id: CubeImage::from_fn(FACE, |i, _| {
+            (i as u32 / (FACE * FACE)) * 1000 + i as u32 % 7
+        }),
+        normal: CubeImage::from_fn(FACE, |_, d| -d),
+    }
+}
+
+/// Writes a one-view pack and returns the raw bytes of its four range-image chunks, read back
+/// through the pack reader (so the checksum path is exercised too).
+fn chunks(dir: &std::path::Path) -> Vec<(ChunkKind, Vec<u8>)> {
+    let path = dir.join("one.pack");
+    let mut writer = PackWriter::create(&path).unwrap();
+    writer
+        .add_range_image(0, 0, &range_image(), CubeFormats::default())
+        .unwrap();
+    writer
+        .finish(&Manifest::new(
+            TimeRange {
+                start: 0.0,
+                end: 1.0,
+            },
+            1.0,
+        ))
+        .unwrap();
+    let reader = PackReader::open(&path).unwrap();
+    [
+        ChunkKind::RadianceCube,
+        ChunkKind::DistanceCube,
+        ChunkKind::ObjectIdCube,
+        ChunkKind::NormalCube,
+    ]
+    .into_iter()
+    .map(|kind| {
+        let index = reader.find(kind, 0, 0).expect("chunk written");
+        (kind, reader.chunk_bytes(index).unwrap())
+    })
+    .collect()
+}
+
+fn load_with_bevy(bytes: &[u8]) -> Image {
+    Image::from_buffer(
+        bytes,
+        ImageType::Extension("ktx2"),
+        CompressedImageFormats::NONE,
+        false,
+        ImageSampler::Default,
+        RenderAssetUsages::default(),
+    )
+    .expect("Bevy's KTX2 loader accepts the chunk")
+}
+
+fn words(data: &[u8]) -> Vec<u32> {
+    data.chunks_exact(4)
+        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+        .collect()
+}
+
+#[test]
+fn every_range_image_chunk_loads_as_a_bevy_cubemap() {
+    let dir = tempfile::tempdir().unwrap();
+    let expected = range_image();
+    let texels = (6 * FACE * FACE) as usize;
+    for (kind, bytes) in chunks(dir.path()) {
+        let image = load_with_bevy(&bytes);
+        let size = image.texture_descriptor.size;
+        assert_eq!((size.width, size.height), (FACE, FACE), "{kind:?}");
+        assert_eq!(size.depth_or_array_layers, 6, "{kind:?}: six faces");
+        let view = image.texture_view_descriptor.as_ref().expect("a view");
+        assert_eq!(view.dimension, Some(TextureViewDimension::Cube), "{kind:?}");
+        let data = image.data.as_ref().expect("texels on the CPU");
+        match kind {
+            ChunkKind::RadianceCube => {
+                assert_eq!(image.texture_descriptor.format, TextureFormat::Rgb9e5Ufloat);
+                let want: Vec<u32> = expected
+                    .radiance
+                    .texels
+                    .iter()
+                    .map(|&c| rgb9e5_pack(c))
+                    .collect();
+                assert_eq!(words(data), want);
+            }
+            ChunkKind::DistanceCube => {
+                assert_eq!(image.texture_descriptor.format, TextureFormat::R32Float);
+                let got: Vec<f32> = words(data).into_iter().map(f32::from_bits).collect();
+                assert_eq!(got, expected.distance.texels);
+            }
+            ChunkKind::ObjectIdCube => {
+                assert_eq!(image.texture_descriptor.format, TextureFormat::R32Uint);
+                assert_eq!(words(data), expected.object_id.texels);
+            }
+            ChunkKind::NormalCube => {
+                assert_eq!(image.texture_descriptor.format, TextureFormat::Rg16Snorm);
+                assert_eq!(data.len(), texels * 4);
+                // Octahedral decode of Bevy's texels gives back the normals to 16-bit precision.
+                for (i, pair) in data.chunks_exact(4).enumerate() {
+                    let x = i16::from_le_bytes([pair[0], pair[1]]) as f32 / 32767.0;
+                    let y = i16::from_le_bytes([pair[2], pair[3]]) as f32 / 32767.0;
+                    let n = plenoptic_pack::cube::oct_decode(Vec2::new(x, y));
+                    let angle = n.angle_between(expected.normal.texels[i]);
+                    assert!(angle < 1e-3, "texel {i}: {angle} rad");
+                }
+            }
+            other => unreachable!("{other:?}"),
+        }
+    }
+}
+
+/// The same chunk through the asset server, as a game would load an extracted `.ktx2`.
+#[test]
+fn asset_server_loads_an_extracted_chunk() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, radiance) = chunks(dir.path()).swap_remove(0);
+    std::fs::write(dir.path().join("radiance.ktx2"), radiance).unwrap();
+
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: dir.path().to_string_lossy().into_owned(),
+            ..default()
+        },
+        ImagePlugin::default(),
+    ));
+    let handle: Handle<Image> = app.world().resource::<AssetServer>().load("radiance.ktx2");
+    for _ in 0..500 {
+        app.update();
+        let state = app.world().resource::<AssetServer>().load_state(&handle);
+        if let LoadState::Failed(err) = state {
+            panic!("load failed: {err}");
+        }
+        if state.is_loaded() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let images = app.world().resource::<Assets<Image>>();
+    let image = images.get(&handle).expect("loaded");
+    assert_eq!(image.texture_descriptor.size.depth_or_array_layers, 6);
+    assert_eq!(image.texture_descriptor.format, TextureFormat::Rgb9e5Ufloat);
+}
