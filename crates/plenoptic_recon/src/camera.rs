@@ -1,0 +1,178 @@
+//! The reconstruction camera: a pinhole with the same convention as
+//! [`plenoptic_trace::PinholeCamera`] (looks along its local −Z with +Y up, row 0 at the top,
+//! pixel centres at half-integer offsets), plus the inverse mapping (world → pixel) that depth
+//! reprojection needs (thesis appendix A.2).
+
+use glam::{Quat, Vec3};
+use plenoptic_trace::PinholeCamera;
+
+use crate::{Error, Result};
+
+/// A pinhole camera: pose, vertical field of view and resolution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position, world space.
+    pub position: Vec3,
+    /// Orientation: the camera looks along `orientation · −Z` with `orientation · +Y` up.
+    pub orientation: Quat,
+    /// Vertical field of view, radians, in (0, π).
+    pub vfov: f32,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl Camera {
+    /// A camera; fails for an empty resolution, a non-finite pose or a field of view outside
+    /// (0, π).
+    pub fn new(
+        position: Vec3,
+        orientation: Quat,
+        vfov: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let c = Camera {
+            position,
+            orientation: orientation.normalize(),
+            vfov,
+            width,
+            height,
+        };
+        c.to_pinhole()?;
+        Ok(c)
+    }
+
+    /// A camera at `eye` looking at `target` with `up` roughly up.
+    pub fn look_at(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        vfov: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let p = PinholeCamera::look_at(eye, target, up, vfov, width, height)
+            .map_err(|e| Error::Camera(e.to_string()))?;
+        Ok(Self::from_pinhole(&p))
+    }
+
+    /// The same camera as the tracer's pinhole.
+    pub fn to_pinhole(&self) -> Result<PinholeCamera> {
+        PinholeCamera::new(
+            self.position,
+            self.orientation,
+            self.vfov,
+            self.width,
+            self.height,
+        )
+        .map_err(|e| Error::Camera(e.to_string()))
+    }
+
+    /// The tracer's pinhole as a reconstruction camera.
+    pub fn from_pinhole(p: &PinholeCamera) -> Self {
+        Camera {
+            position: p.position,
+            orientation: p.rotation,
+            vfov: p.yfov,
+            width: p.width,
+            height: p.height,
+        }
+    }
+
+    /// Number of pixels.
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Precomputed basis for per-pixel work.
+    pub fn basis(&self) -> CameraBasis {
+        let tan = (self.vfov * 0.5).tan();
+        let aspect = self.width as f32 / self.height as f32;
+        CameraBasis {
+            position: self.position,
+            right: self.orientation * Vec3::X,
+            up: self.orientation * Vec3::Y,
+            forward: self.orientation * -Vec3::Z,
+            tan_x: tan * aspect,
+            tan_y: tan,
+            width: self.width as f32,
+            height: self.height as f32,
+            focal_px: self.height as f32 / (2.0 * tan),
+        }
+    }
+}
+
+/// A camera's world-space basis with the projection constants, for the per-pixel loops.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraBasis {
+    /// Eye.
+    pub position: Vec3,
+    /// World direction of +x on the image.
+    pub right: Vec3,
+    /// World direction of up on the image.
+    pub up: Vec3,
+    /// Viewing direction.
+    pub forward: Vec3,
+    /// tan(hfov/2).
+    pub tan_x: f32,
+    /// tan(vfov/2).
+    pub tan_y: f32,
+    /// Width, pixels.
+    pub width: f32,
+    /// Height, pixels.
+    pub height: f32,
+    /// Focal length in pixels (height / (2 tan(vfov/2))).
+    pub focal_px: f32,
+}
+
+impl CameraBasis {
+    /// Unit direction through the continuous image point (px, py) (pixel (x, y)'s centre is
+    /// (x + ½, y + ½)); identical to the tracer's pinhole rays.
+    #[inline]
+    pub fn direction(&self, px: f32, py: f32) -> Vec3 {
+        let sx = (2.0 * px / self.width - 1.0) * self.tan_x;
+        let sy = (1.0 - 2.0 * py / self.height) * self.tan_y;
+        (self.right * sx + self.up * sy + self.forward).normalize()
+    }
+
+    /// Projects a world point: continuous image coordinates and the depth along the viewing
+    /// direction; `None` behind the eye (depth ≤ 1e-4).
+    #[inline]
+    pub fn project(&self, world: Vec3) -> Option<(f32, f32, f32)> {
+        let d = world - self.position;
+        let z = d.dot(self.forward);
+        if !(z > 1e-4) {
+            return None;
+        }
+        let sx = d.dot(self.right) / (z * self.tan_x);
+        let sy = d.dot(self.up) / (z * self.tan_y);
+        Some((
+            (sx + 1.0) * 0.5 * self.width,
+            (1.0 - sy) * 0.5 * self.height,
+            z,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plenoptic_trace::Camera as _;
+
+    #[test]
+    fn matches_tracer_rays_and_projects_back() {
+        let c =
+            Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, Vec3::Y, 1.0, 40, 30).unwrap();
+        let p = c.to_pinhole().unwrap();
+        let b = c.basis();
+        for (x, y) in [(0, 0), (39, 29), (13, 7)] {
+            let r = p.ray(x, y, glam::Vec2::splat(0.5)).unwrap();
+            let d = b.direction(x as f32 + 0.5, y as f32 + 0.5);
+            assert!(r.direction.abs_diff_eq(d, 1e-5));
+            let (px, py, _) = b.project(c.position + d * 2.5).unwrap();
+            assert!((px - x as f32 - 0.5).abs() < 1e-3 && (py - y as f32 - 0.5).abs() < 1e-3);
+        }
+    }
+}
