@@ -1,0 +1,156 @@
+//! Rendering the plan (design.md Baking steps 6–7): range images at every base view and time
+//! key (thesis ch. 6) and temporal volumes per base view (thesis ch. 7), with the multi-stage
+//! renderer and the ambient field interpolated linearly in time between its key times.
+//!
+//! Determinism: every random stream is seeded from the plan's seed, the base view and the
+//! time key (range images; the tracer then seeds per texel and sample) or the volume cell
+//! (volumes), and results are collected in a fixed order, so the output does not depend on
+//! the number of threads.
+//!
+//! Object ids: the pack reserves 0 for "no object", so a scene object `i` is stored as `i + 1`
+//! ([`pack_object_id`]). Misses have infinite distance and a zero normal.
+
+use glam::Vec3;
+use plenoptic_pack::{CubeImage, RangeImage, VolumeSample, face_uv_to_direction};
+use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
+use plenoptic_trace::image::luminance;
+use plenoptic_trace::sampling::Sampler;
+use plenoptic_trace::{
+    AmbientField, CubeCamera, MultiStageRenderer, MultiStageSettings, RadianceSample, Ray,
+    SceneAccel,
+};
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::plan::{Plan, ambient::field_at};
+
+/// The pack's object id of scene object `id` (0 for [`NO_OBJECT`]).
+pub fn pack_object_id(id: ObjectId) -> u32 {
+    if id == NO_OBJECT { 0 } else { id + 1 }
+}
+
+/// A 64-bit mix of the inputs (splitmix64 finaliser over a running hash).
+pub fn seed_of(parts: &[u64]) -> u64 {
+    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    for &p in parts {
+        h ^= p.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6);
+        h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        h ^= h >> 31;
+    }
+    h
+}
+
+/// Renders range images and volume samples for a plan.
+pub struct BakeRenderer<'a> {
+    /// The plan.
+    pub plan: &'a Plan,
+    /// The scene's acceleration structure.
+    pub accel: &'a SceneAccel<'a>,
+    /// Ambient fields at `plan.ambient_keys`.
+    pub fields: &'a [AmbientField],
+}
+
+impl<'a> BakeRenderer<'a> {
+    /// A renderer over a plan, its scene's acceleration structure and its ambient fields.
+    pub fn new(plan: &'a Plan, accel: &'a SceneAccel<'a>, fields: &'a [AmbientField]) -> Self {
+        Self {
+            plan,
+            accel,
+            fields,
+        }
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &'a Scene {
+        self.accel.scene()
+    }
+
+    fn settings(&self, seed: u64, spp: u32) -> MultiStageSettings {
+        MultiStageSettings {
+            samples_per_pixel: spp.max(1),
+            shadow_samples: 2,
+            glossy_samples: 2,
+            max_specular_depth: self.plan.quality.max_specular_depth,
+            seed,
+        }
+    }
+
+    /// The range image of base view `bv` at its time key `key`.
+    pub fn range_image(&self, bv: usize, key: usize) -> Result<RangeImage> {
+        let view = &self.plan.base_views[bv];
+        let t = view.time_keys[key];
+        let placed = self.accel.at_time(t);
+        let field = field_at(&self.plan.ambient_keys, self.fields, t);
+        let seed = seed_of(&[self.plan.seed, 1, bv as u64, key as u64]);
+        let renderer = MultiStageRenderer::new(
+            self.settings(seed, self.plan.quality.samples_per_pixel),
+            &field,
+        );
+        let n = self.plan.quality.range_image_size.max(1);
+        let cube = CubeCamera::new(view.position, n)?;
+        let faces = renderer.render_cube(&placed, &cube);
+        Ok(to_range_image(n, &faces))
+    }
+
+    /// The temporal-volume samples of base view `bv` (empty for a zero budget).
+    pub fn volume(&self, bv: usize) -> Vec<VolumeSample> {
+        let view = &self.plan.base_views[bv];
+        let budget = view.volume_samples as usize;
+        if budget == 0 {
+            return Vec::new();
+        }
+        crate::volume::sample_volume(self, bv, budget)
+    }
+
+    /// One volume sample along `dir` at time `t` from base view `bv`; `stream` picks the
+    /// random stream.
+    pub fn sample(&self, bv: usize, dir: Vec3, t: f32, stream: u64) -> RadianceSample {
+        let view = &self.plan.base_views[bv];
+        let placed = self.accel.at_time(t);
+        // The ambient field changes slowly: evaluate it at the frame nearest to t.
+        let frame = if self.plan.frame_rate > 0.0 {
+            ((t - self.plan.start) * self.plan.frame_rate).round() / self.plan.frame_rate
+                + self.plan.start
+        } else {
+            t
+        };
+        let field = field_at(&self.plan.ambient_keys, self.fields, frame);
+        let seed = seed_of(&[self.plan.seed, 2, bv as u64]);
+        let renderer = MultiStageRenderer::new(self.settings(seed, 1), &field);
+        let mut sampler = Sampler::new(seed, stream, 0);
+        renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler)
+    }
+}
+
+/// Converts six rendered faces (KTX2 layer order, `n`² pixels each) into a range image.
+pub fn to_range_image(n: u32, faces: &[plenoptic_trace::Image<RadianceSample>; 6]) -> RangeImage {
+    let nn = (n * n) as usize;
+    let get = |i: usize| &faces[i / nn].pixels[i % nn];
+    RangeImage {
+        radiance: CubeImage::from_fn(n, |i, _| get(i).radiance.max(Vec3::ZERO)),
+        distance: CubeImage::from_fn(n, |i, _| get(i).distance),
+        object_id: CubeImage::from_fn(n, |i, _| pack_object_id(get(i).object)),
+        normal: CubeImage::from_fn(n, |i, _| get(i).normal),
+    }
+}
+
+/// Whether two samples disagree: different object, or luminance differing by more than
+/// `tolerance` relative to the larger.
+pub fn disagree(a: &RadianceSample, b: &RadianceSample, tolerance: f32) -> bool {
+    if a.object != b.object {
+        return true;
+    }
+    let (la, lb) = (luminance(a.radiance), luminance(b.radiance));
+    (la - lb).abs() > tolerance * la.max(lb).max(1e-4)
+}
+
+/// The direction at face coordinates `(u, v)` in [0, 1]² of cube face `face`, unit length.
+pub fn face_direction(face: usize, u: f32, v: f32) -> Vec3 {
+    face_uv_to_direction(face, u, v).normalize()
+}
+
+/// Runs `f` over `items` in parallel, results in input order.
+pub fn par_map<T: Sync, U: Send>(items: &[T], f: impl Fn(&T) -> U + Sync + Send) -> Vec<U> {
+    items.par_iter().map(f).collect()
+}
