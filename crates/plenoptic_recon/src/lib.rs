@@ -4,10 +4,21 @@
 //! reference for the GPU passes of `bevy_plenoptic`, its fallback, and the quality tools.
 
 pub mod camera;
+pub mod frame;
+mod geometry;
 pub mod path;
+pub mod proxy;
+pub mod reconstructor;
+pub mod temporal;
+pub mod viewspace;
+pub mod volume;
+pub mod warp;
 
 pub use camera::Camera;
+pub use frame::{FallbackReport, Frame, Mode, Report};
 pub use path::{CameraPath, Keyframe, PathSample};
+pub use proxy::{GeometryMask, ProxyGeometry};
+pub use reconstructor::{ReconSettings, Reconstructor};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -1,0 +1,135 @@
+//! Reconstructed frames and what their reconstruction reports.
+
+use glam::Vec3;
+use plenoptic_trace::Image;
+use serde::{Deserialize, Serialize};
+
+/// A reconstructed frame: linear HDR radiance, depth (distance from the eye along each pixel's
+/// ray, metres; ∞ where nothing was reconstructed) so that an engine can composite other
+/// geometry with it, and the object id per pixel (the pack's ids; 0: none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// Linear radiance, row-major from the top row.
+    pub radiance: Vec<Vec3>,
+    /// Distance from the eye along the pixel's ray.
+    pub depth: Vec<f32>,
+    /// Object id.
+    pub object: Vec<u32>,
+}
+
+impl Frame {
+    /// A black, empty frame.
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            radiance: vec![Vec3::ZERO; n],
+            depth: vec![f32::INFINITY; n],
+            object: vec![0; n],
+        }
+    }
+
+    /// The radiance as the tracer's image type (for [`plenoptic_trace::metrics`]).
+    pub fn to_image(&self) -> Image<Vec3> {
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self.radiance.clone(),
+        }
+    }
+}
+
+/// The reconstruction modes (design.md, "Reconstruction").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Range images blended in time (A.1), warped by depth (A.2): the thesis's first system.
+    Image,
+    /// Temporal volumes filtered and triangulated at t, warped by depth: its second system.
+    Volume,
+    /// Geometry mask + lookups through the objects' motion (thesis §8.2.3): the default.
+    #[default]
+    GeometryAssisted,
+}
+
+impl Mode {
+    /// Every mode.
+    pub const ALL: [Mode; 3] = [Mode::Image, Mode::Volume, Mode::GeometryAssisted];
+
+    /// A short lowercase name (`image`, `volume`, `geometry`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Image => "image",
+            Mode::Volume => "volume",
+            Mode::GeometryAssisted => "geometry",
+        }
+    }
+
+    /// Parses [`Mode::name`] (also `geometry_assisted`).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "image" => Some(Mode::Image),
+            "volume" => Some(Mode::Volume),
+            "geometry" | "geometry_assisted" | "geometry-assisted" => Some(Mode::GeometryAssisted),
+            _ => None,
+        }
+    }
+}
+
+/// Fractions of the frame's pixels (summing to 1) by how they were reconstructed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FallbackReport {
+    /// From range images: accepted lookups (geometry-assisted) or splats (image, volume).
+    pub direct: f32,
+    /// From temporal-volume samples (geometry-assisted fallback; all covered pixels in volume
+    /// mode).
+    pub volume: f32,
+    /// Filled from neighbours: same-object fill (geometry-assisted) or background fill (image,
+    /// volume).
+    pub hole_fill: f32,
+    /// Nothing matched: the nearest base view's cube along the pixel's direction, or black.
+    pub background: f32,
+    /// Pixels where the geometry mask shows no proxy geometry (environment lookups).
+    pub no_geometry: f32,
+}
+
+impl FallbackReport {
+    /// Fractions from pixel counts.
+    pub fn from_counts(direct: usize, volume: usize, hole_fill: usize, background: usize, no_geometry: usize) -> Self {
+        let n = (direct + volume + hole_fill + background + no_geometry).max(1) as f32;
+        FallbackReport {
+            direct: direct as f32 / n,
+            volume: volume as f32 / n,
+            hole_fill: hole_fill as f32 / n,
+            background: background as f32 / n,
+            no_geometry: no_geometry as f32 / n,
+        }
+    }
+}
+
+/// What a frame's reconstruction did and what it lacked.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// The mode asked for.
+    pub mode: Mode,
+    /// The mode actually used (e.g. image mode when the pack has no proxy geometry).
+    pub used_mode: Mode,
+    /// How pixels were reconstructed.
+    pub fallback: FallbackReport,
+    /// Base views used and their view-space weights.
+    pub base_views: Vec<(usize, f32)>,
+    /// Every chunk that was needed but missing or unreadable, with the reason.
+    pub missing: Vec<String>,
+}
+
+impl Report {
+    /// True when something needed was missing.
+    pub fn degraded(&self) -> bool {
+        !self.missing.is_empty()
+    }
+}

@@ -1,0 +1,264 @@
+//! Geometry-assisted reconstruction (the default mode; thesis §8.2.3 with the range images of
+//! chapter 6 and the temporal volumes of chapter 7).
+//!
+//! 1. The geometry mask ([`crate::proxy`]) gives, per pixel, the object `o` and the point `p`
+//!    on it at time t.
+//! 2. For each base view `v` of the view-space blend and each time key τ bracketing t, the
+//!    point is carried along the object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, and looked up in
+//!    the cube of `v` at τ in the direction `p_τ − v`. The lookup is *accepted* only if the
+//!    cube saw the same object there and at the same distance (relative tolerance
+//!    [`crate::ReconSettings::depth_tolerance`]); otherwise something occluded the point.
+//! 3. Accepted lookups are blended with weight `w_view · w_time · w_angle`: the view-space
+//!    weight, the linear weight of τ between the bracketing keys, and the angular closeness
+//!    `((1 + cos θ)/2)^p` of the view's direction to the point and the camera's.
+//! 4. No accepted lookup: the temporal-volume samples of the same object near that direction
+//!    and within t ± tε (tent filter in time); then the nearest accepted pixel of the same
+//!    object in screen space (same-object hole fill); then the nearest view's cube in the
+//!    point's direction regardless of id ("background").
+//!
+//! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key; the pixel
+//! loop is parallel over rows and allocates nothing.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+use plenoptic_pack::{CubeImage, cube};
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::frame::{FallbackReport, Frame, Report};
+use crate::reconstructor::{KeyCubes, Reconstructor};
+use crate::temporal::bracketing;
+use crate::volume::VolumeIndex;
+use crate::{Error, Result};
+
+struct ViewKey {
+    base: Vec3,
+    weight: f32,
+    cubes: KeyCubes,
+    /// Per object slot: M(τ) M(t)⁻¹.
+    motion: Vec<Affine3A>,
+}
+
+const DIRECT: u8 = 1;
+const VOLUME: u8 = 2;
+const HOLE: u8 = 0;
+const NONE: u8 = 4;
+
+/// Renders one frame in geometry-assisted mode.
+pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut Report) -> Result<Frame> {
+    let Some(proxy) = rec.proxy() else {
+        return Err(Error::Unusable("no proxy geometry".into()));
+    };
+    let manifest = rec.pack().manifest();
+    let views = rec.view_weights(camera.position);
+    let ids = proxy.object_ids();
+    let slot_of = SlotMap::new(ids);
+    let inv_now: Vec<Affine3A> = ids.iter().map(|&o| proxy.transform(o, t).inverse()).collect();
+    let mut keys: Vec<ViewKey> = Vec::new();
+    let mut volumes: Vec<(Vec3, f32, VolumeIndex)> = Vec::new();
+    for &(v, w) in &views {
+        let bv = &manifest.base_views[v];
+        let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else { continue };
+        let mut pairs = vec![(k0, 1.0 - s)];
+        if k1 != k0 {
+            pairs.push((k1, s));
+        }
+        let mut got = Vec::new();
+        for (k, wt) in pairs {
+            if let Some(c) = rec.key_cubes(v, k, &mut report.missing) {
+                got.push((k, wt, c));
+            }
+        }
+        if got.is_empty() {
+            // Both bracketing keys unreadable: try the nearest readable key.
+            let mut order: Vec<usize> = (0..bv.time_keys.len()).collect();
+            order.sort_by(|&a, &b| (bv.time_keys[a] - t).abs().total_cmp(&(bv.time_keys[b] - t).abs()));
+            if let Some((k, c)) = order.into_iter().filter(|&k| k != k0 && k != k1).take(2).find_map(|k| rec.key_cubes(v, k, &mut report.missing).map(|c| (k, c))) {
+                got.push((k, 1.0, c));
+            }
+        }
+        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
+        for (k, wt, c) in got {
+            let tau = bv.time_keys[k];
+            let motion = ids.iter().zip(&inv_now).map(|(&o, inv)| proxy.transform(o, tau) * *inv).collect();
+            keys.push(ViewKey { base: bv.position, weight: w * wt / total, cubes: c, motion });
+        }
+        if let Some(index) = VolumeIndex::build(rec, v, t, &mut report.missing) {
+            volumes.push((bv.position, w, index));
+        }
+    }
+    if keys.is_empty() {
+        return Err(Error::Unusable(format!("no readable range image near t = {t}: {}", report.missing.join("; "))));
+    }
+    report.base_views = views;
+    let mask = proxy.mask(camera, t);
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let mut frame = Frame::new(camera.width, camera.height);
+    let mut class = vec![HOLE; w * h];
+    let basis = camera.basis();
+    let tol = rec.settings.depth_tolerance;
+    let power = rec.settings.angular_power;
+    // The environment lookup uses the heaviest key.
+    let env = keys.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|k| (k.base, k.cubes.radiance.clone()));
+    frame
+        .radiance
+        .par_chunks_mut(w)
+        .zip(frame.depth.par_chunks_mut(w))
+        .zip(frame.object.par_chunks_mut(w))
+        .zip(class.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (((rad, dep), obj), cls))| {
+            for x in 0..w {
+                let j = y * w + x;
+                let o = mask.object[j];
+                if o == 0 {
+                    cls[x] = NONE;
+                    if let Some((_, env)) = &env {
+                        let dir = basis.direction(x as f32 + 0.5, y as f32 + 0.5);
+                        rad[x] = env.lookup(dir).copied().unwrap_or(Vec3::ZERO);
+                    }
+                    continue;
+                }
+                let p = mask.position[j];
+                dep[x] = mask.depth[j];
+                obj[x] = o;
+                let Some(slot) = slot_of.get(o) else {
+                    cls[x] = NONE;
+                    continue;
+                };
+                let to_eye = (basis.position - p).normalize_or_zero();
+                let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
+                for k in &keys {
+                    let q = k.motion[slot].transform_point3(p);
+                    let d = q - k.base;
+                    let dist = d.length();
+                    if !(dist > 1e-6) {
+                        continue;
+                    }
+                    let n = k.cubes.ids.face_size;
+                    let ti = cube::direction_to_texel(n, d);
+                    if k.cubes.ids.texels[ti] != o || (k.cubes.distance.texels[ti] - dist).abs() > tol * dist {
+                        continue;
+                    }
+                    let wa = if power > 0.0 {
+                        let cos = (-d / dist).dot(to_eye);
+                        ((1.0 + cos) * 0.5).max(1e-3).powf(power)
+                    } else {
+                        1.0
+                    };
+                    let wt = k.weight * wa;
+                    sum += k.cubes.radiance.texels[ti] * wt;
+                    ws += wt;
+                }
+                if ws > 0.0 {
+                    rad[x] = sum / ws;
+                    cls[x] = DIRECT;
+                    continue;
+                }
+                let (mut vs, mut vw) = (Vec3::ZERO, 0.0f32);
+                for (base, w, index) in &volumes {
+                    let d = p - *base;
+                    if let Some((c, wt)) = index.lookup(d, o, tol * 3.0) {
+                        vs += c * wt * *w;
+                        vw += wt * *w;
+                    }
+                }
+                if vw > 0.0 {
+                    rad[x] = vs / vw;
+                    cls[x] = VOLUME;
+                }
+            }
+        });
+    let (hole, background) = hole_fill(&mut frame, &mut class, rec.settings.hole_fill_radius as i64, &keys, &mask.position);
+    let count = |c: u8| class.iter().filter(|&&x| x == c).count();
+    report.fallback = FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
+    Ok(frame)
+}
+
+/// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search);
+/// what remains takes the heaviest view's cube in the point's direction. Returns the counts.
+fn hole_fill(frame: &mut Frame, class: &mut [u8], radius: i64, keys: &[ViewKey], points: &[Vec3]) -> (usize, usize) {
+    let (w, h) = (frame.width as i64, frame.height as i64);
+    let holes: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
+    if holes.is_empty() {
+        return (0, 0);
+    }
+    let fills: Vec<(usize, Option<Vec3>)> = holes
+        .par_iter()
+        .map(|&j| {
+            let (x, y) = (j as i64 % w, j as i64 / w);
+            let o = frame.object[j];
+            for r in 1..=radius {
+                let (mut sum, mut n) = (Vec3::ZERO, 0);
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if dx.abs() != r && dy.abs() != r {
+                            continue;
+                        }
+                        let (nx, ny) = (x + dx, y + dy);
+                        if nx < 0 || ny < 0 || nx >= w || ny >= h {
+                            continue;
+                        }
+                        let k = (ny * w + nx) as usize;
+                        if (class[k] == DIRECT || class[k] == VOLUME) && frame.object[k] == o {
+                            sum += frame.radiance[k];
+                            n += 1;
+                        }
+                    }
+                }
+                if n > 0 {
+                    return (j, Some(sum / n as f32));
+                }
+            }
+            (j, None)
+        })
+        .collect();
+    let env: Option<(Vec3, Arc<CubeImage<Vec3>>)> = keys.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|k| (k.base, k.cubes.radiance.clone()));
+    let (mut filled, mut rest) = (0, 0);
+    for (j, c) in fills {
+        match c {
+            Some(c) => {
+                frame.radiance[j] = c;
+                filled += 1;
+            }
+            None => {
+                rest += 1;
+                class[j] = NONE + 1;
+                if let Some((base, cube)) = &env {
+                    frame.radiance[j] = cube.lookup(points[j] - *base).copied().unwrap_or(Vec3::ZERO);
+                }
+            }
+        }
+    }
+    (filled, rest)
+}
+
+/// Pack object id → slot in the per-object tables (dense for small ids).
+struct SlotMap {
+    dense: Vec<u32>,
+    sparse: Vec<(u32, usize)>,
+}
+
+impl SlotMap {
+    fn new(ids: &[u32]) -> Self {
+        let max = ids.iter().copied().max().unwrap_or(0) as usize;
+        if max < 1 << 20 {
+            let mut dense = vec![u32::MAX; max + 1];
+            for (i, &o) in ids.iter().enumerate() {
+                dense[o as usize] = i as u32;
+            }
+            SlotMap { dense, sparse: Vec::new() }
+        } else {
+            SlotMap { dense: Vec::new(), sparse: ids.iter().enumerate().map(|(i, &o)| (o, i)).collect() }
+        }
+    }
+
+    #[inline]
+    fn get(&self, id: u32) -> Option<usize> {
+        if !self.dense.is_empty() {
+            return self.dense.get(id as usize).filter(|&&s| s != u32::MAX).map(|&s| s as usize);
+        }
+        self.sparse.iter().find(|x| x.0 == id).map(|x| x.1)
+    }
+}

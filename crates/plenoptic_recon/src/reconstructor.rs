@@ -1,0 +1,372 @@
+//! The [`Reconstructor`]: an open pack, its proxy geometry, a cache of decoded chunks, and
+//! [`Reconstructor::render`] for every mode.
+//!
+//! Failure policy: a chunk that is missing or unreadable (read error, checksum mismatch,
+//! corrupt data) is left out — the frame is reconstructed from what remains and the
+//! [`Report`] lists every such chunk. Only when nothing at all can be used (no base view with
+//! one readable range image) does `render` return [`Error::Unusable`].
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use glam::Vec3;
+use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
+
+use crate::camera::Camera;
+use crate::frame::{FallbackReport, Frame, Mode, Report};
+use crate::proxy::ProxyGeometry;
+use crate::temporal::{bezier_weights, nearest_key};
+use crate::viewspace::ViewWeights;
+use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
+use crate::{Error, Result};
+
+/// Reconstruction settings; each field's cost/quality trade-off is documented.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReconSettings {
+    /// Most base views blended per frame (more: smoother transitions, linear cost).
+    pub max_views: usize,
+    /// Relative distance tolerance of a geometry-assisted lookup (|d_cube − d| < tol·d).
+    /// Too small rejects valid lookups at grazing angles; too large lets occluders through.
+    pub depth_tolerance: f32,
+    /// Exponent of the angular-closeness weight `((1 + cos θ)/2)^p` between a base view's
+    /// direction to a point and the camera's (0 disables it).
+    pub angular_power: f32,
+    /// Half-width tε of the temporal filter window, seconds (`None`: half the bucket span).
+    pub time_epsilon: Option<f32>,
+    /// Face size of cubes reconstructed from temporal volumes (cost grows with its square).
+    pub volume_face_size: u32,
+    /// Radius, pixels, of the same-object hole fill search (cost grows with its square in the
+    /// worst case; only holes pay it).
+    pub hole_fill_radius: u32,
+    /// Passes of the background fill in image and volume modes (each extends by a pixel).
+    pub background_passes: u32,
+    /// Bytes of decoded chunks kept in the cache.
+    pub cache_bytes: usize,
+}
+
+impl Default for ReconSettings {
+    fn default() -> Self {
+        ReconSettings {
+            max_views: 4,
+            depth_tolerance: 0.04,
+            angular_power: 8.0,
+            time_epsilon: None,
+            volume_face_size: 48,
+            hole_fill_radius: 12,
+            background_passes: 24,
+            cache_bytes: 512 << 20,
+        }
+    }
+}
+
+#[derive(Clone)]
+pub(crate) enum Cached {
+    Radiance(Arc<CubeImage<Vec3>>),
+    Distance(Arc<CubeImage<f32>>),
+    Ids(Arc<CubeImage<u32>>),
+    Volume(Arc<VolumeBlock>),
+    Failed(String),
+}
+
+impl Cached {
+    fn bytes(&self) -> usize {
+        match self {
+            Cached::Radiance(c) => c.texels.len() * 12,
+            Cached::Distance(c) => c.texels.len() * 4,
+            Cached::Ids(c) => c.texels.len() * 4,
+            Cached::Volume(b) => b.samples.len() * 64,
+            Cached::Failed(s) => s.len(),
+        }
+    }
+}
+
+#[derive(Default)]
+struct Cache {
+    map: HashMap<(ChunkKind, u32, u32), (Cached, u64)>,
+    tick: u64,
+    bytes: usize,
+}
+
+/// Reconstructs frames from one pack.
+pub struct Reconstructor {
+    pack: PackReader,
+    proxy: Option<ProxyGeometry>,
+    proxy_missing: Vec<String>,
+    /// Settings (may be changed between frames).
+    pub settings: ReconSettings,
+    cache: Mutex<Cache>,
+}
+
+impl std::fmt::Debug for Reconstructor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Reconstructor")
+            .field("proxy", &self.proxy)
+            .field("settings", &self.settings)
+            .finish()
+    }
+}
+
+/// The cubes of one base view at one time key.
+#[derive(Clone)]
+pub(crate) struct KeyCubes {
+    pub radiance: Arc<CubeImage<Vec3>>,
+    pub distance: Arc<CubeImage<f32>>,
+    pub ids: Arc<CubeImage<u32>>,
+}
+
+impl Reconstructor {
+    /// Opens the pack at `path` with default settings.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        Ok(Self::new(PackReader::open(path)?, ReconSettings::default()))
+    }
+
+    /// A reconstructor over an open pack. Reads the proxy geometry and tracks now (what cannot
+    /// be read is reported with every frame).
+    pub fn new(pack: PackReader, settings: ReconSettings) -> Self {
+        let (proxy, proxy_missing) = ProxyGeometry::from_pack(&pack);
+        Reconstructor {
+            pack,
+            proxy,
+            proxy_missing,
+            settings,
+            cache: Mutex::new(Cache::default()),
+        }
+    }
+
+    /// The pack.
+    pub fn pack(&self) -> &PackReader {
+        &self.pack
+    }
+
+    /// The proxy geometry, if the pack has readable proxy meshes.
+    pub fn proxy(&self) -> Option<&ProxyGeometry> {
+        self.proxy.as_ref()
+    }
+
+    /// The temporal filter half-width in use.
+    pub fn time_epsilon(&self) -> f32 {
+        self.settings
+            .time_epsilon
+            .unwrap_or(self.pack.manifest().bucket_span * 0.5)
+            .max(1e-6)
+    }
+
+    pub(crate) fn cached(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
+        {
+            let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+            c.tick += 1;
+            let tick = c.tick;
+            if let Some(entry) = c.map.get_mut(&(kind, view, key)) {
+                entry.1 = tick;
+                return entry.0.clone();
+            }
+        }
+        let what = |e: plenoptic_pack::PackError| Cached::Failed(e.to_string());
+        let value = match kind {
+            ChunkKind::RadianceCube => self.pack.radiance(view, key).map(|c| Cached::Radiance(Arc::new(c))),
+            ChunkKind::DistanceCube => self.pack.distance(view, key).map(|c| Cached::Distance(Arc::new(c))),
+            ChunkKind::ObjectIdCube => self.pack.object_id(view, key).map(|c| Cached::Ids(Arc::new(c))),
+            _ => self.pack.volume_block(view, key).map(|b| Cached::Volume(Arc::new(b))),
+        }
+        .unwrap_or_else(what);
+        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        c.tick += 1;
+        let tick = c.tick;
+        c.bytes += value.bytes();
+        c.map.insert((kind, view, key), (value.clone(), tick));
+        while c.bytes > self.settings.cache_bytes && c.map.len() > 1 {
+            let Some((&k, _)) = c.map.iter().min_by_key(|(_, v)| v.1) else { break };
+            if let Some((v, _)) = c.map.remove(&k) {
+                c.bytes = c.bytes.saturating_sub(v.bytes());
+            }
+        }
+        value
+    }
+
+    /// The three cubes of (view, key), or a description of what failed.
+    pub(crate) fn key_cubes(&self, view: usize, key: usize, missing: &mut Vec<String>) -> Option<KeyCubes> {
+        let (v, k) = (view as u32, key as u32);
+        let mut fail = |kind: &str, e: String| missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"));
+        let radiance = match self.cached(ChunkKind::RadianceCube, v, k) {
+            Cached::Radiance(c) => c,
+            Cached::Failed(e) => return fail("radiance", e).then_none(),
+            _ => return None,
+        };
+        let distance = match self.cached(ChunkKind::DistanceCube, v, k) {
+            Cached::Distance(c) => c,
+            Cached::Failed(e) => return fail("distance", e).then_none(),
+            _ => return None,
+        };
+        let ids = match self.cached(ChunkKind::ObjectIdCube, v, k) {
+            Cached::Ids(c) => c,
+            Cached::Failed(e) => return fail("object-id", e).then_none(),
+            _ => return None,
+        };
+        if radiance.face_size != distance.face_size || ids.face_size != distance.face_size {
+            missing.push(format!("base view {view}, key {key}: cube face sizes differ"));
+            return None;
+        }
+        Some(KeyCubes { radiance, distance, ids })
+    }
+
+    /// The volume block of (view, bucket), if present and readable (absence of a block is not
+    /// reported: volumes are optional).
+    pub(crate) fn volume_block(&self, view: usize, bucket: u32, missing: &mut Vec<String>) -> Option<Arc<VolumeBlock>> {
+        if self.pack.find(ChunkKind::VolumeBlock, view as u32, bucket).is_none() {
+            return None;
+        }
+        match self.cached(ChunkKind::VolumeBlock, view as u32, bucket) {
+            Cached::Volume(b) => Some(b),
+            Cached::Failed(e) => {
+                missing.push(format!("volume block of base view {view}, bucket {bucket}: {e}"));
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// View-space weights of the base views for `camera`, over the views that have a readable
+    /// radiance cube at some key (known failures excluded).
+    pub(crate) fn view_weights(&self, position: Vec3) -> Vec<(usize, f32)> {
+        let m = self.pack.manifest();
+        let usable: Vec<bool> = m
+            .base_views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (0..v.time_keys.len()).any(|k| self.pack.find(ChunkKind::RadianceCube, i as u32, k as u32).is_some()))
+            .collect();
+        let mut w = ViewWeights::new(&m.view_space, &m.base_views, &usable).weights(position);
+        w.truncate(self.settings.max_views.max(1));
+        let s: f32 = w.iter().map(|x| x.1).sum();
+        if s > 0.0 {
+            for x in &mut w {
+                x.1 /= s;
+            }
+        }
+        w
+    }
+
+    /// Reconstructs the frame `camera` sees at time `t` in `mode`.
+    pub fn render(&self, camera: &Camera, t: f32, mode: Mode) -> Result<(Frame, Report)> {
+        camera.to_pinhole()?;
+        let mut report = Report {
+            mode,
+            used_mode: mode,
+            missing: self.proxy_missing.clone(),
+            ..Report::default()
+        };
+        let frame = match mode {
+            Mode::GeometryAssisted if self.proxy.is_some() => crate::geometry::render(self, camera, t, &mut report)?,
+            Mode::GeometryAssisted => {
+                report.missing.push("no usable proxy geometry: fell back to image mode".into());
+                report.used_mode = Mode::Image;
+                self.render_image(camera, t, &mut report)?
+            }
+            Mode::Image => self.render_image(camera, t, &mut report)?,
+            Mode::Volume => crate::volume::render(self, camera, t, &mut report)?,
+        };
+        Ok((frame, report))
+    }
+
+    /// Image mode: Bézier blend of each view's keys, then warp and blend.
+    fn render_image(&self, camera: &Camera, t: f32, report: &mut Report) -> Result<Frame> {
+        let views = self.view_weights(camera.position);
+        let mut cubes = Vec::new();
+        for &(v, w) in &views {
+            if let Some(c) = self.view_at_time(v, t, &mut report.missing) {
+                cubes.push((v, w, c));
+            }
+        }
+        if cubes.is_empty() {
+            return Err(Error::Unusable(format!("no readable range image near t = {t}: {}", report.missing.join("; "))));
+        }
+        report.base_views = cubes.iter().map(|c| (c.0, c.1)).collect();
+        let warped: Vec<(Warped, f32)> = {
+            use rayon::prelude::*;
+            let basis = camera.basis();
+            let positions: Vec<Vec3> = cubes.iter().map(|c| self.pack.manifest().base_views[c.0].position).collect();
+            cubes
+                .par_iter()
+                .zip(positions)
+                .map(|((_, w, c), position)| {
+                    let view = ViewCubes { position, radiance: &c.0, distance: &c.1.distance, object: &c.1.ids };
+                    (warp_view(&view, &basis, camera.width, camera.height), *w)
+                })
+                .collect()
+        };
+        Ok(self.finish_warped(camera, &warped, report, false))
+    }
+
+    /// Blends warped views, fills holes, converts depth, fills the report.
+    pub(crate) fn finish_warped(&self, camera: &Camera, warped: &[(Warped, f32)], report: &mut Report, volume: bool) -> Frame {
+        let (w, h) = (camera.width, camera.height);
+        let (mut rad, mut z, mut obj, mut cov) = blend_warped(warped, w, h, self.settings.depth_tolerance);
+        let direct = cov.iter().filter(|&&c| c).count();
+        let filled = background_fill(w, h, &mut rad, &mut z, &mut obj, &mut cov, self.settings.background_passes);
+        let rest = cov.len() - direct - filled;
+        let basis = camera.basis();
+        let mut frame = Frame::new(w, h);
+        for (j, zz) in z.iter().enumerate() {
+            if zz.is_finite() {
+                let (x, y) = ((j % w as usize) as f32 + 0.5, (j / w as usize) as f32 + 0.5);
+                let cos = basis.direction(x, y).dot(basis.forward).max(1e-6);
+                frame.depth[j] = zz / cos;
+            }
+        }
+        frame.radiance = rad;
+        frame.object = obj;
+        report.fallback = if volume {
+            FallbackReport::from_counts(0, direct, filled, rest, 0)
+        } else {
+            FallbackReport::from_counts(direct, 0, filled, rest, 0)
+        };
+        frame
+    }
+
+    /// One base view's range image at time t: radiance by the Bézier weights over the keys
+    /// that could be read, distance and ids from the nearest readable key.
+    pub(crate) fn view_at_time(&self, view: usize, t: f32, missing: &mut Vec<String>) -> Option<(CubeImage<Vec3>, KeyCubes)> {
+        let times = &self.pack.manifest().base_views.get(view)?.time_keys;
+        let weights = bezier_weights(times, t);
+        let mut parts = Vec::new();
+        for &(k, w) in &weights {
+            if let Some(c) = self.key_cubes(view, k, missing) {
+                parts.push((k, w, c));
+            }
+        }
+        if parts.len() < weights.len() {
+            // Some keys are unreadable: fall back to linear weights over the readable nearest.
+            let mut readable: Vec<(usize, KeyCubes)> = parts.drain(..).map(|(k, _, c)| (k, c)).collect();
+            if readable.is_empty() {
+                let k = nearest_key(times, t)?;
+                let mut order: Vec<usize> = (0..times.len()).collect();
+                order.sort_by(|&a, &b| (times[a] - times[k]).abs().total_cmp(&(times[b] - times[k]).abs()));
+                readable = order.into_iter().take(3).filter_map(|k| self.key_cubes(view, k, missing).map(|c| (k, c))).collect();
+            }
+            let ws: Vec<f32> = readable.iter().map(|(k, _)| 1.0 / ((times[*k] - t).abs() + 1e-4)).collect();
+            let s: f32 = ws.iter().sum();
+            parts = readable.into_iter().zip(ws).map(|((k, c), w)| (k, w / s, c)).collect();
+        }
+        let nearest = parts.iter().min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?.2.clone();
+        let list: Vec<(&CubeImage<Vec3>, f32)> = parts
+            .iter()
+            .filter(|p| p.2.radiance.face_size == nearest.radiance.face_size)
+            .map(|p| (&*p.2.radiance, p.1))
+            .collect();
+        let sum: f32 = list.iter().map(|x| x.1).sum();
+        let list: Vec<(&CubeImage<Vec3>, f32)> = list.into_iter().map(|(c, w)| (c, w / sum)).collect();
+        let radiance = crate::temporal::blend_cubes(&list)?;
+        Some((radiance, nearest))
+    }
+}
+
+trait ThenNone {
+    fn then_none<T>(self) -> Option<T>;
+}
+
+impl ThenNone for () {
+    fn then_none<T>(self) -> Option<T> {
+        None
+    }
+}
