@@ -100,7 +100,13 @@ pub struct FallbackReport {
 
 impl FallbackReport {
     /// Fractions from pixel counts.
-    pub fn from_counts(direct: usize, volume: usize, hole_fill: usize, background: usize, no_geometry: usize) -> Self {
+    pub fn from_counts(
+        direct: usize,
+        volume: usize,
+        hole_fill: usize,
+        background: usize,
+        no_geometry: usize,
+    ) -> Self {
         let n = (direct + volume + hole_fill + background + no_geometry).max(1) as f32;
         FallbackReport {
             direct: direct as f32 / n,

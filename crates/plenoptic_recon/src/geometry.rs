@@ -46,7 +46,12 @@ const HOLE: u8 = 0;
 const NONE: u8 = 4;
 
 /// Renders one frame in geometry-assisted mode.
-pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut Report) -> Result<Frame> {
+pub(crate) fn render(
+    rec: &Reconstructor,
+    camera: &Camera,
+    t: f32,
+    report: &mut Report,
+) -> Result<Frame> {
     let Some(proxy) = rec.proxy() else {
         return Err(Error::Unusable("no proxy geometry".into()));
     };
@@ -54,12 +59,17 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
     let views = rec.view_weights(camera.position);
     let ids = proxy.object_ids();
     let slot_of = SlotMap::new(ids);
-    let inv_now: Vec<Affine3A> = ids.iter().map(|&o| proxy.transform(o, t).inverse()).collect();
+    let inv_now: Vec<Affine3A> = ids
+        .iter()
+        .map(|&o| proxy.transform(o, t).inverse())
+        .collect();
     let mut keys: Vec<ViewKey> = Vec::new();
     let mut volumes: Vec<(Vec3, f32, VolumeIndex)> = Vec::new();
     for &(v, w) in &views {
         let bv = &manifest.base_views[v];
-        let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else { continue };
+        let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
+            continue;
+        };
         let mut pairs = vec![(k0, 1.0 - s)];
         if k1 != k0 {
             pairs.push((k1, s));
@@ -73,23 +83,44 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
         if got.is_empty() {
             // Both bracketing keys unreadable: try the nearest readable key.
             let mut order: Vec<usize> = (0..bv.time_keys.len()).collect();
-            order.sort_by(|&a, &b| (bv.time_keys[a] - t).abs().total_cmp(&(bv.time_keys[b] - t).abs()));
-            if let Some((k, c)) = order.into_iter().filter(|&k| k != k0 && k != k1).take(2).find_map(|k| rec.key_cubes(v, k, &mut report.missing).map(|c| (k, c))) {
+            order.sort_by(|&a, &b| {
+                (bv.time_keys[a] - t)
+                    .abs()
+                    .total_cmp(&(bv.time_keys[b] - t).abs())
+            });
+            if let Some((k, c)) = order
+                .into_iter()
+                .filter(|&k| k != k0 && k != k1)
+                .take(2)
+                .find_map(|k| rec.key_cubes(v, k, &mut report.missing).map(|c| (k, c)))
+            {
                 got.push((k, 1.0, c));
             }
         }
         let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
         for (k, wt, c) in got {
             let tau = bv.time_keys[k];
-            let motion = ids.iter().zip(&inv_now).map(|(&o, inv)| proxy.transform(o, tau) * *inv).collect();
-            keys.push(ViewKey { base: bv.position, weight: w * wt / total, cubes: c, motion });
+            let motion = ids
+                .iter()
+                .zip(&inv_now)
+                .map(|(&o, inv)| proxy.transform(o, tau) * *inv)
+                .collect();
+            keys.push(ViewKey {
+                base: bv.position,
+                weight: w * wt / total,
+                cubes: c,
+                motion,
+            });
         }
         if let Some(index) = VolumeIndex::build(rec, v, t, &mut report.missing) {
             volumes.push((bv.position, w, index));
         }
     }
     if keys.is_empty() {
-        return Err(Error::Unusable(format!("no readable range image near t = {t}: {}", report.missing.join("; "))));
+        return Err(Error::Unusable(format!(
+            "no readable range image near t = {t}: {}",
+            report.missing.join("; ")
+        )));
     }
     report.base_views = views;
     let mask = proxy.mask(camera, t);
@@ -100,7 +131,10 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
     let tol = rec.settings.depth_tolerance;
     let power = rec.settings.angular_power;
     // The environment lookup uses the heaviest key.
-    let env = keys.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|k| (k.base, k.cubes.radiance.clone()));
+    let env = keys
+        .iter()
+        .max_by(|a, b| a.weight.total_cmp(&b.weight))
+        .map(|k| (k.base, k.cubes.radiance.clone()));
     frame
         .radiance
         .par_chunks_mut(w)
@@ -138,7 +172,24 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
                     }
                     let n = k.cubes.ids.face_size;
                     let ti = cube::direction_to_texel(n, d);
-                    if k.cubes.ids.texels[ti] != o || (k.cubes.distance.texels[ti] - dist).abs() > tol * dist {
+                    if k.cubes.ids.texels[ti] != o {
+                        continue;
+                    }
+                    let dc = k.cubes.distance.texels[ti];
+                    let expected = match &k.cubes.normal {
+                        Some(nc) => {
+                            // Distance to the texel's surface plane along the lookup direction.
+                            let nrm = nc.texels[ti];
+                            let denom = d.dot(nrm) / dist;
+                            if denom.abs() > 0.05 {
+                                (cube::texel_direction(n, ti) * dc).dot(nrm) / denom
+                            } else {
+                                dc
+                            }
+                        }
+                        None => dc,
+                    };
+                    if (expected - dist).abs() > tol * dist {
                         continue;
                     }
                     let wa = if power > 0.0 {
@@ -170,15 +221,28 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
                 }
             }
         });
-    let (hole, background) = hole_fill(&mut frame, &mut class, rec.settings.hole_fill_radius as i64, &keys, &mask.position);
+    let (hole, background) = hole_fill(
+        &mut frame,
+        &mut class,
+        rec.settings.hole_fill_radius as i64,
+        &keys,
+        &mask.position,
+    );
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
-    report.fallback = FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
+    report.fallback =
+        FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
     Ok(frame)
 }
 
 /// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search);
 /// what remains takes the heaviest view's cube in the point's direction. Returns the counts.
-fn hole_fill(frame: &mut Frame, class: &mut [u8], radius: i64, keys: &[ViewKey], points: &[Vec3]) -> (usize, usize) {
+fn hole_fill(
+    frame: &mut Frame,
+    class: &mut [u8],
+    radius: i64,
+    keys: &[ViewKey],
+    points: &[Vec3],
+) -> (usize, usize) {
     let (w, h) = (frame.width as i64, frame.height as i64);
     let holes: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
     if holes.is_empty() {
@@ -214,7 +278,10 @@ fn hole_fill(frame: &mut Frame, class: &mut [u8], radius: i64, keys: &[ViewKey],
             (j, None)
         })
         .collect();
-    let env: Option<(Vec3, Arc<CubeImage<Vec3>>)> = keys.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|k| (k.base, k.cubes.radiance.clone()));
+    let env: Option<(Vec3, Arc<CubeImage<Vec3>>)> = keys
+        .iter()
+        .max_by(|a, b| a.weight.total_cmp(&b.weight))
+        .map(|k| (k.base, k.cubes.radiance.clone()));
     let (mut filled, mut rest) = (0, 0);
     for (j, c) in fills {
         match c {
@@ -226,7 +293,10 @@ fn hole_fill(frame: &mut Frame, class: &mut [u8], radius: i64, keys: &[ViewKey],
                 rest += 1;
                 class[j] = NONE + 1;
                 if let Some((base, cube)) = &env {
-                    frame.radiance[j] = cube.lookup(points[j] - *base).copied().unwrap_or(Vec3::ZERO);
+                    frame.radiance[j] = cube
+                        .lookup(points[j] - *base)
+                        .copied()
+                        .unwrap_or(Vec3::ZERO);
                 }
             }
         }
@@ -248,16 +318,26 @@ impl SlotMap {
             for (i, &o) in ids.iter().enumerate() {
                 dense[o as usize] = i as u32;
             }
-            SlotMap { dense, sparse: Vec::new() }
+            SlotMap {
+                dense,
+                sparse: Vec::new(),
+            }
         } else {
-            SlotMap { dense: Vec::new(), sparse: ids.iter().enumerate().map(|(i, &o)| (o, i)).collect() }
+            SlotMap {
+                dense: Vec::new(),
+                sparse: ids.iter().enumerate().map(|(i, &o)| (o, i)).collect(),
+            }
         }
     }
 
     #[inline]
     fn get(&self, id: u32) -> Option<usize> {
         if !self.dense.is_empty() {
-            return self.dense.get(id as usize).filter(|&&s| s != u32::MAX).map(|&s| s as usize);
+            return self
+                .dense
+                .get(id as usize)
+                .filter(|&&s| s != u32::MAX)
+                .map(|&s| s as usize);
         }
         self.sparse.iter().find(|x| x.0 == id).map(|x| x.1)
     }

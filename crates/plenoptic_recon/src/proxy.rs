@@ -16,7 +16,9 @@
 use std::collections::HashMap;
 
 use glam::{Affine3A, Vec3};
-use plenoptic_pack::{AnimationTracks, Interpolation as PackInterp, PackReader, Track as PackTrack};
+use plenoptic_pack::{
+    AnimationTracks, Interpolation as PackInterp, PackReader, Track as PackTrack,
+};
 use plenoptic_scene::{Interpolation, Key, Mesh, Node, Object, Scene, Track, Trs, TrsTrack};
 use plenoptic_trace::{PlacedScene, Ray, SceneAccel};
 use rayon::prelude::*;
@@ -86,21 +88,33 @@ impl ProxyGeometry {
         let tracks = match pack.tracks() {
             Ok(t) => t,
             Err(e) => {
-                if pack.manifest().objects.iter().any(|o| o.motion == plenoptic_pack::Motion::Animated) {
+                if pack
+                    .manifest()
+                    .objects
+                    .iter()
+                    .any(|o| o.motion == plenoptic_pack::Motion::Animated)
+                {
                     missing.push(format!("animation tracks: {e}"));
                 }
                 AnimationTracks::default()
             }
         };
         let mut scene = Scene::default();
-        scene.materials.push(plenoptic_trace::shapes::diffuse(Vec3::splat(0.5)));
+        scene
+            .materials
+            .push(plenoptic_trace::shapes::diffuse(Vec3::splat(0.5)));
         let mut pack_ids = Vec::new();
         for entry in &pack.manifest().objects {
-            let Some(key) = entry.proxy_mesh else { continue };
+            let Some(key) = entry.proxy_mesh else {
+                continue;
+            };
             let mesh = match pack.proxy_mesh(key) {
                 Ok(m) => m,
                 Err(e) => {
-                    missing.push(format!("proxy mesh of object {} ({}): {e}", entry.id, entry.name));
+                    missing.push(format!(
+                        "proxy mesh of object {} ({}): {e}",
+                        entry.id, entry.name
+                    ));
                     continue;
                 }
             };
@@ -110,13 +124,21 @@ impl ProxyGeometry {
                 normals,
                 uvs: Vec::new(),
                 tangents: Vec::new(),
-                triangles: mesh.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+                triangles: mesh
+                    .indices
+                    .chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect(),
             });
-            let track = tracks.objects.iter().find(|o| o.object_id == entry.id).map(|o| TrsTrack {
-                translation: o.translation.as_ref().and_then(convert_track),
-                rotation: o.rotation.as_ref().and_then(convert_track),
-                scale: o.scale.as_ref().and_then(convert_track),
-            });
+            let track = tracks
+                .objects
+                .iter()
+                .find(|o| o.object_id == entry.id)
+                .map(|o| TrsTrack {
+                    translation: o.translation.as_ref().and_then(convert_track),
+                    rotation: o.rotation.as_ref().and_then(convert_track),
+                    scale: o.scale.as_ref().and_then(convert_track),
+                });
             scene.nodes.push(Node {
                 name: entry.name.clone(),
                 parent: None,
@@ -138,7 +160,11 @@ impl ProxyGeometry {
         let scene: &'static Scene = Box::leak(Box::new(scene));
         match SceneAccel::new(scene) {
             Ok(accel) => {
-                let index_of = pack_ids.iter().enumerate().map(|(i, &id)| (id, i)).collect();
+                let index_of = pack_ids
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &id)| (id, i))
+                    .collect();
                 (
                     Some(ProxyGeometry {
                         scene,

@@ -26,8 +26,10 @@ use crate::{Error, Result};
 pub struct ReconSettings {
     /// Most base views blended per frame (more: smoother transitions, linear cost).
     pub max_views: usize,
-    /// Relative distance tolerance of a geometry-assisted lookup (|d_cube − d| < tol·d).
-    /// Too small rejects valid lookups at grazing angles; too large lets occluders through.
+    /// Relative distance tolerance of a geometry-assisted lookup (|d_cube − d| < tol·d, where
+    /// d_cube is the distance to the plane of the texel's surface along the lookup direction
+    /// when normals are available). Too small rejects valid lookups; too large lets occluders
+    /// through. Also the relative depth window of blending in image and volume modes.
     pub depth_tolerance: f32,
     /// Exponent of the angular-closeness weight `((1 + cos θ)/2)^p` between a base view's
     /// direction to a point and the camera's (0 disables it).
@@ -49,7 +51,7 @@ impl Default for ReconSettings {
     fn default() -> Self {
         ReconSettings {
             max_views: 4,
-            depth_tolerance: 0.04,
+            depth_tolerance: 0.03,
             angular_power: 8.0,
             time_epsilon: None,
             volume_face_size: 48,
@@ -65,6 +67,7 @@ pub(crate) enum Cached {
     Radiance(Arc<CubeImage<Vec3>>),
     Distance(Arc<CubeImage<f32>>),
     Ids(Arc<CubeImage<u32>>),
+    Normal(Arc<CubeImage<Vec3>>),
     Volume(Arc<VolumeBlock>),
     Failed(String),
 }
@@ -75,6 +78,7 @@ impl Cached {
             Cached::Radiance(c) => c.texels.len() * 12,
             Cached::Distance(c) => c.texels.len() * 4,
             Cached::Ids(c) => c.texels.len() * 4,
+            Cached::Normal(c) => c.texels.len() * 12,
             Cached::Volume(b) => b.samples.len() * 64,
             Cached::Failed(s) => s.len(),
         }
@@ -113,6 +117,8 @@ pub(crate) struct KeyCubes {
     pub radiance: Arc<CubeImage<Vec3>>,
     pub distance: Arc<CubeImage<f32>>,
     pub ids: Arc<CubeImage<u32>>,
+    /// Normals, when readable (sharpen the distance test at grazing angles).
+    pub normal: Option<Arc<CubeImage<Vec3>>>,
 }
 
 impl Reconstructor {
@@ -164,10 +170,26 @@ impl Reconstructor {
         }
         let what = |e: plenoptic_pack::PackError| Cached::Failed(e.to_string());
         let value = match kind {
-            ChunkKind::RadianceCube => self.pack.radiance(view, key).map(|c| Cached::Radiance(Arc::new(c))),
-            ChunkKind::DistanceCube => self.pack.distance(view, key).map(|c| Cached::Distance(Arc::new(c))),
-            ChunkKind::ObjectIdCube => self.pack.object_id(view, key).map(|c| Cached::Ids(Arc::new(c))),
-            _ => self.pack.volume_block(view, key).map(|b| Cached::Volume(Arc::new(b))),
+            ChunkKind::RadianceCube => self
+                .pack
+                .radiance(view, key)
+                .map(|c| Cached::Radiance(Arc::new(c))),
+            ChunkKind::DistanceCube => self
+                .pack
+                .distance(view, key)
+                .map(|c| Cached::Distance(Arc::new(c))),
+            ChunkKind::ObjectIdCube => self
+                .pack
+                .object_id(view, key)
+                .map(|c| Cached::Ids(Arc::new(c))),
+            ChunkKind::NormalCube => self
+                .pack
+                .normal(view, key)
+                .map(|c| Cached::Normal(Arc::new(c))),
+            _ => self
+                .pack
+                .volume_block(view, key)
+                .map(|b| Cached::Volume(Arc::new(b))),
         }
         .unwrap_or_else(what);
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
@@ -176,7 +198,9 @@ impl Reconstructor {
         c.bytes += value.bytes();
         c.map.insert((kind, view, key), (value.clone(), tick));
         while c.bytes > self.settings.cache_bytes && c.map.len() > 1 {
-            let Some((&k, _)) = c.map.iter().min_by_key(|(_, v)| v.1) else { break };
+            let Some((&k, _)) = c.map.iter().min_by_key(|(_, v)| v.1) else {
+                break;
+            };
             if let Some((v, _)) = c.map.remove(&k) {
                 c.bytes = c.bytes.saturating_sub(v.bytes());
             }
@@ -185,9 +209,16 @@ impl Reconstructor {
     }
 
     /// The three cubes of (view, key), or a description of what failed.
-    pub(crate) fn key_cubes(&self, view: usize, key: usize, missing: &mut Vec<String>) -> Option<KeyCubes> {
+    pub(crate) fn key_cubes(
+        &self,
+        view: usize,
+        key: usize,
+        missing: &mut Vec<String>,
+    ) -> Option<KeyCubes> {
         let (v, k) = (view as u32, key as u32);
-        let mut fail = |kind: &str, e: String| missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"));
+        let mut fail = |kind: &str, e: String| {
+            missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"))
+        };
         let radiance = match self.cached(ChunkKind::RadianceCube, v, k) {
             Cached::Radiance(c) => c,
             Cached::Failed(e) => return fail("radiance", e).then_none(),
@@ -204,22 +235,48 @@ impl Reconstructor {
             _ => return None,
         };
         if radiance.face_size != distance.face_size || ids.face_size != distance.face_size {
-            missing.push(format!("base view {view}, key {key}: cube face sizes differ"));
+            missing.push(format!(
+                "base view {view}, key {key}: cube face sizes differ"
+            ));
             return None;
         }
-        Some(KeyCubes { radiance, distance, ids })
+        let normal = match self.cached(ChunkKind::NormalCube, v, k) {
+            Cached::Normal(c) if c.face_size == distance.face_size => Some(c),
+            Cached::Failed(e) => {
+                missing.push(format!("normal cube of base view {view}, key {key}: {e}"));
+                None
+            }
+            _ => None,
+        };
+        Some(KeyCubes {
+            radiance,
+            distance,
+            ids,
+            normal,
+        })
     }
 
     /// The volume block of (view, bucket), if present and readable (absence of a block is not
     /// reported: volumes are optional).
-    pub(crate) fn volume_block(&self, view: usize, bucket: u32, missing: &mut Vec<String>) -> Option<Arc<VolumeBlock>> {
-        if self.pack.find(ChunkKind::VolumeBlock, view as u32, bucket).is_none() {
+    pub(crate) fn volume_block(
+        &self,
+        view: usize,
+        bucket: u32,
+        missing: &mut Vec<String>,
+    ) -> Option<Arc<VolumeBlock>> {
+        if self
+            .pack
+            .find(ChunkKind::VolumeBlock, view as u32, bucket)
+            .is_none()
+        {
             return None;
         }
         match self.cached(ChunkKind::VolumeBlock, view as u32, bucket) {
             Cached::Volume(b) => Some(b),
             Cached::Failed(e) => {
-                missing.push(format!("volume block of base view {view}, bucket {bucket}: {e}"));
+                missing.push(format!(
+                    "volume block of base view {view}, bucket {bucket}: {e}"
+                ));
                 None
             }
             _ => None,
@@ -234,7 +291,13 @@ impl Reconstructor {
             .base_views
             .iter()
             .enumerate()
-            .map(|(i, v)| (0..v.time_keys.len()).any(|k| self.pack.find(ChunkKind::RadianceCube, i as u32, k as u32).is_some()))
+            .map(|(i, v)| {
+                (0..v.time_keys.len()).any(|k| {
+                    self.pack
+                        .find(ChunkKind::RadianceCube, i as u32, k as u32)
+                        .is_some()
+                })
+            })
             .collect();
         let mut w = ViewWeights::new(&m.view_space, &m.base_views, &usable).weights(position);
         w.truncate(self.settings.max_views.max(1));
@@ -257,9 +320,13 @@ impl Reconstructor {
             ..Report::default()
         };
         let frame = match mode {
-            Mode::GeometryAssisted if self.proxy.is_some() => crate::geometry::render(self, camera, t, &mut report)?,
+            Mode::GeometryAssisted if self.proxy.is_some() => {
+                crate::geometry::render(self, camera, t, &mut report)?
+            }
             Mode::GeometryAssisted => {
-                report.missing.push("no usable proxy geometry: fell back to image mode".into());
+                report
+                    .missing
+                    .push("no usable proxy geometry: fell back to image mode".into());
                 report.used_mode = Mode::Image;
                 self.render_image(camera, t, &mut report)?
             }
@@ -279,18 +346,29 @@ impl Reconstructor {
             }
         }
         if cubes.is_empty() {
-            return Err(Error::Unusable(format!("no readable range image near t = {t}: {}", report.missing.join("; "))));
+            return Err(Error::Unusable(format!(
+                "no readable range image near t = {t}: {}",
+                report.missing.join("; ")
+            )));
         }
         report.base_views = cubes.iter().map(|c| (c.0, c.1)).collect();
         let warped: Vec<(Warped, f32)> = {
             use rayon::prelude::*;
             let basis = camera.basis();
-            let positions: Vec<Vec3> = cubes.iter().map(|c| self.pack.manifest().base_views[c.0].position).collect();
+            let positions: Vec<Vec3> = cubes
+                .iter()
+                .map(|c| self.pack.manifest().base_views[c.0].position)
+                .collect();
             cubes
                 .par_iter()
                 .zip(positions)
                 .map(|((_, w, c), position)| {
-                    let view = ViewCubes { position, radiance: &c.0, distance: &c.1.distance, object: &c.1.ids };
+                    let view = ViewCubes {
+                        position,
+                        radiance: &c.0,
+                        distance: &c.1.distance,
+                        object: &c.1.ids,
+                    };
                     (warp_view(&view, &basis, camera.width, camera.height), *w)
                 })
                 .collect()
@@ -299,11 +377,26 @@ impl Reconstructor {
     }
 
     /// Blends warped views, fills holes, converts depth, fills the report.
-    pub(crate) fn finish_warped(&self, camera: &Camera, warped: &[(Warped, f32)], report: &mut Report, volume: bool) -> Frame {
+    pub(crate) fn finish_warped(
+        &self,
+        camera: &Camera,
+        warped: &[(Warped, f32)],
+        report: &mut Report,
+        volume: bool,
+    ) -> Frame {
         let (w, h) = (camera.width, camera.height);
-        let (mut rad, mut z, mut obj, mut cov) = blend_warped(warped, w, h, self.settings.depth_tolerance);
+        let (mut rad, mut z, mut obj, mut cov) =
+            blend_warped(warped, w, h, self.settings.depth_tolerance);
         let direct = cov.iter().filter(|&&c| c).count();
-        let filled = background_fill(w, h, &mut rad, &mut z, &mut obj, &mut cov, self.settings.background_passes);
+        let filled = background_fill(
+            w,
+            h,
+            &mut rad,
+            &mut z,
+            &mut obj,
+            &mut cov,
+            self.settings.background_passes,
+        );
         let rest = cov.len() - direct - filled;
         let basis = camera.basis();
         let mut frame = Frame::new(w, h);
@@ -326,7 +419,12 @@ impl Reconstructor {
 
     /// One base view's range image at time t: radiance by the Bézier weights over the keys
     /// that could be read, distance and ids from the nearest readable key.
-    pub(crate) fn view_at_time(&self, view: usize, t: f32, missing: &mut Vec<String>) -> Option<(CubeImage<Vec3>, KeyCubes)> {
+    pub(crate) fn view_at_time(
+        &self,
+        view: usize,
+        t: f32,
+        missing: &mut Vec<String>,
+    ) -> Option<(CubeImage<Vec3>, KeyCubes)> {
         let times = &self.pack.manifest().base_views.get(view)?.time_keys;
         let weights = bezier_weights(times, t);
         let mut parts = Vec::new();
@@ -337,25 +435,46 @@ impl Reconstructor {
         }
         if parts.len() < weights.len() {
             // Some keys are unreadable: fall back to linear weights over the readable nearest.
-            let mut readable: Vec<(usize, KeyCubes)> = parts.drain(..).map(|(k, _, c)| (k, c)).collect();
+            let mut readable: Vec<(usize, KeyCubes)> =
+                parts.drain(..).map(|(k, _, c)| (k, c)).collect();
             if readable.is_empty() {
                 let k = nearest_key(times, t)?;
                 let mut order: Vec<usize> = (0..times.len()).collect();
-                order.sort_by(|&a, &b| (times[a] - times[k]).abs().total_cmp(&(times[b] - times[k]).abs()));
-                readable = order.into_iter().take(3).filter_map(|k| self.key_cubes(view, k, missing).map(|c| (k, c))).collect();
+                order.sort_by(|&a, &b| {
+                    (times[a] - times[k])
+                        .abs()
+                        .total_cmp(&(times[b] - times[k]).abs())
+                });
+                readable = order
+                    .into_iter()
+                    .take(3)
+                    .filter_map(|k| self.key_cubes(view, k, missing).map(|c| (k, c)))
+                    .collect();
             }
-            let ws: Vec<f32> = readable.iter().map(|(k, _)| 1.0 / ((times[*k] - t).abs() + 1e-4)).collect();
+            let ws: Vec<f32> = readable
+                .iter()
+                .map(|(k, _)| 1.0 / ((times[*k] - t).abs() + 1e-4))
+                .collect();
             let s: f32 = ws.iter().sum();
-            parts = readable.into_iter().zip(ws).map(|((k, c), w)| (k, w / s, c)).collect();
+            parts = readable
+                .into_iter()
+                .zip(ws)
+                .map(|((k, c), w)| (k, w / s, c))
+                .collect();
         }
-        let nearest = parts.iter().min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?.2.clone();
+        let nearest = parts
+            .iter()
+            .min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?
+            .2
+            .clone();
         let list: Vec<(&CubeImage<Vec3>, f32)> = parts
             .iter()
             .filter(|p| p.2.radiance.face_size == nearest.radiance.face_size)
             .map(|p| (&*p.2.radiance, p.1))
             .collect();
         let sum: f32 = list.iter().map(|x| x.1).sum();
-        let list: Vec<(&CubeImage<Vec3>, f32)> = list.into_iter().map(|(c, w)| (c, w / sum)).collect();
+        let list: Vec<(&CubeImage<Vec3>, f32)> =
+            list.into_iter().map(|(c, w)| (c, w / sum)).collect();
         let radiance = crate::temporal::blend_cubes(&list)?;
         Some((radiance, nearest))
     }

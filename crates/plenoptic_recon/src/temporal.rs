@@ -34,7 +34,10 @@ pub fn bezier_weights(times: &[f32], t: f32) -> Vec<(usize, f32)> {
     if t >= times[n - 1] {
         return vec![(n - 1, 1.0)];
     }
-    let i = times.partition_point(|&a| a <= t).saturating_sub(1).min(n - 2);
+    let i = times
+        .partition_point(|&a| a <= t)
+        .saturating_sub(1)
+        .min(n - 2);
     let (a0, a1) = (times[i], times[i + 1]);
     let h = a1 - a0;
     if h <= 0.0 {
@@ -56,7 +59,12 @@ pub fn bezier_weights(times: &[f32], t: f32) -> Vec<(usize, f32)> {
         c
     };
     let (m0, m1) = (tangent(i), tangent(i + 1));
-    let b = [(1.0 - s).powi(3), 3.0 * (1.0 - s).powi(2) * s, 3.0 * (1.0 - s) * s * s, s.powi(3)];
+    let b = [
+        (1.0 - s).powi(3),
+        3.0 * (1.0 - s).powi(2) * s,
+        3.0 * (1.0 - s) * s * s,
+        s.powi(3),
+    ];
     // p_i
     w[1] += b[0] + b[1];
     // p_i⁺ = p_i + m_i h/3
@@ -92,9 +100,16 @@ pub fn bracketing(times: &[f32], t: f32) -> Option<(usize, usize, f32)> {
     if t >= times[n - 1] {
         return Some((n - 1, n - 1, 0.0));
     }
-    let i = times.partition_point(|&a| a <= t).saturating_sub(1).min(n - 2);
+    let i = times
+        .partition_point(|&a| a <= t)
+        .saturating_sub(1)
+        .min(n - 2);
     let h = times[i + 1] - times[i];
-    let s = if h > 0.0 { ((t - times[i]) / h).clamp(0.0, 1.0) } else { 1.0 };
+    let s = if h > 0.0 {
+        ((t - times[i]) / h).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
     Some((i, i + 1, s))
 }
 
@@ -102,7 +117,10 @@ pub fn bracketing(times: &[f32], t: f32) -> Option<(usize, usize, f32)> {
 /// cubic may overshoot). `None` if the list is empty or the sizes differ.
 pub fn blend_cubes(cubes: &[(&CubeImage<Vec3>, f32)]) -> Option<CubeImage<Vec3>> {
     let (first, _) = cubes.first()?;
-    if cubes.iter().any(|(c, _)| c.texels.len() != first.texels.len()) {
+    if cubes
+        .iter()
+        .any(|(c, _)| c.texels.len() != first.texels.len())
+    {
         return None;
     }
     let mut out = vec![Vec3::ZERO; first.texels.len()];
@@ -125,7 +143,10 @@ mod tests {
     use super::*;
 
     fn eval(times: &[f32], values: &[f32], t: f32) -> f32 {
-        bezier_weights(times, t).iter().map(|&(k, w)| w * values[k]).sum()
+        bezier_weights(times, t)
+            .iter()
+            .map(|&(k, w)| w * values[k])
+            .sum()
     }
 
     #[test]
@@ -138,7 +159,10 @@ mod tests {
         let line: Vec<f32> = times.iter().map(|a| 2.0 * a + 1.0).collect();
         for k in 0..=30 {
             let t = k as f32 * 0.1;
-            assert!((eval(&times, &line, t) - (2.0 * t + 1.0)).abs() < 1e-4, "t = {t}");
+            assert!(
+                (eval(&times, &line, t) - (2.0 * t + 1.0)).abs() < 1e-4,
+                "t = {t}"
+            );
             let sum: f32 = bezier_weights(&times, t).iter().map(|w| w.1).sum();
             assert!((sum - 1.0).abs() < 1e-5);
         }

@@ -26,8 +26,17 @@ impl HasPosition for Site {
 }
 
 enum Kind {
-    Segment { a: Vec3, dir: Vec3, order: Vec<(f32, usize)> },
-    Plane { origin: Vec3, u: Vec3, v: Vec3, tri: Box<DelaunayTriangulation<Site>> },
+    Segment {
+        a: Vec3,
+        dir: Vec3,
+        order: Vec<(f32, usize)>,
+    },
+    Plane {
+        origin: Vec3,
+        u: Vec3,
+        v: Vec3,
+        tri: Box<DelaunayTriangulation<Site>>,
+    },
     Nearest,
 }
 
@@ -39,7 +48,9 @@ pub struct ViewWeights {
 
 impl std::fmt::Debug for ViewWeights {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ViewWeights").field("positions", &self.positions).finish()
+        f.debug_struct("ViewWeights")
+            .field("positions", &self.positions)
+            .finish()
     }
 }
 
@@ -75,7 +86,12 @@ impl ViewWeights {
                 if u == Vec3::ZERO || v == Vec3::ZERO || tri.num_inner_faces() == 0 {
                     Kind::Nearest
                 } else {
-                    Kind::Plane { origin, u, v, tri: Box::new(tri) }
+                    Kind::Plane {
+                        origin,
+                        u,
+                        v,
+                        tri: Box::new(tri),
+                    }
                 }
             }
             _ => Kind::Nearest,
@@ -126,7 +142,9 @@ impl ViewWeights {
         {
             return vec![(i, 1.0)];
         }
-        d.into_iter().map(|(i, dist)| (i, 1.0 / (dist * dist))).collect()
+        d.into_iter()
+            .map(|(i, dist)| (i, 1.0 / (dist * dist)))
+            .collect()
     }
 }
 
@@ -141,7 +159,10 @@ fn segment(order: &[(f32, usize)], s: f32) -> Vec<(usize, f32)> {
     if s >= last.0 {
         return vec![(last.1, 1.0)];
     }
-    let i = order.partition_point(|x| x.0 <= s).saturating_sub(1).min(order.len() - 2);
+    let i = order
+        .partition_point(|x| x.0 <= s)
+        .saturating_sub(1)
+        .min(order.len() - 2);
     let (a, b) = (order[i], order[i + 1]);
     let h = b.0 - a.0;
     if h <= 0.0 {
@@ -171,7 +192,11 @@ fn plane(tri: &DelaunayTriangulation<Site>, q: Vec2) -> Option<Vec<(usize, f32)>
             let face = tri.face(f);
             let bary = face.barycentric_interpolation(p);
             let vs = face.vertices();
-            Some((0..3).map(|k| (vs[k].data().view, bary[k].max(0.0) as f32)).collect())
+            Some(
+                (0..3)
+                    .map(|k| (vs[k].data().view, bary[k].max(0.0) as f32))
+                    .collect(),
+            )
         }
         _ => None,
     }
@@ -184,24 +209,36 @@ mod tests {
     fn views(ps: &[Vec3]) -> Vec<BaseView> {
         ps.iter()
             .enumerate()
-            .map(|(i, &p)| BaseView { id: i as u32, position: p, time_keys: vec![0.0] })
+            .map(|(i, &p)| BaseView {
+                id: i as u32,
+                position: p,
+                time_keys: vec![0.0],
+            })
             .collect()
     }
 
     #[test]
     fn segment_plane_and_nearest() {
         let vs = views(&[Vec3::ZERO, Vec3::X * 2.0, Vec3::X]);
-        let space = ViewSpace::Segment { a: Vec3::ZERO, b: Vec3::X * 2.0 };
+        let space = ViewSpace::Segment {
+            a: Vec3::ZERO,
+            b: Vec3::X * 2.0,
+        };
         let w = ViewWeights::new(&space, &vs, &[true; 3]).weights(Vec3::new(1.5, 0.3, 0.0));
         assert_eq!(w, vec![(2, 0.5), (1, 0.5)]);
         let vs = views(&[Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z]);
-        let space = ViewSpace::Rectangle { corners: [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z] };
+        let space = ViewSpace::Rectangle {
+            corners: [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z],
+        };
         let w = ViewWeights::new(&space, &vs, &[true; 4]).weights(Vec3::new(0.25, 0.0, 0.1));
         let sum: f32 = w.iter().map(|x| x.1).sum();
         assert!((sum - 1.0).abs() < 1e-5 && w.len() == 3);
         let pos: Vec3 = w.iter().map(|&(i, x)| vs[i].position * x).sum();
         assert!(pos.abs_diff_eq(Vec3::new(0.25, 0.0, 0.1), 1e-4));
-        let space = ViewSpace::Box { min: Vec3::ZERO, max: Vec3::ONE };
+        let space = ViewSpace::Box {
+            min: Vec3::ZERO,
+            max: Vec3::ONE,
+        };
         let w = ViewWeights::new(&space, &vs, &[true, false, true, true]).weights(Vec3::X);
         assert!(w.iter().all(|x| x.0 != 1));
     }

@@ -39,14 +39,21 @@ pub struct VolumeIndex {
 
 /// The samples of `view` with |t_s − t| ≤ tε and their tent weights; `None` if the view has no
 /// readable block overlapping the window.
-pub(crate) fn filtered_samples(rec: &Reconstructor, view: usize, t: f32, missing: &mut Vec<String>) -> Option<Vec<(VolumeSample, f32)>> {
+pub(crate) fn filtered_samples(
+    rec: &Reconstructor,
+    view: usize,
+    t: f32,
+    missing: &mut Vec<String>,
+) -> Option<Vec<(VolumeSample, f32)>> {
     let m = rec.pack().manifest();
     let eps = rec.time_epsilon();
     let (b0, b1) = (m.bucket_of(t - eps), m.bucket_of(t + eps));
     let mut out = Vec::new();
     let mut any = false;
     for b in b0..=b1.min(b0.saturating_add(64)) {
-        let Some(block) = rec.volume_block(view, b, missing) else { continue };
+        let Some(block) = rec.volume_block(view, b, missing) else {
+            continue;
+        };
         any = true;
         for s in &block.samples {
             let dt = (s.t - t).abs();
@@ -60,13 +67,21 @@ pub(crate) fn filtered_samples(rec: &Reconstructor, view: usize, t: f32, missing
 
 impl VolumeIndex {
     /// Reads and bins the samples of `view` around `t`.
-    pub(crate) fn build(rec: &Reconstructor, view: usize, t: f32, missing: &mut Vec<String>) -> Option<Self> {
+    pub(crate) fn build(
+        rec: &Reconstructor,
+        view: usize,
+        t: f32,
+        missing: &mut Vec<String>,
+    ) -> Option<Self> {
         let samples = filtered_samples(rec, view, t, missing)?;
         if samples.is_empty() {
             return None;
         }
         let bins = 6 * (BIN_FACE * BIN_FACE) as usize;
-        let bin: Vec<usize> = samples.iter().map(|(s, _)| cube::direction_to_texel(BIN_FACE, s.direction)).collect();
+        let bin: Vec<usize> = samples
+            .iter()
+            .map(|(s, _)| cube::direction_to_texel(BIN_FACE, s.direction))
+            .collect();
         let mut offsets = vec![0u32; bins + 1];
         for &b in &bin {
             offsets[b + 1] += 1;
@@ -80,7 +95,11 @@ impl VolumeIndex {
             order[fill[b] as usize] = i as u32;
             fill[b] += 1;
         }
-        Some(VolumeIndex { samples, offsets, order })
+        Some(VolumeIndex {
+            samples,
+            offsets,
+            order,
+        })
     }
 
     /// Number of samples in the window.
@@ -145,7 +164,10 @@ fn face_frame(f: usize) -> (Vec3, Vec3, Vec3) {
 }
 
 /// Reconstructs radiance, distance and object-id cubes of face size `n` from filtered samples.
-pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>) {
+pub fn samples_to_cube(
+    samples: &[(VolumeSample, f32)],
+    n: u32,
+) -> (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>) {
     let nn = (n * n) as usize;
     let faces: Vec<(Vec<Vec3>, Vec<f32>, Vec<u32>)> = (0..6)
         .into_par_iter()
@@ -163,7 +185,10 @@ pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> (CubeImage<Ve
                 let p = s.direction / m;
                 let (x, y) = (p.dot(u), p.dot(v));
                 if x.abs() <= 1.3 && y.abs() <= 1.3 {
-                    let _ = tri.insert(Site { p: Point2::new(x as f64, y as f64), sample: i as u32 });
+                    let _ = tri.insert(Site {
+                        p: Point2::new(x as f64, y as f64),
+                        sample: i as u32,
+                    });
                 }
             }
             if tri.num_vertices() == 0 {
@@ -179,9 +204,13 @@ pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> (CubeImage<Ve
                             let face = tri.face(fh);
                             let b = face.barycentric_interpolation(q);
                             let vs = face.vertices();
-                            (0..3).map(|k| (vs[k].data().sample, b[k].max(0.0))).collect()
+                            (0..3)
+                                .map(|k| (vs[k].data().sample, b[k].max(0.0)))
+                                .collect()
                         }
-                        PositionInTriangulation::OnVertex(vh) => vec![(tri.vertex(vh).data().sample, 1.0)],
+                        PositionInTriangulation::OnVertex(vh) => {
+                            vec![(tri.vertex(vh).data().sample, 1.0)]
+                        }
                         PositionInTriangulation::OnEdge(e) => {
                             let e = tri.directed_edge(e);
                             vec![(e.from().data().sample, 0.5), (e.to().data().sample, 0.5)]
@@ -225,22 +254,38 @@ pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> (CubeImage<Ve
 }
 
 /// Volume mode: cubes at t from the temporal volumes of the nearest views, warped and blended.
-pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut Report) -> Result<Frame> {
+pub(crate) fn render(
+    rec: &Reconstructor,
+    camera: &Camera,
+    t: f32,
+    report: &mut Report,
+) -> Result<Frame> {
     let views = rec.view_weights(camera.position);
-    let mut cubes: Vec<(usize, f32, (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>))> = Vec::new();
+    let mut cubes: Vec<(
+        usize,
+        f32,
+        (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>),
+    )> = Vec::new();
     for &(v, w) in &views {
         match filtered_samples(rec, v, t, &mut report.missing) {
-            Some(s) if s.len() >= 3 => cubes.push((v, w, samples_to_cube(&s, rec.settings.volume_face_size))),
+            Some(s) if s.len() >= 3 => {
+                cubes.push((v, w, samples_to_cube(&s, rec.settings.volume_face_size)))
+            }
             _ => {
                 if let Some((r, k)) = rec.view_at_time(v, t, &mut report.missing) {
-                    report.missing.push(format!("base view {v} has no temporal volume near t = {t}: used its range images"));
+                    report.missing.push(format!(
+                        "base view {v} has no temporal volume near t = {t}: used its range images"
+                    ));
                     cubes.push((v, w, (r, (*k.distance).clone(), (*k.ids).clone())));
                 }
             }
         }
     }
     if cubes.is_empty() {
-        return Err(Error::Unusable(format!("no temporal volume or range image near t = {t}: {}", report.missing.join("; "))));
+        return Err(Error::Unusable(format!(
+            "no temporal volume or range image near t = {t}: {}",
+            report.missing.join("; ")
+        )));
     }
     report.base_views = cubes.iter().map(|c| (c.0, c.1)).collect();
     let basis = camera.basis();
@@ -248,7 +293,12 @@ pub(crate) fn render(rec: &Reconstructor, camera: &Camera, t: f32, report: &mut 
         .par_iter()
         .map(|(v, w, (r, d, o))| {
             let position = rec.pack().manifest().base_views[*v].position;
-            let view = ViewCubes { position, radiance: r, distance: d, object: o };
+            let view = ViewCubes {
+                position,
+                radiance: r,
+                distance: d,
+                object: o,
+            };
             (warp_view(&view, &basis, camera.width, camera.height), *w)
         })
         .collect();

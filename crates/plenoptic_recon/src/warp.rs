@@ -6,8 +6,8 @@
 //! texel spans `2/n` in face coordinates, so at distance `d` along a direction whose largest
 //! component is `m` it covers about `2 d m / n` metres across (surface slant is ignored),
 //! i.e. `2 d m f / (n z)` pixels at camera depth `z` with focal length `f` pixels. Splats are
-//! capped at [`MAX_SPLAT_PX`] pixels. Among splats of the same surface the one whose centre is
-//! nearer the pixel wins (a depth bias of 10⁻³ per squared pixel of offset).
+//! capped at [`MAX_SPLAT_PX`] pixels. A splat in front (by more than [`SAME_SURFACE`], relative)
+//! wins; among splats of the same surface the one whose centre is nearer the pixel wins.
 //!
 //! Warped views are blended per pixel over the views whose depth is within a relative
 //! tolerance of the nearest ([`blend_warped`]), and the remaining holes are filled from the
@@ -19,6 +19,9 @@ use plenoptic_pack::{CubeImage, cube};
 use rayon::prelude::*;
 
 use crate::camera::CameraBasis;
+
+/// Relative depth difference under which two splats count as the same surface.
+pub const SAME_SURFACE: f32 = 0.03;
 
 /// Largest splat edge, pixels.
 pub const MAX_SPLAT_PX: f32 = 8.0;
@@ -57,7 +60,12 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
     };
     let mut key = vec![f32::INFINITY; w * h];
     let n = view.distance.face_size;
-    let texels = view.distance.texels.len().min(view.radiance.texels.len()).min(view.object.texels.len());
+    let texels = view
+        .distance
+        .texels
+        .len()
+        .min(view.radiance.texels.len())
+        .min(view.object.texels.len());
     if view.radiance.face_size != n || view.object.face_size != n {
         return out;
     }
@@ -74,8 +82,14 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
         let m = dir.abs().max_element();
         let size = (2.0 * d * m * cam.focal_px / (n as f32 * z)).min(MAX_SPLAT_PX);
         let half = (size * 0.5).max(0.5);
-        let (x0, x1) = ((px - half).floor().max(0.0), (px + half).floor().min(w as f32 - 1.0));
-        let (y0, y1) = ((py - half).floor().max(0.0), (py + half).floor().min(h as f32 - 1.0));
+        let (x0, x1) = (
+            (px - half).floor().max(0.0),
+            (px + half).floor().min(w as f32 - 1.0),
+        );
+        let (y0, y1) = (
+            (py - half).floor().max(0.0),
+            (py + half).floor().min(h as f32 - 1.0),
+        );
         if x0 > x1 || y0 > y1 {
             continue;
         }
@@ -84,10 +98,15 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
             let dy = y as f32 + 0.5 - py;
             for x in x0 as usize..=x1 as usize {
                 let dx = x as f32 + 0.5 - px;
-                let k = z * (1.0 + 1e-3 * (dx * dx + dy * dy));
+                let r2 = dx * dx + dy * dy;
                 let j = y * w + x;
-                if k < key[j] {
-                    key[j] = k;
+                let cur = out.z[j];
+                // Clearly in front: wins. Same surface (within the tolerance): the nearer
+                // splat centre wins. Behind: loses.
+                if z < cur * (1.0 - SAME_SURFACE)
+                    || (z <= cur * (1.0 + SAME_SURFACE) && r2 < key[j])
+                {
+                    key[j] = r2;
                     out.z[j] = z;
                     out.radiance[j] = c;
                     out.object[j] = o;
@@ -101,7 +120,12 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
 /// Blends warped views with `weights` (one per view): per pixel, the views whose depth is
 /// within `tolerance` (relative) of the nearest take part. Returns radiance, depth, object and
 /// a coverage flag per pixel.
-pub fn blend_warped(views: &[(Warped, f32)], width: u32, height: u32, tolerance: f32) -> (Vec<Vec3>, Vec<f32>, Vec<u32>, Vec<bool>) {
+pub fn blend_warped(
+    views: &[(Warped, f32)],
+    width: u32,
+    height: u32,
+    tolerance: f32,
+) -> (Vec<Vec3>, Vec<f32>, Vec<u32>, Vec<bool>) {
     let n = width as usize * height as usize;
     let mut rad = vec![Vec3::ZERO; n];
     let mut z = vec![f32::INFINITY; n];
@@ -113,7 +137,10 @@ pub fn blend_warped(views: &[(Warped, f32)], width: u32, height: u32, tolerance:
         .zip(cov.par_iter_mut())
         .enumerate()
         .for_each(|(j, (((r, zz), o), c))| {
-            let zmin = views.iter().map(|(v, _)| v.z[j]).fold(f32::INFINITY, f32::min);
+            let zmin = views
+                .iter()
+                .map(|(v, _)| v.z[j])
+                .fold(f32::INFINITY, f32::min);
             if !zmin.is_finite() {
                 return;
             }
@@ -137,7 +164,15 @@ pub fn blend_warped(views: &[(Warped, f32)], width: u32, height: u32, tolerance:
 
 /// Fills holes (`covered == false`) from their farthest covered 8-neighbour, up to `passes`
 /// times; returns the number of pixels filled. Filled pixels become covered.
-pub fn background_fill(width: u32, height: u32, radiance: &mut [Vec3], z: &mut [f32], object: &mut [u32], covered: &mut [bool], passes: u32) -> usize {
+pub fn background_fill(
+    width: u32,
+    height: u32,
+    radiance: &mut [Vec3],
+    z: &mut [f32],
+    object: &mut [u32],
+    covered: &mut [bool],
+    passes: u32,
+) -> usize {
     let (w, h) = (width as usize, height as usize);
     let mut filled = 0;
     for _ in 0..passes {

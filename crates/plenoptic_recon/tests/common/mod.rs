@@ -6,8 +6,9 @@
 use std::path::Path;
 
 use plenoptic_pack::{
-    AnimationTracks, BaseView, CubeFormats, CubeImage, Interpolation, Manifest, Motion, ObjectEntry, ObjectTracks,
-    PackWriter, ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample, cube,
+    AnimationTracks, BaseView, CubeFormats, CubeImage, Interpolation, Manifest, Motion,
+    ObjectEntry, ObjectTracks, PackWriter, ProxyMesh, RangeImage, TimeRange, Track, ViewSpace,
+    VolumeSample, cube,
 };
 use plenoptic_scene::Scene;
 use plenoptic_trace::glam::{Quat, Vec2, Vec3};
@@ -22,34 +23,105 @@ pub fn room(moving: bool) -> Scene {
     let mut b = shapes::SceneBuilder::default();
     let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
     let wall = |b: &mut shapes::SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3| {
-        let rot = if n.dot(Vec3::Y) < -0.999 { Quat::from_rotation_x(std::f32::consts::PI) } else { Quat::from_rotation_arc(Vec3::Y, n) };
-        b.object_trs(name, shapes::quad(size), m, plenoptic_scene::Trs { translation: pos, rotation: rot, scale: Vec3::ONE });
+        let rot = if n.dot(Vec3::Y) < -0.999 {
+            Quat::from_rotation_x(std::f32::consts::PI)
+        } else {
+            Quat::from_rotation_arc(Vec3::Y, n)
+        };
+        b.object_trs(
+            name,
+            shapes::quad(size),
+            m,
+            plenoptic_scene::Trs {
+                translation: pos,
+                rotation: rot,
+                scale: Vec3::ONE,
+            },
+        );
     };
     wall(&mut b, "floor", Vec2::new(4.0, 5.0), Vec3::ZERO, Vec3::Y);
-    wall(&mut b, "ceiling", Vec2::new(4.0, 5.0), Vec3::new(0.0, 2.6, 0.0), -Vec3::Y);
-    wall(&mut b, "back", Vec2::new(4.0, 2.6), Vec3::new(0.0, 1.3, -2.5), Vec3::Z);
-    wall(&mut b, "front", Vec2::new(4.0, 2.6), Vec3::new(0.0, 1.3, 2.5), -Vec3::Z);
-    wall(&mut b, "left", Vec2::new(2.6, 5.0), Vec3::new(-2.0, 1.3, 0.0), Vec3::X);
-    wall(&mut b, "right", Vec2::new(2.6, 5.0), Vec3::new(2.0, 1.3, 0.0), -Vec3::X);
-    b.object("box", shapes::cuboid(Vec3::splat(0.7)), m, Vec3::new(0.6, 0.35, -1.0));
-    b.object("pillar", shapes::cuboid(Vec3::new(0.3, 1.6, 0.3)), m, Vec3::new(-0.9, 0.8, -0.6));
+    wall(
+        &mut b,
+        "ceiling",
+        Vec2::new(4.0, 5.0),
+        Vec3::new(0.0, 2.6, 0.0),
+        -Vec3::Y,
+    );
+    wall(
+        &mut b,
+        "back",
+        Vec2::new(4.0, 2.6),
+        Vec3::new(0.0, 1.3, -2.5),
+        Vec3::Z,
+    );
+    wall(
+        &mut b,
+        "front",
+        Vec2::new(4.0, 2.6),
+        Vec3::new(0.0, 1.3, 2.5),
+        -Vec3::Z,
+    );
+    wall(
+        &mut b,
+        "left",
+        Vec2::new(2.6, 5.0),
+        Vec3::new(-2.0, 1.3, 0.0),
+        Vec3::X,
+    );
+    wall(
+        &mut b,
+        "right",
+        Vec2::new(2.6, 5.0),
+        Vec3::new(2.0, 1.3, 0.0),
+        -Vec3::X,
+    );
+    b.object(
+        "box",
+        shapes::cuboid(Vec3::splat(0.7)),
+        m,
+        Vec3::new(0.6, 0.35, -1.0),
+    );
+    b.object(
+        "pillar",
+        shapes::cuboid(Vec3::new(0.3, 1.6, 0.3)),
+        m,
+        Vec3::new(-0.9, 0.8, -0.6),
+    );
     if moving {
-        let id = b.object("slider", shapes::cuboid(Vec3::new(0.5, 0.5, 0.5)), m, Vec3::new(-1.2, 0.25, -0.2));
-        b.animate_translation(id, &[(0.0, Vec3::new(-1.2, 0.25, -0.2)), (2.0, Vec3::new(1.2, 0.25, -0.2))]);
+        let id = b.object(
+            "slider",
+            shapes::cuboid(Vec3::new(0.5, 0.5, 0.5)),
+            m,
+            Vec3::new(-1.2, 0.25, -0.2),
+        );
+        b.animate_translation(
+            id,
+            &[
+                (0.0, Vec3::new(-1.2, 0.25, -0.2)),
+                (2.0, Vec3::new(1.2, 0.25, -0.2)),
+            ],
+        );
     }
     b.build()
 }
 
 fn object_colour(id: u32) -> Vec3 {
     let h = id.wrapping_mul(2654435761);
-    Vec3::new(0.35 + 0.6 * ((h & 255) as f32 / 255.0), 0.35 + 0.6 * (((h >> 8) & 255) as f32 / 255.0), 0.35 + 0.6 * (((h >> 16) & 255) as f32 / 255.0))
+    Vec3::new(
+        0.35 + 0.6 * ((h & 255) as f32 / 255.0),
+        0.35 + 0.6 * (((h >> 8) & 255) as f32 / 255.0),
+        0.35 + 0.6 * (((h >> 16) & 255) as f32 / 255.0),
+    )
 }
 
 /// Deterministic shading of a hit seen along `ray`: object colour × object-space checker ×
 /// (ambient + shadowed diffuse) + a view-dependent highlight.
 pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<(Vec3, f32, u32, Vec3)> {
     let hit = placed.intersect(ray)?;
-    let local = placed.object_transform(hit.object).inverse().transform_point3(hit.position);
+    let local = placed
+        .object_transform(hit.object)
+        .inverse()
+        .transform_point3(hit.position);
     let c = ((local * 4.0).floor().dot(Vec3::ONE) as i32).rem_euclid(2) as f32;
     let albedo = object_colour(hit.object) * (0.6 + 0.4 * c);
     let mut n = hit.geometric_normal.normalize();
@@ -60,10 +132,23 @@ pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<(Vec3, f32, u32, Vec
     let dl = to_light.length();
     let l = to_light / dl;
     let lit = !placed.segment_occluded(hit.offset_origin(l), LIGHT);
-    let diffuse = if lit { n.dot(l).max(0.0) * 3.0 / (dl * dl) } else { 0.0 };
+    let diffuse = if lit {
+        n.dot(l).max(0.0) * 3.0 / (dl * dl)
+    } else {
+        0.0
+    };
     let refl = (2.0 * n.dot(l) * n - l).normalize();
-    let spec = if lit { refl.dot(-ray.direction).max(0.0).powi(12) * 0.6 } else { 0.0 };
-    Some((albedo * (0.15 + diffuse) + Vec3::splat(spec), hit.distance, hit.object + 1, n))
+    let spec = if lit {
+        refl.dot(-ray.direction).max(0.0).powi(12) * 0.6
+    } else {
+        0.0
+    };
+    Some((
+        albedo * (0.15 + diffuse) + Vec3::splat(spec),
+        hit.distance,
+        hit.object + 1,
+        n,
+    ))
 }
 
 /// Range image of face size `n` from `position` with the scene placed at `placed`.
@@ -117,8 +202,27 @@ impl PackSpec {
     /// `count` base views evenly along the segment from (−1, 1.3, 1) to (1, 1.3, 1).
     pub fn segment(count: usize, keys: Vec<f32>, face: u32) -> Self {
         let (a, b) = segment_ends();
-        let views = (0..count).map(|i| a.lerp(b, if count > 1 { i as f32 / (count - 1) as f32 } else { 0.5 })).collect();
-        PackSpec { views, keys, face, volume_samples: 0, time: (0.0, 2.0), bucket: 0.25, skip: Vec::new() }
+        let views = (0..count)
+            .map(|i| {
+                a.lerp(
+                    b,
+                    if count > 1 {
+                        i as f32 / (count - 1) as f32
+                    } else {
+                        0.5
+                    },
+                )
+            })
+            .collect();
+        PackSpec {
+            views,
+            keys,
+            face,
+            volume_samples: 0,
+            time: (0.0, 2.0),
+            bucket: 0.25,
+            skip: Vec::new(),
+        }
     }
 }
 
@@ -130,7 +234,10 @@ pub fn segment_ends() -> (Vec3, Vec3) {
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 40) as f32) / (1u64 << 24) as f32
     }
 }
@@ -145,10 +252,22 @@ pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
             if spec.skip.contains(&(v, k)) {
                 continue;
             }
-            w.add_range_image(v as u32, k as u32, &range_image(p, pos, spec.face), CubeFormats::default()).unwrap();
+            w.add_range_image(
+                v as u32,
+                k as u32,
+                &range_image(p, pos, spec.face),
+                CubeFormats::default(),
+            )
+            .unwrap();
         }
     }
-    let mut manifest = Manifest::new(TimeRange { start: spec.time.0, end: spec.time.1 }, spec.bucket);
+    let mut manifest = Manifest::new(
+        TimeRange {
+            start: spec.time.0,
+            end: spec.time.1,
+        },
+        spec.bucket,
+    );
     if spec.volume_samples > 0 {
         let mut rng = Lcg(7);
         for (v, &pos) in spec.views.iter().enumerate() {
@@ -179,7 +298,8 @@ pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
                         })
                     })
                     .collect();
-                w.add_volume_block(v as u32, bucket, (t0, t1), &samples, None).unwrap();
+                w.add_volume_block(v as u32, bucket, (t0, t1), &samples, None)
+                    .unwrap();
             }
         }
     }
@@ -189,13 +309,36 @@ pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
         let animated = scene.object_is_animated(i as u32);
         let mesh = &scene.meshes[obj.mesh];
         let to_world = scene.object_transform(i as u32, 0.0);
-        let positions = if animated { mesh.positions.clone() } else { mesh.positions.iter().map(|&p| to_world.transform_point3(p)).collect() };
-        w.add_proxy_mesh(&ProxyMesh { object_id: id, positions, indices: mesh.triangles.iter().flatten().copied().collect(), normals: None }).unwrap();
+        let positions = if animated {
+            mesh.positions.clone()
+        } else {
+            mesh.positions
+                .iter()
+                .map(|&p| to_world.transform_point3(p))
+                .collect()
+        };
+        w.add_proxy_mesh(&ProxyMesh {
+            object_id: id,
+            positions,
+            indices: mesh.triangles.iter().flatten().copied().collect(),
+            normals: None,
+        })
+        .unwrap();
         if animated {
-            let track = scene.nodes[obj.node].track.as_ref().unwrap().translation.as_ref().unwrap();
+            let track = scene.nodes[obj.node]
+                .track
+                .as_ref()
+                .unwrap()
+                .translation
+                .as_ref()
+                .unwrap();
             tracks.objects.push(ObjectTracks {
                 object_id: id,
-                translation: Some(Track { interpolation: Interpolation::Linear, times: track.keys.iter().map(|k| k.time).collect(), values: track.keys.iter().map(|k| k.value).collect() }),
+                translation: Some(Track {
+                    interpolation: Interpolation::Linear,
+                    times: track.keys.iter().map(|k| k.time).collect(),
+                    values: track.keys.iter().map(|k| k.value).collect(),
+                }),
                 rotation: None,
                 scale: None,
             });
@@ -204,14 +347,27 @@ pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
             id,
             name: obj.name.clone(),
             node_path: obj.node_path.clone(),
-            motion: if animated { Motion::Animated } else { Motion::Static },
+            motion: if animated {
+                Motion::Animated
+            } else {
+                Motion::Static
+            },
             proxy_mesh: Some(id),
         });
     }
     w.add_tracks(&tracks).unwrap();
     let (a, b) = segment_ends();
     manifest.view_space = ViewSpace::Segment { a, b };
-    manifest.base_views = spec.views.iter().enumerate().map(|(i, &p)| BaseView { id: i as u32, position: p, time_keys: spec.keys.clone() }).collect();
+    manifest.base_views = spec
+        .views
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| BaseView {
+            id: i as u32,
+            position: p,
+            time_keys: spec.keys.clone(),
+        })
+        .collect();
     manifest.bake.cube_face_size = spec.face;
     w.finish(&manifest).unwrap();
 }
@@ -221,7 +377,10 @@ pub fn sample_cube(cube: &CubeImage<Vec3>, camera: &plenoptic_recon::Camera) -> 
     let b = camera.basis();
     (0..camera.pixel_count())
         .map(|j| {
-            let (x, y) = ((j % camera.width as usize) as f32 + 0.5, (j / camera.width as usize) as f32 + 0.5);
+            let (x, y) = (
+                (j % camera.width as usize) as f32 + 0.5,
+                (j / camera.width as usize) as f32 + 0.5,
+            );
             *cube.lookup(b.direction(x, y)).unwrap()
         })
         .collect()
