@@ -5,11 +5,14 @@
 
 pub mod camera;
 pub mod frame;
+pub mod frame_io;
 mod geometry;
 pub mod path;
+pub mod plot;
 pub mod proxy;
 pub mod reconstructor;
 pub mod temporal;
+pub mod tools;
 pub mod viewspace;
 pub mod volume;
 pub mod warp;
