@@ -1,2 +1,382 @@
-//! The plenoptic command (being written).
-fn main() {}
+//! The `plenoptic` command: plan, bake, merge, inspect and reference-render radiance packs.
+//!
+//! ```text
+//! plenoptic plan RECIPE [--out PLAN.json]          print the plan and its cost, write the plan
+//! plenoptic bake RECIPE [--resume] [--shard i/N] [--keep-work] [--timings-in-manifest] [-q]
+//! plenoptic merge RECIPE [--keep-work]              join shards into the pack
+//! plenoptic inspect PACK [--chunks] [--extract N OUT]
+//! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N]
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Parser, Subcommand};
+use plenoptic_bake::progress::Progress;
+use plenoptic_bake::{BakeError, BakeOptions, Result, Shard, plan};
+use plenoptic_pack::PackReader;
+use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
+
+#[derive(Parser)]
+#[command(name = "plenoptic", version, about = "Bake and inspect radiance packs")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Compute the bake plan (base views, time keys, ambient keys) and print its cost.
+    Plan {
+        /// The bake recipe (TOML).
+        recipe: PathBuf,
+        /// Where to write the plan JSON (default: `<output>.plan.json`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print the plan JSON instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Bake the recipe into its pack.
+    Bake {
+        /// The bake recipe (TOML).
+        recipe: PathBuf,
+        /// Continue an interrupted bake from `<output>.work/`.
+        #[arg(long)]
+        resume: bool,
+        /// Bake only shard i of N into `<output>.work/` (then run `plenoptic merge`).
+        #[arg(long)]
+        shard: Option<Shard>,
+        /// Keep `<output>.work/` after writing the pack.
+        #[arg(long)]
+        keep_work: bool,
+        /// Store wall-clock timings in the manifest too (the pack is then not byte-identical
+        /// between runs).
+        #[arg(long)]
+        timings_in_manifest: bool,
+        /// Write the pack here instead of the recipe's output.
+        #[arg(long)]
+        output: Option<PathBuf>,
+        /// No progress bars.
+        #[arg(short, long)]
+        quiet: bool,
+        /// Stop after rendering N work items (for testing --resume).
+        #[arg(long, hide = true)]
+        stop_after: Option<usize>,
+    },
+    /// Join the shards in `<output>.work/` into the pack.
+    Merge {
+        /// The bake recipe (TOML).
+        recipe: PathBuf,
+        /// Write the pack here instead of the recipe's output.
+        #[arg(long)]
+        output: Option<PathBuf>,
+        /// Keep `<output>.work/` after writing the pack.
+        #[arg(long)]
+        keep_work: bool,
+    },
+    /// Summarise a pack.
+    Inspect {
+        /// The pack.
+        pack: PathBuf,
+        /// List every chunk.
+        #[arg(long)]
+        chunks: bool,
+        /// Write chunk N's bytes (a KTX2 file for cube chunks) to OUT.
+        #[arg(long, num_args = 2, value_names = ["N", "OUT"])]
+        extract: Option<Vec<String>>,
+    },
+    /// Render reference frames along a camera path with the path tracer (PNG).
+    Reference {
+        /// The bake recipe (TOML): scene and quality.
+        recipe: PathBuf,
+        /// The camera path (JSON, plenoptic_recon's format).
+        #[arg(long)]
+        path: PathBuf,
+        /// Output directory.
+        #[arg(long, default_value = "reference")]
+        out: PathBuf,
+        /// Samples per pixel (default: the recipe's reference_samples_per_pixel).
+        #[arg(long)]
+        spp: Option<u32>,
+        /// Exposure of the PNGs.
+        #[arg(long, default_value_t = 1.0)]
+        exposure: f32,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("plenoptic: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(command: Command) -> Result<()> {
+    match command {
+        Command::Plan { recipe, out, json } => cmd_plan(&recipe, out, json),
+        Command::Bake {
+            recipe,
+            resume,
+            shard,
+            keep_work,
+            timings_in_manifest,
+            output,
+            quiet,
+            stop_after,
+        } => {
+            let options = BakeOptions {
+                resume,
+                shard,
+                keep_work,
+                timings_in_manifest,
+                stop_after,
+                progress: Progress::new(!quiet),
+                output,
+            };
+            let report = plenoptic_bake::bake_recipe(&recipe, &options)?;
+            match (&report.output, shard) {
+                (Some(out), _) => println!(
+                    "wrote {} ({} items rendered, {} resumed)",
+                    out.display(),
+                    report.items_rendered,
+                    report.items_skipped
+                ),
+                (None, Some(s)) => println!(
+                    "shard {s}: {} items rendered, {} already done, of {} in the plan",
+                    report.items_rendered, report.items_skipped, report.items_total
+                ),
+                (None, None) => {}
+            }
+            for (phase, secs) in &report.timings {
+                println!("  {phase:>14}: {secs:.3} s");
+            }
+            Ok(())
+        }
+        Command::Merge {
+            recipe,
+            output,
+            keep_work,
+        } => {
+            let options = BakeOptions {
+                keep_work,
+                output,
+                ..Default::default()
+            };
+            let report = plenoptic_bake::merge_recipe(&recipe, &options)?;
+            if let Some(out) = report.output {
+                println!("merged {} items into {}", report.items_total, out.display());
+            }
+            Ok(())
+        }
+        Command::Inspect {
+            pack,
+            chunks,
+            extract,
+        } => cmd_inspect(&pack, chunks, extract),
+        Command::Reference {
+            recipe,
+            path,
+            out,
+            spp,
+            exposure,
+        } => cmd_reference(&recipe, &path, &out, spp, exposure),
+    }
+}
+
+fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> {
+    let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
+    let accel = SceneAccel::new(&scene)?;
+    let clock = Instant::now();
+    let planned = plan::build(&recipe, &scene, &accel)?;
+    let secs = clock.elapsed().as_secs_f64().max(1e-6);
+    // Id rays are about as costly as one shading ray; the planning rate stands in for both.
+    let rate = planned.id_rays as f64 / secs;
+    let p = &planned.plan;
+    let cost = p.cost(rate);
+    let out = out.unwrap_or_else(|| {
+        let mut n = recipe.output.as_os_str().to_owned();
+        n.push(".plan.json");
+        PathBuf::from(n)
+    });
+    std::fs::write(&out, p.to_json()).map_err(|e| BakeError::io(&out, e))?;
+    if json {
+        println!("{}", p.to_json());
+        return Ok(());
+    }
+    println!("plan of {} (q = {})", p.recipe, p.quality.q);
+    println!(
+        "  base views: {} (lattice {} per axis, {} cells tested, {} split)",
+        p.base_views.len(),
+        p.space_lattice,
+        p.counters.space_cells_tested,
+        p.counters.space_cells_split
+    );
+    println!(
+        "  time: {} .. {} s, animated: {}, light keys: {}, time keys: {}",
+        p.start,
+        p.end,
+        p.animated,
+        p.light_keys.len(),
+        p.time_key_count()
+    );
+    for v in &p.base_views {
+        println!(
+            "    view {:>4} at ({:.3}, {:.3}, {:.3}): {} keys, {} volume samples",
+            v.id,
+            v.position.x,
+            v.position.y,
+            v.position.z,
+            v.time_keys.len(),
+            v.volume_samples
+        );
+    }
+    println!("  ambient key times: {:?}", p.ambient_keys);
+    println!("cost:");
+    println!("  range images:   {}", cost.range_images);
+    println!("  camera samples: {}", cost.camera_samples);
+    println!("  volume samples: {}", cost.volume_samples);
+    println!("  ambient fields: {}", cost.ambient_fields);
+    println!(
+        "  estimated size: {:.1} MiB before compression",
+        cost.estimated_bytes as f64 / (1024.0 * 1024.0)
+    );
+    println!(
+        "  estimated time: {:.0} s (at {:.2} Mrays/s measured while planning in {secs:.2} s)",
+        cost.estimated_seconds,
+        rate / 1e6
+    );
+    println!("plan written to {}", out.display());
+    Ok(())
+}
+
+fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> Result<()> {
+    let pack = PackReader::open(pack_path)?;
+    if let Some(args) = extract {
+        let n: usize = args[0]
+            .parse()
+            .map_err(|_| BakeError::Invalid(format!("chunk index '{}'", args[0])))?;
+        if n >= pack.entries().len() {
+            return Err(BakeError::Invalid(format!(
+                "chunk {n} out of range: the pack has {}",
+                pack.entries().len()
+            )));
+        }
+        let bytes = pack.chunk_bytes(n)?;
+        let out = Path::new(&args[1]);
+        std::fs::write(out, &bytes).map_err(|e| BakeError::io(out, e))?;
+        println!(
+            "wrote chunk {n} ({} bytes) to {}",
+            bytes.len(),
+            out.display()
+        );
+        return Ok(());
+    }
+    let m = pack.manifest();
+    println!("{}: {} bytes", pack_path.display(), pack.file_length());
+    println!(
+        "  time {} .. {} s, bucket span {} s ({} buckets)",
+        m.time_range.start,
+        m.time_range.end,
+        m.bucket_span,
+        m.bucket_count()
+    );
+    println!("  view space: {:?}", m.view_space);
+    println!(
+        "  scene bounds: {:?} .. {:?}",
+        m.scene_bounds.min, m.scene_bounds.max
+    );
+    println!(
+        "  bake: q = {}, face {} px, {} spp, {} volume samples per view",
+        m.bake.quality,
+        m.bake.cube_face_size,
+        m.bake.samples_per_texel,
+        m.bake.volume_samples_per_view
+    );
+    println!("  base views: {}", m.base_views.len());
+    for v in &m.base_views {
+        println!(
+            "    {:>4} at ({:.3}, {:.3}, {:.3}): keys {:?}",
+            v.id, v.position.x, v.position.y, v.position.z, v.time_keys
+        );
+    }
+    println!("  objects: {}", m.objects.len());
+    for o in &m.objects {
+        println!("    {:>4} {} ({:?})", o.id, o.name, o.motion);
+    }
+    println!("  lights: {}", m.lights.len());
+    println!("  chunks: {}", pack.entries().len());
+    for (k, v) in &m.stats.bytes {
+        println!("    bytes {k}: {v}");
+    }
+    for (k, v) in &m.stats.sample_counts {
+        println!("    count {k}: {v}");
+    }
+    for (k, v) in &m.stats.phase_seconds {
+        println!("    seconds {k}: {v:.3}");
+    }
+    if chunks {
+        println!(
+            "  {:>6} {:<20} {:>6} {:>6} {:>12} {:>10} {:>12} {:>18}",
+            "index", "kind", "view", "key", "offset", "length", "uncompressed", "checksum"
+        );
+        for (i, e) in pack.entries().iter().enumerate() {
+            let view = if e.base_view == plenoptic_pack::NO_BASE_VIEW {
+                "-".to_owned()
+            } else {
+                e.base_view.to_string()
+            };
+            println!(
+                "  {:>6} {:<20} {:>6} {:>6} {:>12} {:>10} {:>12} {:>#18x}",
+                i,
+                format!("{:?}", e.kind),
+                view,
+                e.key,
+                e.offset,
+                e.length,
+                e.uncompressed_length,
+                e.checksum
+            );
+        }
+    }
+    Ok(())
+}
+
+fn cmd_reference(
+    recipe_path: &Path,
+    path: &Path,
+    out: &Path,
+    spp: Option<u32>,
+    exposure: f32,
+) -> Result<()> {
+    let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
+    let camera_path = plenoptic_recon::CameraPath::load(path)
+        .map_err(|e| BakeError::Invalid(format!("{}: {e}", path.display())))?;
+    let accel = SceneAccel::new(&scene)?;
+    std::fs::create_dir_all(out).map_err(|e| BakeError::io(out, e))?;
+    let tracer = PathTracer::new(PathTracerSettings {
+        samples_per_pixel: spp.unwrap_or(recipe.quality.reference_samples_per_pixel),
+        ..Default::default()
+    });
+    let frames: Vec<_> = camera_path.frames().collect();
+    let bar = Progress::new(true).phase("reference", frames.len() as u64);
+    for f in frames {
+        let camera = f
+            .camera
+            .to_pinhole()
+            .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
+        let placed = accel.at_time(f.scene_time);
+        let image = tracer.render(&placed, &camera).radiance();
+        let png = out.join(format!("frame_{:05}.png", f.index));
+        image.save_png(&png, exposure)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    println!("reference frames written to {}", out.display());
+    Ok(())
+}
