@@ -143,7 +143,7 @@ impl CameraBasis {
     pub fn project(&self, world: Vec3) -> Option<(f32, f32, f32)> {
         let d = world - self.position;
         let z = d.dot(self.forward);
-        if !(z > 1e-4) {
+        if z.is_nan() || z <= 1e-4 {
             return None;
         }
         let sx = d.dot(self.right) / (z * self.tan_x);

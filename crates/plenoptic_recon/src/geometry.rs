@@ -167,7 +167,7 @@ pub(crate) fn render(
                     let q = k.motion[slot].transform_point3(p);
                     let d = q - k.base;
                     let dist = d.length();
-                    if !(dist > 1e-6) {
+                    if dist.is_nan() || dist <= 1e-6 {
                         continue;
                     }
                     let n = k.cubes.ids.face_size;

@@ -1,7 +1,68 @@
 //! # plenoptic_recon
 //!
-//! CPU reconstruction of frames from a radiance pack (design.md, "Reconstruction"), the
-//! reference for the GPU passes of `bevy_plenoptic`, its fallback, and the quality tools.
+//! CPU reconstruction of frames from a radiance pack (design.md, "Reconstruction"): the
+//! reference the GPU passes of `bevy_plenoptic` are tested against, their fallback, and the
+//! quality tools (`plenoptic render`, `plenoptic compare`).
+//!
+//! From Nimeroff's thesis (1997):
+//!
+//! - [`temporal`]: the piecewise cubic Bézier blend of range images through time keys
+//!   (appendix A.1, used by chapter 6's image-based system);
+//! - [`warp`]: depth reprojection of a base view's cube into the camera with a z-buffer,
+//!   footprint splats (foreground fill) and background fill (appendix A.2, §6.7);
+//! - [`viewspace`]: blending base views by the camera's place in the view space (§6.7);
+//! - [`volume`]: temporal volumes filtered around t and triangulated (§7.4);
+//! - [`proxy`] and the geometry-assisted mode: geometry masks and motion-compensated lookups,
+//!   the improvement the thesis proposes in §8.2.3.
+//!
+//! [`Reconstructor::render`] runs one of the three [`Mode`]s and returns a [`Frame`]
+//! (radiance, depth, object id) and a [`Report`] (fallback fractions, missing chunks). A
+//! damaged pack degrades the frame instead of failing it. [`path`] is the camera-path file
+//! shared with the reference renderer, [`tools`] and [`plot`] write frames, metrics (relative
+//! LRMS and PSNR from [`plenoptic_trace::metrics`]) and error-along-path plots.
+//!
+//! ```
+//! use plenoptic_pack::*;
+//! use plenoptic_pack::glam::{Quat, Vec3};
+//! use plenoptic_recon::{Camera, Mode, Reconstructor};
+//!
+//! // A pack with one base view inside a 4 m box (object 1) whose walls shine like |dir|.
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("box.pack");
+//! let mut image = RangeImage::new(16);
+//! image.radiance = CubeImage::from_fn(16, |_, d| d.abs());
+//! image.distance = CubeImage::from_fn(16, |_, d| 2.0 / d.abs().max_element());
+//! image.object_id = CubeImage::filled(16, 1);
+//! image.normal = CubeImage::from_fn(16, |_, d| {
+//!     let a = d.abs();
+//!     if a.x >= a.y && a.x >= a.z { Vec3::new(-d.x.signum(), 0.0, 0.0) }
+//!     else if a.y >= a.z { Vec3::new(0.0, -d.y.signum(), 0.0) }
+//!     else { Vec3::new(0.0, 0.0, -d.z.signum()) }
+//! });
+//! let mesh = plenoptic_trace::shapes::cuboid(Vec3::splat(4.0));
+//! let mut writer = PackWriter::create(&path).unwrap();
+//! writer.add_range_image(0, 0, &image, CubeFormats::default()).unwrap();
+//! writer.add_proxy_mesh(&ProxyMesh {
+//!     object_id: 1,
+//!     positions: mesh.positions.clone(),
+//!     indices: mesh.triangles.iter().flatten().copied().collect(),
+//!     normals: None,
+//! }).unwrap();
+//! let mut manifest = Manifest::new(TimeRange { start: 0.0, end: 1.0 }, 0.5);
+//! manifest.base_views.push(BaseView { id: 0, position: Vec3::ZERO, time_keys: vec![0.0] });
+//! manifest.objects.push(ObjectEntry {
+//!     id: 1, name: "box".into(), node_path: "/box".into(), motion: Motion::Static, proxy_mesh: Some(1),
+//! });
+//! writer.finish(&manifest).unwrap();
+//!
+//! // Reconstruct: at the base view, every pixel is a direct lookup of the range image.
+//! let recon = Reconstructor::open(&path).unwrap();
+//! let camera = Camera::new(Vec3::ZERO, Quat::IDENTITY, 1.0, 32, 24).unwrap();
+//! let (frame, report) = recon.render(&camera, 0.0, Mode::GeometryAssisted).unwrap();
+//! assert!(report.fallback.direct > 0.99, "{report:?}");
+//! assert!(frame.depth.iter().all(|d| (2.0..3.5).contains(d)));
+//! assert!(frame.radiance[12 * 32 + 16].abs_diff_eq(Vec3::new(0.0, 0.0, 1.0), 0.1));
+//! ```
 
 pub mod camera;
 pub mod frame;

@@ -216,22 +216,23 @@ impl Reconstructor {
         missing: &mut Vec<String>,
     ) -> Option<KeyCubes> {
         let (v, k) = (view as u32, key as u32);
-        let mut fail = |kind: &str, e: String| {
-            missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"))
+        let mut fail = |kind: &str, e: String| -> Option<KeyCubes> {
+            missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"));
+            None
         };
         let radiance = match self.cached(ChunkKind::RadianceCube, v, k) {
             Cached::Radiance(c) => c,
-            Cached::Failed(e) => return fail("radiance", e).then_none(),
+            Cached::Failed(e) => return fail("radiance", e),
             _ => return None,
         };
         let distance = match self.cached(ChunkKind::DistanceCube, v, k) {
             Cached::Distance(c) => c,
-            Cached::Failed(e) => return fail("distance", e).then_none(),
+            Cached::Failed(e) => return fail("distance", e),
             _ => return None,
         };
         let ids = match self.cached(ChunkKind::ObjectIdCube, v, k) {
             Cached::Ids(c) => c,
-            Cached::Failed(e) => return fail("object-id", e).then_none(),
+            Cached::Failed(e) => return fail("object-id", e),
             _ => return None,
         };
         if radiance.face_size != distance.face_size || ids.face_size != distance.face_size {
@@ -264,13 +265,8 @@ impl Reconstructor {
         bucket: u32,
         missing: &mut Vec<String>,
     ) -> Option<Arc<VolumeBlock>> {
-        if self
-            .pack
-            .find(ChunkKind::VolumeBlock, view as u32, bucket)
-            .is_none()
-        {
-            return None;
-        }
+        self.pack
+            .find(ChunkKind::VolumeBlock, view as u32, bucket)?;
         match self.cached(ChunkKind::VolumeBlock, view as u32, bucket) {
             Cached::Volume(b) => Some(b),
             Cached::Failed(e) => {
@@ -477,15 +473,5 @@ impl Reconstructor {
             list.into_iter().map(|(c, w)| (c, w / sum)).collect();
         let radiance = crate::temporal::blend_cubes(&list)?;
         Some((radiance, nearest))
-    }
-}
-
-trait ThenNone {
-    fn then_none<T>(self) -> Option<T>;
-}
-
-impl ThenNone for () {
-    fn then_none<T>(self) -> Option<T> {
-        None
     }
 }

@@ -94,7 +94,7 @@ pub fn bracketing(times: &[f32], t: f32) -> Option<(usize, usize, f32)> {
     if n == 0 {
         return None;
     }
-    if n == 1 || !(t > times[0]) {
+    if n == 1 || t.is_nan() || t <= times[0] {
         return Some((0, 0, 0.0));
     }
     if t >= times[n - 1] {

@@ -26,6 +26,9 @@ use crate::reconstructor::Reconstructor;
 use crate::warp::{ViewCubes, Warped, warp_view};
 use crate::{Error, Result};
 
+/// Radiance, distance and object-id cubes.
+type Cubes = (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>);
+
 /// Face size of the direction bins of a [`VolumeIndex`].
 const BIN_FACE: u32 = 16;
 
@@ -117,7 +120,7 @@ impl VolumeIndex {
     /// within `tol` (relative): `(radiance, total weight)`.
     pub fn lookup(&self, d: Vec3, object: u32, tol: f32) -> Option<(Vec3, f32)> {
         let dist = d.length();
-        if !(dist > 1e-6) {
+        if dist.is_nan() || dist <= 1e-6 {
             return None;
         }
         let dir = d / dist;
@@ -164,10 +167,7 @@ fn face_frame(f: usize) -> (Vec3, Vec3, Vec3) {
 }
 
 /// Reconstructs radiance, distance and object-id cubes of face size `n` from filtered samples.
-pub fn samples_to_cube(
-    samples: &[(VolumeSample, f32)],
-    n: u32,
-) -> (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>) {
+pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> Cubes {
     let nn = (n * n) as usize;
     let faces: Vec<(Vec<Vec3>, Vec<f32>, Vec<u32>)> = (0..6)
         .into_par_iter()
@@ -261,11 +261,7 @@ pub(crate) fn render(
     report: &mut Report,
 ) -> Result<Frame> {
     let views = rec.view_weights(camera.position);
-    let mut cubes: Vec<(
-        usize,
-        f32,
-        (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>),
-    )> = Vec::new();
+    let mut cubes: Vec<(usize, f32, Cubes)> = Vec::new();
     for &(v, w) in &views {
         match filtered_samples(rec, v, t, &mut report.missing) {
             Some(s) if s.len() >= 3 => {
