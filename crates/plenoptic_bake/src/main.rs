@@ -204,6 +204,9 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
         n.push(".plan.json");
         PathBuf::from(n)
     });
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| BakeError::io(parent, e))?;
+    }
     std::fs::write(&out, p.to_json()).map_err(|e| BakeError::io(&out, e))?;
     if json {
         println!("{}", p.to_json());

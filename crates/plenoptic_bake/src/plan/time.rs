@@ -33,10 +33,7 @@ pub fn subdivide<V>(
     while let Some((a, b)) = stack.pop() {
         tested += 1;
         for k in [a, b] {
-            if !values.contains_key(&k) {
-                let v = eval(k);
-                values.insert(k, v);
-            }
+            values.entry(k).or_insert_with(|| eval(k));
         }
         if b - a <= 1 || passes(&values[&a], &values[&b]) {
             continue;

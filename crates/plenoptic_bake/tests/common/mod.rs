@@ -18,7 +18,7 @@ pub fn room(
     let w = 0.2;
     for (i, axis) in [Vec3::X, Vec3::Y, Vec3::Z].into_iter().enumerate() {
         let size = Vec3::splat(2.0 * h + 2.0 * w) - axis * (2.0 * h + w);
-        let mesh = b.add_box(&format!("{name}-wall{i}"), size, mat);
+        let mesh = b.add_box(format!("{name}-wall{i}"), size, mat);
         for s in [-1.0f32, 1.0] {
             b.add_node(
                 NodeDesc::new(format!("{name}-wall{i}{}", if s < 0.0 { "n" } else { "p" }))
