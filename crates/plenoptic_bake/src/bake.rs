@@ -35,6 +35,8 @@ pub struct BakeOptions {
     pub progress: Progress,
     /// Write here instead of the recipe's `output`.
     pub output: Option<PathBuf>,
+    /// Also store the (x, y, t) Delaunay complex of every volume block.
+    pub volume_complex: bool,
 }
 
 impl Default for BakeOptions {
@@ -47,6 +49,7 @@ impl Default for BakeOptions {
             stop_after: None,
             progress: Progress::hidden(),
             output: None,
+            volume_complex: false,
         }
     }
 }
@@ -109,6 +112,7 @@ pub fn bake(recipe: &BakeRecipe, scene: &Scene, options: &BakeOptions) -> Result
     let clock = Instant::now();
     let bar = progress.phase("ambient field", 0);
     let fields = plan::ambient_phase(&mut plan, scene, &accel)?;
+    plan.volume_complex = options.volume_complex;
     bar.finish_and_clear();
     timings.insert("ambient_field".to_owned(), clock.elapsed().as_secs_f64());
 

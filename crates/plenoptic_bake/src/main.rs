@@ -58,6 +58,9 @@ enum Command {
         /// Write the pack here instead of the recipe's output.
         #[arg(long)]
         output: Option<PathBuf>,
+        /// Also store the (x, y, t) Delaunay complex of every temporal-volume block.
+        #[arg(long)]
+        volume_complex: bool,
         /// No progress bars.
         #[arg(short, long)]
         quiet: bool,
@@ -127,6 +130,7 @@ fn run(command: Command) -> Result<()> {
             keep_work,
             timings_in_manifest,
             output,
+            volume_complex,
             quiet,
             stop_after,
         } => {
@@ -138,6 +142,7 @@ fn run(command: Command) -> Result<()> {
                 stop_after,
                 progress: Progress::new(!quiet),
                 output,
+                volume_complex,
             };
             let report = plenoptic_bake::bake_recipe(&recipe, &options)?;
             match (&report.output, shard) {

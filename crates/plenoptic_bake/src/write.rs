@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 use plenoptic_pack::{
     Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, Interpolation, Light,
     LightKind, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter, ProxyMesh, RangeImage,
-    TimeRange, Track, ViewSpace, VolumeSample, encode_distance, encode_normal, encode_object_id,
-    encode_radiance, encode_volume_block,
+    TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block, encode_connectivity,
+    encode_distance, encode_normal, encode_object_id, encode_radiance, encode_volume_block,
 };
 use plenoptic_scene::Scene;
 use plenoptic_trace::SceneAccel;
@@ -93,6 +93,11 @@ pub fn volume_chunks(plan: &Plan, bv: u32, samples: &[VolumeSample]) -> Result<V
     for (b, list) in buckets {
         let (t0, t1) = m.bucket_range(b);
         let enc = encode_volume_block(t0, t1, &list)?;
+        let complex = if plan.volume_complex {
+            complex_chunk(&enc.bytes)?
+        } else {
+            None
+        };
         out.push(ItemChunk {
             kind: ChunkKind::VolumeBlock,
             base_view: bv,
@@ -100,8 +105,45 @@ pub fn volume_chunks(plan: &Plan, bv: u32, samples: &[VolumeSample]) -> Result<V
             uncompressed_length: enc.uncompressed_length,
             bytes: enc.bytes,
         });
+        if let Some((bytes, len)) = complex {
+            out.push(ItemChunk {
+                kind: ChunkKind::VolumeConnectivity,
+                base_view: bv,
+                key: b,
+                uncompressed_length: len,
+                bytes,
+            });
+        }
     }
     Ok(out)
+}
+
+/// The (x, y, t) Delaunay complex of an encoded volume block (thesis §7.4.2), over its samples
+/// as stored (quantized, in stored order): x, y the octahedral coordinates of the direction in
+/// [−1, 1]², t the position in the bucket in [0, 1]. `None` when the samples span no volume
+/// (fewer than four, or coplanar).
+pub fn complex_chunk(block: &[u8]) -> Result<Option<(Vec<u8>, u64)>> {
+    let decoded = decode_volume_block(block)?;
+    let span = (decoded.t_end - decoded.t_start).max(f32::MIN_POSITIVE);
+    let points: Vec<[f64; 3]> = decoded
+        .samples
+        .iter()
+        .map(|s| {
+            let o = plenoptic_pack::cube::oct_encode(s.direction);
+            [
+                f64::from(o.x),
+                f64::from(o.y),
+                f64::from((s.t - decoded.t_start) / span),
+            ]
+        })
+        .collect();
+    match crate::delaunay3::tetrahedralize(&points) {
+        Ok(complex) => Ok(Some(encode_connectivity(
+            decoded.samples.len() as u32,
+            &complex.tets,
+        )?)),
+        Err(_) => Ok(None),
+    }
 }
 
 /// The proxy mesh of every object with triangles (object-space positions, indices, normals).

@@ -318,3 +318,37 @@ fn floor_radiance_is_at_least_the_analytic_direct_light() {
     }
     assert!(checked > 0);
 }
+
+#[test]
+fn volume_blocks_carry_their_delaunay_complex_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let recipe = moving_recipe(dir.path());
+    let options = BakeOptions {
+        volume_complex: true,
+        ..Default::default()
+    };
+    bake_recipe(&recipe, &options).unwrap();
+    let pack = PackReader::open(pack_path(dir.path())).unwrap();
+    let mut complexes = 0;
+    for e in pack
+        .entries()
+        .iter()
+        .filter(|e| e.kind == ChunkKind::VolumeBlock)
+    {
+        let block = pack.volume_block(e.base_view, e.key).unwrap();
+        if pack
+            .find(ChunkKind::VolumeConnectivity, e.base_view, e.key)
+            .is_some()
+        {
+            let tets = pack.connectivity(e.base_view, e.key).unwrap();
+            assert!(!tets.is_empty());
+            assert!(
+                tets.iter()
+                    .flatten()
+                    .all(|&i| (i as usize) < block.samples.len())
+            );
+            complexes += 1;
+        }
+    }
+    assert!(complexes > 0);
+}

@@ -131,6 +131,10 @@ pub struct Plan {
     pub ambient_keys: Vec<f32>,
     /// Temporal-volume bucket length, seconds.
     pub bucket_span: f32,
+    /// Whether each volume block also gets its (x, y, t) Delaunay complex
+    /// ([`crate::delaunay3`]); set by the bake's options, not by the recipe.
+    #[serde(default)]
+    pub volume_complex: bool,
     /// Planning counters.
     pub counters: PlanCounters,
 }
@@ -321,6 +325,7 @@ pub fn decompose(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> 
         base_views,
         ambient_keys: Vec::new(),
         bucket_span: bucket_span(start, end, recipe.time.frame_rate),
+        volume_complex: false,
         counters,
     };
     (plan, rays)
