@@ -35,7 +35,14 @@ fn renders_a_frame_and_reads_it_back() {
         Transform::from_xyz(0.0, 0.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
     ));
 
-    let data = render_and_read(&mut app, image, 3, 200);
+    // Wait until the cube's pipeline has compiled and the centre pixel is no longer the
+    // clear colour; the assertions below then check what was drawn.
+    let data = render_until(&mut app, image, 3000, |data| {
+        data.len() == (WIDTH * HEIGHT * 4) as usize && {
+            let centre = pixel(data, WIDTH / 2, HEIGHT / 2);
+            centre[3] == 255 && centre[0] < 128
+        }
+    });
     assert_eq!(data.len(), (WIDTH * HEIGHT * 4) as usize);
 
     let centre = pixel(&data, WIDTH / 2, HEIGHT / 2);

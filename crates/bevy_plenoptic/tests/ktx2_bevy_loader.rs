@@ -6,13 +6,13 @@ use std::time::Duration;
 
 use bevy::{
     asset::{AssetPlugin, LoadState, RenderAssetUsages},
-    image::{CompressedImageFormats, ImageSampler, ImageType},
+    image::{CompressedImageFormats, ImageLoader, ImageSampler, ImageType},
     prelude::*,
     render::render_resource::{TextureFormat, TextureViewDimension},
 };
 use plenoptic_pack::{
-    ChunkKind, CubeFormats, CubeImage, Manifest, PackReader, PackWriter, RangeImage, TimeRange,
-    cube::rgb9e5_pack,
+    BaseView, ChunkKind, CubeFormats, CubeImage, Manifest, PackReader, PackWriter, RangeImage,
+    TimeRange, cube::rgb9e5_pack,
 };
 
 const FACE: u32 = 8;
@@ -40,15 +40,19 @@ fn chunks(dir: &std::path::Path) -> Vec<(ChunkKind, Vec<u8>)> {
     writer
         .add_range_image(0, 0, &range_image(), CubeFormats::default())
         .unwrap();
-    writer
-        .finish(&Manifest::new(
-            TimeRange {
-                start: 0.0,
-                end: 1.0,
-            },
-            1.0,
-        ))
-        .unwrap();
+    let mut manifest = Manifest::new(
+        TimeRange {
+            start: 0.0,
+            end: 1.0,
+        },
+        1.0,
+    );
+    manifest.base_views.push(BaseView {
+        id: 0,
+        position: Vec3::ZERO,
+        time_keys: vec![0.0],
+    });
+    writer.finish(&manifest).unwrap();
     let reader = PackReader::open(&path).unwrap();
     [
         ChunkKind::RadianceCube,
@@ -148,6 +152,11 @@ fn asset_server_loads_an_extracted_chunk() {
         },
         ImagePlugin::default(),
     ));
+    // `ImagePlugin` only pre-registers the loader; the render plugin registers it once it knows
+    // the GPU's compressed formats. Without a GPU, register it as the render plugin does.
+    app.register_asset_loader(ImageLoader::new(CompressedImageFormats::NONE));
+    app.finish();
+    app.cleanup();
     let handle: Handle<Image> = app.world().resource::<AssetServer>().load("radiance.ktx2");
     for _ in 0..500 {
         app.update();
@@ -160,8 +169,11 @@ fn asset_server_loads_an_extracted_chunk() {
         }
         std::thread::sleep(Duration::from_millis(5));
     }
+    let state = app.world().resource::<AssetServer>().load_state(&handle);
     let images = app.world().resource::<Assets<Image>>();
-    let image = images.get(&handle).expect("loaded");
+    let image = images
+        .get(&handle)
+        .unwrap_or_else(|| panic!("not loaded: {state:?}"));
     assert_eq!(image.texture_descriptor.size.depth_or_array_layers, 6);
     assert_eq!(image.texture_descriptor.format, TextureFormat::Rgb9e5Ufloat);
 }

@@ -57,33 +57,35 @@ pub fn camera_into(image: Handle<Image>, transform: Transform) -> impl Bundle {
     )
 }
 
-/// Runs `app` until the image has been rendered `warmup` times and then read back, returning
-/// RGBA8 pixels row by row. Panics after `max_frames` without a readback.
-pub fn render_and_read(
+/// Reads `image` back every frame and returns the pixels (RGBA8, row by row) of the first
+/// frame for which `ready` holds, or of the last frame after `max_frames`. Pipelines compile
+/// asynchronously (slowly on the software driver), so the first frames may show only the
+/// clear colour; `ready` says when the scene is on screen.
+pub fn render_until(
     app: &mut App,
     image: Handle<Image>,
-    warmup: u32,
     max_frames: u32,
+    ready: impl Fn(&[u8]) -> bool,
 ) -> Vec<u8> {
-    let pixels: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
-    for frame in 0..max_frames {
-        if frame == warmup {
-            let sink = pixels.clone();
-            app.world_mut()
-                .spawn(Readback::texture(image.clone()))
-                .observe(move |event: On<ReadbackComplete>| {
-                    let mut slot = sink.lock().unwrap();
-                    if slot.is_none() {
-                        *slot = Some(event.data.clone());
-                    }
-                });
-        }
+    let latest: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
+    let sink = latest.clone();
+    app.world_mut()
+        .spawn(Readback::texture(image))
+        .observe(move |event: On<ReadbackComplete>| {
+            *sink.lock().unwrap() = Some(event.data.clone());
+        });
+    let mut last = None;
+    for _ in 0..max_frames {
         app.update();
-        if let Some(data) = pixels.lock().unwrap().take() {
-            return data;
+        if let Some(data) = latest.lock().unwrap().take() {
+            if ready(&data) {
+                return data;
+            }
+            last = Some(data);
         }
+        std::thread::sleep(std::time::Duration::from_millis(10));
     }
-    panic!("no readback after {max_frames} frames");
+    last.unwrap_or_else(|| panic!("no readback in {max_frames} frames"))
 }
 
 /// The RGBA8 pixel at (x, y).
