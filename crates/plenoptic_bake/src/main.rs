@@ -5,7 +5,9 @@
 //! plenoptic bake RECIPE [--resume] [--shard i/N] [--keep-work] [--timings-in-manifest] [-q]
 //! plenoptic merge RECIPE [--keep-work]              join shards into the pack
 //! plenoptic inspect PACK [--chunks] [--extract N OUT]
-//! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N]
+//! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--exposure E]
+//! plenoptic render PACK --path PATH.json [--mode image|volume|geometry] --out DIR
+//! plenoptic compare --reference DIR [LABEL=]DIR... [--csv OUT.csv] [--plot OUT.png]
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -90,7 +92,38 @@ enum Command {
         #[arg(long, num_args = 2, value_names = ["N", "OUT"])]
         extract: Option<Vec<String>>,
     },
-    /// Render reference frames along a camera path with the path tracer (PNG).
+    /// Reconstruct frames along a camera path from a pack (plenoptic_recon): EXR + PNG per
+    /// frame and report.csv.
+    Render {
+        /// The pack.
+        pack: PathBuf,
+        /// The camera path (JSON).
+        #[arg(long)]
+        path: PathBuf,
+        /// Reconstruction mode: image, volume or geometry (geometry-assisted, the default).
+        #[arg(long, default_value = "geometry")]
+        mode: String,
+        /// Output directory.
+        #[arg(long, default_value = "frames")]
+        out: PathBuf,
+    },
+    /// Compare frame directories with a reference directory: relative LRMS and PSNR per frame
+    /// (CSV) and an error-along-path plot (PNG).
+    Compare {
+        /// The reference frames (from `plenoptic reference`).
+        #[arg(long)]
+        reference: PathBuf,
+        /// Candidate frame directories, as DIR or LABEL=DIR.
+        #[arg(required = true)]
+        candidates: Vec<String>,
+        /// The CSV to write.
+        #[arg(long, default_value = "compare.csv")]
+        csv: PathBuf,
+        /// The plot to write.
+        #[arg(long, default_value = "compare.png")]
+        plot: PathBuf,
+    },
+    /// Render reference frames along a camera path with the path tracer (EXR + PNG).
     Reference {
         /// The bake recipe (TOML): scene and quality.
         recipe: PathBuf,
@@ -103,9 +136,9 @@ enum Command {
         /// Samples per pixel (default: the recipe's reference_samples_per_pixel).
         #[arg(long)]
         spp: Option<u32>,
-        /// Exposure of the PNGs.
-        #[arg(long, default_value_t = 1.0)]
-        exposure: f32,
+        /// Exposure of the PNGs (default: automatic from the first frame).
+        #[arg(long)]
+        exposure: Option<f32>,
     },
 }
 
@@ -184,6 +217,53 @@ fn run(command: Command) -> Result<()> {
             chunks,
             extract,
         } => cmd_inspect(&pack, chunks, extract),
+        Command::Render {
+            pack,
+            path,
+            mode,
+            out,
+        } => {
+            let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
+                BakeError::Invalid(format!("mode '{mode}': expected image, volume or geometry"))
+            })?;
+            let summary = plenoptic_recon::tools::render_path(&pack, &path, mode, &out, true)
+                .map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
+            println!(
+                "{} frames in {} ({:.1} ms per frame), report {}",
+                summary.frames,
+                out.display(),
+                summary.mean_ms,
+                summary.report_csv.display()
+            );
+            Ok(())
+        }
+        Command::Compare {
+            reference,
+            candidates,
+            csv,
+            plot,
+        } => {
+            let candidates: Vec<(String, PathBuf)> = candidates
+                .iter()
+                .map(|c| match c.split_once('=') {
+                    Some((label, dir)) => (label.to_owned(), PathBuf::from(dir)),
+                    None => {
+                        let dir = PathBuf::from(c);
+                        let label = dir
+                            .file_name()
+                            .map_or_else(|| c.clone(), |n| n.to_string_lossy().into_owned());
+                        (label, dir)
+                    }
+                })
+                .collect();
+            let metrics = plenoptic_recon::tools::compare(&reference, &candidates, &csv, &plot)
+                .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
+            for m in &metrics {
+                println!("{}: mean relative LRMS {:.4}", m.label, m.mean_lrms());
+            }
+            println!("wrote {} and {}", csv.display(), plot.display());
+            Ok(())
+        }
         Command::Reference {
             recipe,
             path,
@@ -360,7 +440,7 @@ fn cmd_reference(
     path: &Path,
     out: &Path,
     spp: Option<u32>,
-    exposure: f32,
+    exposure: Option<f32>,
 ) -> Result<()> {
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
     let camera_path = plenoptic_recon::CameraPath::load(path)
@@ -373,6 +453,7 @@ fn cmd_reference(
     });
     let frames: Vec<_> = camera_path.frames().collect();
     let bar = Progress::new(true).phase("reference", frames.len() as u64);
+    let mut exposure = exposure;
     for f in frames {
         let camera = f
             .camera
@@ -380,8 +461,18 @@ fn cmd_reference(
             .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
         let placed = accel.at_time(f.scene_time);
         let image = tracer.render(&placed, &camera).radiance();
-        let png = out.join(format!("frame_{:05}.png", f.index));
-        image.save_png(&png, exposure)?;
+        let e = *exposure
+            .get_or_insert_with(|| plenoptic_recon::frame_io::auto_exposure(&image.pixels));
+        plenoptic_recon::tools::write_frame_files(
+            out,
+            f.index,
+            image.width,
+            image.height,
+            &image.pixels,
+            None,
+            e,
+        )
+        .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
         bar.inc(1);
     }
     bar.finish_and_clear();

@@ -352,3 +352,90 @@ fn volume_blocks_carry_their_delaunay_complex_when_asked() {
     }
     assert!(complexes > 0);
 }
+
+#[test]
+fn reference_render_and_compare_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let recipe = write_recipe(dir.path(), &static_room(), STATIC_SEGMENT, "q = 0.0");
+    let r = recipe.to_str().unwrap();
+    let path = dir.path().join("path.json");
+    std::fs::write(
+        &path,
+        r#"{ "frame_rate": 2.0, "width": 16, "height": 12, "keyframes": [
+            { "time": 0.0, "position": [-0.5, 0.5, -0.5], "yaw_deg": 30.0, "vfov_deg": 70.0 },
+            { "time": 0.5, "position": [0.5, 0.5, 0.5], "yaw_deg": 40.0, "vfov_deg": 70.0 } ] }"#,
+    )
+    .unwrap();
+    let p = path.to_str().unwrap();
+    let reference = dir.path().join("reference");
+    let out = plenoptic(
+        &[
+            "reference",
+            r,
+            "--path",
+            p,
+            "--out",
+            reference.to_str().unwrap(),
+            "--spp",
+            "2",
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(reference.join("frame_00000.exr").exists());
+    assert!(reference.join("frame_00001.png").exists());
+
+    let out = plenoptic(&["bake", r, "-q"], None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let frames = dir.path().join("frames");
+    let pack = pack_path(dir.path());
+    let out = plenoptic(
+        &[
+            "render",
+            pack.to_str().unwrap(),
+            "--path",
+            p,
+            "--mode",
+            "image",
+            "--out",
+            frames.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(frames.join("frame_00001.exr").exists());
+    let csv = dir.path().join("compare.csv");
+    let plot = dir.path().join("compare.png");
+    let out = plenoptic(
+        &[
+            "compare",
+            "--reference",
+            reference.to_str().unwrap(),
+            &format!("image={}", frames.display()),
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("image: mean relative LRMS"));
+    assert!(csv.exists() && plot.exists());
+}
