@@ -102,6 +102,8 @@ pub fn room(moving: bool) -> Scene {
             ],
         );
     }
+    // A light so that the reference path tracer (benchmark) sees the room lit like `shade`.
+    b.point_light(LIGHT, Vec3::ONE, 3.0);
     b.build()
 }
 
