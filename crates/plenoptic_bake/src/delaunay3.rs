@@ -264,7 +264,7 @@ fn insertion_order(points: &[[f64; 3]], ids: &mut [u32]) {
         });
         hilbert3(q, BITS)
     };
-    let mut state = 0x5EED_0F_DE1A_u64;
+    let mut state = 0x005E_ED0F_DE1A_u64;
     for i in (1..ids.len()).rev() {
         let j = (splitmix(&mut state) % (i as u64 + 1)) as usize;
         ids.swap(i, j);
@@ -345,8 +345,8 @@ impl<'a> Builder<'a> {
         };
         let t0 = b.new_tet(v, [NO_NEIGHBOUR; 4]);
         b.edges.clear();
-        for i in 0..4 {
-            let f = FACE[i].map(|k| v[k]);
+        for (i, face) in FACE.iter().enumerate() {
+            let f = face.map(|k| v[k]);
             // Swapping two face vertices puts the vertex at infinity on the outer side.
             let g = b.new_tet(
                 [f[1], f[0], f[2], INF],
@@ -377,7 +377,7 @@ impl<'a> Builder<'a> {
 
     fn link_edges(&mut self) -> Result<(), DelaunayError> {
         self.edges.sort_unstable();
-        if self.edges.len() % 2 != 0 {
+        if !self.edges.len().is_multiple_of(2) {
             return Err(DelaunayError::Internal("odd cavity boundary".into()));
         }
         for pair in self.edges.chunks_exact(2) {
@@ -908,8 +908,8 @@ pub fn validate(tri: &Tetrahedralization, points: &[[f64; 3]]) -> Result<(), Str
     // Faces.
     let mut faces: Vec<([u32; 3], u32, u8)> = Vec::with_capacity(4 * nt);
     for (t, v) in tri.tets.iter().enumerate() {
-        for i in 0..4 {
-            let mut f = FACE[i].map(|k| v[k]);
+        for (i, face) in FACE.iter().enumerate() {
+            let mut f = face.map(|k| v[k]);
             f.sort_unstable();
             faces.push((f, t as u32, i as u8));
         }

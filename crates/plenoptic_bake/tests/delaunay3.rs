@@ -283,3 +283,90 @@ fn larger_input_is_consistent() {
         }
     }
 }
+
+#[test]
+fn all_points_exactly_cospherical() {
+    // Every integer point with x² + y² + z² = 50, plus the centre: maximal degeneracy.
+    let mut points = Vec::new();
+    for x in -7i32..=7 {
+        for y in -7i32..=7 {
+            for z in -7i32..=7 {
+                if x * x + y * y + z * z == 50 {
+                    points.push([x as f64, y as f64, z as f64]);
+                }
+            }
+        }
+    }
+    assert!(points.len() > 50);
+    check(&points);
+    points.push([0.0; 3]);
+    check(&points);
+}
+
+#[test]
+fn far_from_origin_and_nearly_degenerate() {
+    // Tiny extents far from the origin: only exact predicates get this right.
+    let mut rng = Rng(13);
+    let points: Vec<[f64; 3]> = (0..400)
+        .map(|_| {
+            let p = rng.point([1e-3; 3]);
+            [1e6 + p[0], -3e5 + p[1], 7e4 + p[2]]
+        })
+        .collect();
+    check(&points);
+    // A grid jittered by a few ulps.
+    let mut points = Vec::new();
+    for i in 0..7 {
+        for j in 0..7 {
+            for k in 0..7 {
+                let mut c = |v: i32| v as f64 + (rng.f() - 0.5) * 1e-14;
+                points.push([c(i), c(j), c(k)]);
+            }
+        }
+    }
+    check(&points);
+}
+
+#[test]
+fn validate_rejects_broken_complexes() {
+    let mut rng = Rng(14);
+    let mut points = box_corners([1.0; 3]);
+    points.extend((0..60).map(|_| rng.point([1.0; 3])));
+    let good = check(&points);
+
+    let mut flipped = good.clone();
+    flipped.tets[3].swap(0, 1);
+    assert!(validate(&flipped, &points).is_err());
+
+    let mut missing = good.clone();
+    missing.tets.pop();
+    missing.neighbours.clear();
+    assert!(validate(&missing, &points).is_err());
+
+    let mut bad_neighbours = good.clone();
+    bad_neighbours.neighbours[0] = bad_neighbours.neighbours[1];
+    assert!(validate(&bad_neighbours, &points).is_err());
+
+    // A valid but non-Delaunay complex: a flat bipyramid as two tets sharing the big face
+    // (the Delaunay one is three tets around the short apex edge).
+    let bipyramid = [
+        [10.0, 0.0, 0.0],
+        [-5.0, 8.0, 0.0],
+        [-5.0, -8.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let orient = |mut t: [u32; 4]| {
+        if signed_volume(&bipyramid, t) < 0.0 {
+            t.swap(0, 1);
+        }
+        t
+    };
+    let two = Tetrahedralization {
+        tets: vec![orient([0, 1, 2, 3]), orient([0, 1, 2, 4])],
+        ..Default::default()
+    };
+    let err = validate(&two, &bipyramid).unwrap_err();
+    assert!(err.contains("circumsphere"), "{err}");
+    assert_eq!(check(&bipyramid).tets.len(), 3);
+}
