@@ -78,10 +78,11 @@ fn bench(c: &mut Criterion) {
         #[expect(clippy::print_stdout, reason = "the benchmark reports its ratio")]
         {
             println!(
-                "ratio 640x360 {}: {ms:.2} ms vs path tracer {PATH_SPP} spp {pt:.1} ms = {:.0}× faster; {:?}",
+                "ratio 640x360 {}: {ms:.2} ms vs path tracer {PATH_SPP} spp {pt:.1} ms = {:.0}× faster; {:?}; stages {:?}",
                 mode.name(),
                 pt / ms,
-                report.fallback
+                report.fallback,
+                report.stage_ms
             );
         }
     }

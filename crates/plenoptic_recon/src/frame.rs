@@ -131,6 +131,8 @@ pub struct Report {
     pub base_views: Vec<(usize, f32)>,
     /// Every chunk that was needed but missing or unreadable, with the reason.
     pub missing: Vec<String>,
+    /// Wall-clock milliseconds of the stages of the reconstruction (diagnostics).
+    pub stage_ms: Vec<(String, f64)>,
 }
 
 impl Report {

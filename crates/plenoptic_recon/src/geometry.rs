@@ -20,6 +20,7 @@
 //! loop is parallel over rows and allocates nothing.
 
 use std::sync::Arc;
+use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
 use plenoptic_pack::{CubeImage, cube};
@@ -27,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Report};
-use crate::reconstructor::{KeyCubes, Reconstructor};
+use crate::reconstructor::{KeyCubes, MaskMethod, Reconstructor};
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
 use crate::{Error, Result};
@@ -52,6 +53,7 @@ pub(crate) fn render(
     t: f32,
     report: &mut Report,
 ) -> Result<Frame> {
+    let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
         return Err(Error::Unusable("no proxy geometry".into()));
     };
@@ -123,13 +125,25 @@ pub(crate) fn render(
         )));
     }
     report.base_views = views;
-    let mask = proxy.mask(camera, t);
+    report.stage_ms.push(("setup".into(), ms(start)));
+    let start = Instant::now();
+    let mask = match rec.settings.mask {
+        MaskMethod::Raster => proxy.mask_raster(camera, t),
+        MaskMethod::RayCast => proxy.mask(camera, t),
+    };
+    report.stage_ms.push(("mask".into(), ms(start)));
+    let start = Instant::now();
     let (w, h) = (camera.width as usize, camera.height as usize);
     let mut frame = Frame::new(camera.width, camera.height);
     let mut class = vec![HOLE; w * h];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
     let power = rec.settings.angular_power;
+    let power_int = if power.fract() == 0.0 && power <= 64.0 {
+        power as i32
+    } else {
+        0
+    };
     // The environment lookup uses the heaviest key.
     let env = keys
         .iter()
@@ -194,7 +208,12 @@ pub(crate) fn render(
                     }
                     let wa = if power > 0.0 {
                         let cos = (-d / dist).dot(to_eye);
-                        ((1.0 + cos) * 0.5).max(1e-3).powf(power)
+                        let c = ((1.0 + cos) * 0.5).max(1e-3);
+                        if power_int > 0 {
+                            c.powi(power_int)
+                        } else {
+                            c.powf(power)
+                        }
                     } else {
                         1.0
                     };
@@ -221,6 +240,8 @@ pub(crate) fn render(
                 }
             }
         });
+    report.stage_ms.push(("lookups".into(), ms(start)));
+    let start = Instant::now();
     let (hole, background) = hole_fill(
         &mut frame,
         &mut class,
@@ -228,6 +249,7 @@ pub(crate) fn render(
         &keys,
         &mask.position,
     );
+    report.stage_ms.push(("hole_fill".into(), ms(start)));
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
     report.fallback =
         FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
@@ -341,4 +363,8 @@ impl SlotMap {
         }
         self.sparse.iter().find(|x| x.0 == id).map(|x| x.1)
     }
+}
+
+fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }

@@ -71,6 +71,7 @@ mod geometry;
 pub mod path;
 pub mod plot;
 pub mod proxy;
+mod raster;
 pub mod reconstructor;
 pub mod temporal;
 pub mod tools;
@@ -82,7 +83,7 @@ pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry};
-pub use reconstructor::{ReconSettings, Reconstructor};
+pub use reconstructor::{MaskMethod, ReconSettings, Reconstructor};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

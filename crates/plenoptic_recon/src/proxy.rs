@@ -200,10 +200,31 @@ impl ProxyGeometry {
         self.accel.at_time(t)
     }
 
-    /// The geometry mask of `camera` at time `t`.
+    /// The geometry mask of `camera` at time `t` by ray casting through the tracer's
+    /// two-level BVH (the reference; about one ray per pixel).
     pub fn mask(&self, camera: &Camera, t: f32) -> GeometryMask {
         let placed = self.at_time(t);
         self.mask_placed(&placed, camera)
+    }
+
+    /// The geometry mask of `camera` at time `t` by rasterizing the placed proxy triangles
+    /// (what the GPU mask pass does): the same object ids and hit points as [`Self::mask`]
+    /// up to pixel-centre edge rules, at a fraction of the cost. See [`crate::raster`].
+    pub fn mask_raster(&self, camera: &Camera, t: f32) -> GeometryMask {
+        let objects: Vec<(u32, Affine3A, &Mesh)> = self
+            .scene
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                (
+                    self.pack_ids[i],
+                    self.scene.object_transform(i as u32, t),
+                    &self.scene.meshes[o.mesh],
+                )
+            })
+            .collect();
+        crate::raster::rasterize(camera, &objects)
     }
 
     /// The geometry mask of `camera` over already placed geometry.

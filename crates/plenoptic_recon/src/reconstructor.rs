@@ -45,6 +45,18 @@ pub struct ReconSettings {
     pub background_passes: u32,
     /// Bytes of decoded chunks kept in the cache.
     pub cache_bytes: usize,
+    /// How the geometry mask is computed.
+    pub mask: MaskMethod,
+}
+
+/// How the geometry mask is computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MaskMethod {
+    /// Rasterize the placed proxy triangles (fast; the default).
+    #[default]
+    Raster,
+    /// Cast one ray per pixel through the tracer's BVH (the reference; slower).
+    RayCast,
 }
 
 impl Default for ReconSettings {
@@ -58,6 +70,7 @@ impl Default for ReconSettings {
             hole_fill_radius: 12,
             background_passes: 24,
             cache_bytes: 512 << 20,
+            mask: MaskMethod::Raster,
         }
     }
 }

@@ -311,3 +311,48 @@ fn corrupt_or_missing_chunks_degrade_without_panicking() {
         report.missing
     );
 }
+
+#[test]
+fn rasterized_mask_matches_the_ray_cast_mask() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mask.pack");
+    let scene = room(true);
+    write_pack(&scene, &PackSpec::segment(2, vec![0.0, 2.0], 8), &path);
+    let rec = Reconstructor::open(&path).unwrap();
+    let proxy = rec.proxy().unwrap();
+    for (t, eye) in [
+        (0.4f32, Vec3::new(0.2, 1.2, 1.5)),
+        (1.7, Vec3::new(-1.5, 0.4, -2.0)),
+    ] {
+        let cam = Camera::look_at(eye, Vec3::new(0.0, 0.5, -1.0), Vec3::Y, 1.3, 96, 64).unwrap();
+        let (a, b) = (proxy.mask(&cam, t), proxy.mask_raster(&cam, t));
+        let same = a
+            .object
+            .iter()
+            .zip(&b.object)
+            .filter(|(x, y)| x == y)
+            .count() as f32
+            / a.object.len() as f32;
+        let depth_ok = a
+            .depth
+            .iter()
+            .zip(&b.depth)
+            .zip(a.object.iter().zip(&b.object))
+            .filter(|((da, db), (oa, ob))| {
+                oa == ob && **oa != 0 && (*da - *db).abs() <= 1e-3 * da.max(1.0)
+            })
+            .count();
+        let hits = a
+            .object
+            .iter()
+            .zip(&b.object)
+            .filter(|(x, y)| x == y && **x != 0)
+            .count();
+        println!(
+            "t = {t}: raster/ray-cast ids agree on {:.2}% of pixels",
+            same * 100.0
+        );
+        assert!(same > 0.99, "{same}");
+        assert_eq!(depth_ok, hits);
+    }
+}

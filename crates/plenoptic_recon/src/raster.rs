@@ -1,0 +1,169 @@
+//! A CPU rasterizer of the proxy triangles for the geometry mask.
+//!
+//! Triangles are placed by their object's transform at t, clipped against the near plane,
+//! projected, and scan-converted with edge functions at pixel centres (both windings: proxy
+//! geometry is double-sided like the ray-cast mask). Depth is interpolated as 1/z (affine in
+//! screen space), so every covered pixel gets the camera-space depth of the surface through
+//! its centre; the hit point is the eye plus the pixel's ray direction times the ray distance.
+//! The image is split into bands of rows rasterized in parallel.
+
+use glam::{Affine3A, Vec3};
+use plenoptic_scene::Mesh;
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::proxy::GeometryMask;
+
+const NEAR: f32 = 1e-3;
+const BAND: usize = 16;
+
+/// A projected triangle: screen x, y and 1/z per vertex, with its object.
+#[derive(Clone, Copy)]
+struct Tri {
+    x: [f32; 3],
+    y: [f32; 3],
+    iz: [f32; 3],
+    object: u32,
+    ymin: f32,
+    ymax: f32,
+}
+
+/// Rasterizes `objects` (pack id, object-to-world transform, mesh) for `camera`.
+pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> GeometryMask {
+    let b = camera.basis();
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let (sx, sy) = (0.5 * b.width / b.tan_x, 0.5 * b.height / b.tan_y);
+    let mut tris = Vec::new();
+    for &(object, xf, mesh) in objects {
+        let cam: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .map(|&p| {
+                let d = xf.transform_point3(p) - b.position;
+                Vec3::new(d.dot(b.right), d.dot(b.up), d.dot(b.forward))
+            })
+            .collect();
+        for t in &mesh.triangles {
+            let Some(v) = t
+                .map(|i| cam.get(i as usize).copied())
+                .into_iter()
+                .collect::<Option<Vec<Vec3>>>()
+            else {
+                continue;
+            };
+            // Clip against z ≥ NEAR (Sutherland–Hodgman on one plane).
+            let mut poly: Vec<Vec3> = Vec::with_capacity(4);
+            for k in 0..3 {
+                let (a, c) = (v[k], v[(k + 1) % 3]);
+                if a.z >= NEAR {
+                    poly.push(a);
+                }
+                if (a.z >= NEAR) != (c.z >= NEAR) {
+                    let f = (NEAR - a.z) / (c.z - a.z);
+                    poly.push(a + (c - a) * f);
+                }
+            }
+            let proj = |p: Vec3| {
+                (
+                    0.5 * b.width + sx * p.x / p.z,
+                    0.5 * b.height - sy * p.y / p.z,
+                    1.0 / p.z,
+                )
+            };
+            for k in 1..poly.len().saturating_sub(1) {
+                let (p0, p1, p2) = (proj(poly[0]), proj(poly[k]), proj(poly[k + 1]));
+                let x = [p0.0, p1.0, p2.0];
+                let y = [p0.1, p1.1, p2.1];
+                if !(x.iter().chain(&y).all(|c| c.is_finite())) {
+                    continue;
+                }
+                let ymin = y[0].min(y[1]).min(y[2]);
+                let ymax = y[0].max(y[1]).max(y[2]);
+                if ymax < 0.0
+                    || ymin > b.height
+                    || x.iter().all(|&c| c < 0.0)
+                    || x.iter().all(|&c| c > b.width)
+                {
+                    continue;
+                }
+                tris.push(Tri {
+                    x,
+                    y,
+                    iz: [p0.2, p1.2, p2.2],
+                    object,
+                    ymin,
+                    ymax,
+                });
+            }
+        }
+    }
+    let mut object = vec![0u32; w * h];
+    let mut depth = vec![f32::INFINITY; w * h];
+    let mut position = vec![Vec3::ZERO; w * h];
+    object
+        .par_chunks_mut(w * BAND)
+        .zip(depth.par_chunks_mut(w * BAND))
+        .zip(position.par_chunks_mut(w * BAND))
+        .enumerate()
+        .for_each(|(band, ((obj, dep), pos))| {
+            let y0 = band * BAND;
+            let rows = obj.len() / w;
+            let mut zbuf = vec![f32::INFINITY; rows * w];
+            for t in &tris {
+                if t.ymax < y0 as f32 || t.ymin > (y0 + rows) as f32 {
+                    continue;
+                }
+                let area =
+                    (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.x[2] - t.x[0]) * (t.y[1] - t.y[0]);
+                if area.abs() < 1e-12 {
+                    continue;
+                }
+                let inv = 1.0 / area;
+                let xmin = t.x[0].min(t.x[1]).min(t.x[2]).floor().max(0.0) as usize;
+                let xmax = (t.x[0].max(t.x[1]).max(t.x[2]).ceil() as usize).min(w);
+                let ylo = (t.ymin.floor().max(y0 as f32) as usize).max(y0);
+                let yhi = (t.ymax.ceil() as usize).min(y0 + rows);
+                for py in ylo..yhi {
+                    let cy = py as f32 + 0.5;
+                    for px in xmin..xmax {
+                        let cx = px as f32 + 0.5;
+                        let e = |i: usize, j: usize| {
+                            (t.x[j] - t.x[i]) * (cy - t.y[i]) - (t.y[j] - t.y[i]) * (cx - t.x[i])
+                        };
+                        let b0 = e(1, 2) * inv;
+                        let b1 = e(2, 0) * inv;
+                        let b2 = e(0, 1) * inv;
+                        if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
+                            continue;
+                        }
+                        let iz = b0 * t.iz[0] + b1 * t.iz[1] + b2 * t.iz[2];
+                        if iz <= 0.0 {
+                            continue;
+                        }
+                        let z = 1.0 / iz;
+                        let j = (py - y0) * w + px;
+                        if z < zbuf[j] {
+                            zbuf[j] = z;
+                            obj[j] = t.object;
+                        }
+                    }
+                }
+            }
+            for (j, &z) in zbuf.iter().enumerate() {
+                if z.is_finite() {
+                    let (px, py) = ((j % w) as f32 + 0.5, (y0 + j / w) as f32 + 0.5);
+                    let dir = b.direction(px, py);
+                    let dist = z / dir.dot(b.forward);
+                    dep[j] = dist;
+                    pos[j] = b.position + dir * dist;
+                }
+            }
+        });
+    GeometryMask {
+        width: camera.width,
+        height: camera.height,
+        object,
+        position,
+        depth,
+    }
+}
