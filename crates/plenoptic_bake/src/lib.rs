@@ -21,7 +21,14 @@
 //! - [`delaunay3`]: the 3D Delaunay complex (x, y, t) of temporal volumes.
 //!
 //! The `plenoptic` command (`src/main.rs`) exposes `plan`, `bake` (`--resume`,
-//! `--shard i/N`), `merge`, `inspect` and `reference`.
+//! `--shard i/N`, `--volume-complex`), `merge`, `inspect`, `reference` (path-traced frames
+//! along a camera path), and `render` / `compare` (reconstruction and metrics from
+//! `plenoptic_recon::tools`). Cluster use: `docs/baking-on-a-cluster.md`.
+//!
+//! Decisions the design leaves open, documented in the modules: object ids are stored as scene
+//! id + 1 (0 = none, [`render::pack_object_id`]); the decomposition of space uses the scene at
+//! the start time; a static scene gets one time key per base view and no temporal volume;
+//! timings go to a sidecar file ([`write`]).
 //!
 //! Same inputs give a byte-identical pack, whatever the thread count and whether the bake ran
 //! in one go, resumed, or in shards: wall-clock timings are kept out of the pack (sidecar

@@ -10,6 +10,9 @@
 //! Object ids: the pack reserves 0 for "no object", so a scene object `i` is stored as `i + 1`
 //! ([`pack_object_id`]). Misses have infinite distance and a zero normal.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use glam::Vec3;
 use plenoptic_pack::{CubeImage, RangeImage, VolumeSample, face_uv_to_direction};
 use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
@@ -49,15 +52,20 @@ pub struct BakeRenderer<'a> {
     pub accel: &'a SceneAccel<'a>,
     /// Ambient fields at `plan.ambient_keys`.
     pub fields: &'a [AmbientField],
+    single: Arc<AmbientField>,
+    cache: Mutex<HashMap<u32, Arc<AmbientField>>>,
 }
 
 impl<'a> BakeRenderer<'a> {
-    /// A renderer over a plan, its scene's acceleration structure and its ambient fields.
+    /// A renderer over a plan, its scene's acceleration structure and its ambient fields (at
+    /// least one).
     pub fn new(plan: &'a Plan, accel: &'a SceneAccel<'a>, fields: &'a [AmbientField]) -> Self {
         Self {
             plan,
             accel,
             fields,
+            single: Arc::new(fields[0].clone()),
+            cache: Mutex::new(HashMap::new()),
         }
     }
 
@@ -93,6 +101,23 @@ impl<'a> BakeRenderer<'a> {
         Ok(to_range_image(n, &faces))
     }
 
+    /// The ambient field at time `t`, interpolated once per distinct `t` and cached (volume
+    /// samples ask at frame times only).
+    fn frame_field(&self, t: f32) -> Arc<AmbientField> {
+        if self.fields.len() == 1 {
+            return self.single.clone();
+        }
+        let key = t.to_bits();
+        if let Some(f) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return f;
+        }
+        let f = Arc::new(field_at(&self.plan.ambient_keys, self.fields, t).into_owned());
+        if let Ok(mut c) = self.cache.lock() {
+            c.entry(key).or_insert_with(|| f.clone());
+        }
+        f
+    }
+
     /// The temporal-volume samples of base view `bv` (empty for a zero budget).
     pub fn volume(&self, bv: usize) -> Vec<VolumeSample> {
         let view = &self.plan.base_views[bv];
@@ -115,7 +140,7 @@ impl<'a> BakeRenderer<'a> {
         } else {
             t
         };
-        let field = field_at(&self.plan.ambient_keys, self.fields, frame);
+        let field = self.frame_field(frame);
         let seed = seed_of(&[self.plan.seed, 2, bv as u64]);
         let renderer = MultiStageRenderer::new(self.settings(seed, 1), &field);
         let mut sampler = Sampler::new(seed, stream, 0);
