@@ -85,6 +85,8 @@ fn a_moving_object_adds_keys_only_where_it_is_seen() {
     assert!(a.position.x < 0.0 && b.position.x > 0.0);
     assert!(a.time_keys.len() > 2, "room A: {:?}", a.time_keys);
     assert_eq!(b.time_keys, vec![0.0, 1.0]);
+    // The temporal-volume budget follows the change seen.
+    assert!(a.volume_samples > b.volume_samples && b.volume_samples > 0);
 }
 
 #[test]

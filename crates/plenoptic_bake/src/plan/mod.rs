@@ -81,7 +81,8 @@ pub struct PlannedView {
     pub position: Vec3,
     /// This view's time keys, ascending.
     pub time_keys: Vec<f32>,
-    /// Temporal-volume sample budget.
+    /// Temporal-volume sample budget: the recipe's `temporal_volume_samples` on average over
+    /// the base views, in proportion to this view's number of time intervals.
     pub volume_samples: u32,
 }
 
@@ -291,22 +292,32 @@ pub fn decompose(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> 
             .map(|&k| time::key_time(start, end, time_lattice, k))
             .collect()
     };
-    let volume_samples = if animated {
-        q.temporal_volume_samples
-    } else {
-        0
-    };
+    // Volume budgets: `temporal_volume_samples` per base view on average, shared in
+    // proportion to each view's number of time intervals (views that see more change get
+    // more samples, thesis ch. 7: dense in time where the radiance changes); none for a
+    // static scene.
+    let intervals: Vec<u64> = view_keys
+        .iter()
+        .map(|k| (k.len() as u64).saturating_sub(1).max(1))
+        .collect();
+    let total_intervals: u64 = intervals.iter().sum::<u64>().max(1);
+    let total_samples = u64::from(q.temporal_volume_samples) * view_keys.len() as u64;
     let base_views = space
         .views
         .iter()
         .zip(&view_keys)
+        .zip(&intervals)
         .enumerate()
-        .map(|(i, (&(lattice, position), keys))| PlannedView {
+        .map(|(i, ((&(lattice, position), keys), &n))| PlannedView {
             id: i as u32,
             lattice,
             position,
             time_keys: to_times(keys),
-            volume_samples,
+            volume_samples: if animated {
+                (total_samples * n / total_intervals).min(u64::from(u32::MAX)) as u32
+            } else {
+                0
+            },
         })
         .collect();
     let plan = Plan {
