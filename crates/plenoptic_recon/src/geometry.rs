@@ -41,6 +41,18 @@ struct ViewKey {
     motion: Vec<Affine3A>,
 }
 
+/// A key's data as flat slices for the pixel loop.
+struct FastKey<'a> {
+    base: Vec3,
+    weight: f32,
+    face: u32,
+    ids: &'a [u32],
+    distance: &'a [f32],
+    radiance: &'a [Vec3],
+    normal: Option<&'a [Vec3]>,
+    motion: &'a [Affine3A],
+}
+
 const DIRECT: u8 = 1;
 const VOLUME: u8 = 2;
 const HOLE: u8 = 0;
@@ -135,6 +147,21 @@ pub(crate) fn render(
     let start = Instant::now();
     let (w, h) = (camera.width as usize, camera.height as usize);
     let mut frame = Frame::new(camera.width, camera.height);
+    // Flat views of the cubes for the pixel loop; keys of negligible weight are skipped.
+    let fast: Vec<FastKey<'_>> = keys
+        .iter()
+        .filter(|k| k.weight > 1e-4)
+        .map(|k| FastKey {
+            base: k.base,
+            weight: k.weight,
+            face: k.cubes.ids.face_size,
+            ids: &k.cubes.ids.texels,
+            distance: &k.cubes.distance.texels,
+            radiance: &k.cubes.radiance.texels,
+            normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
+            motion: &k.motion,
+        })
+        .collect();
     let mut class = vec![HOLE; w * h];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
@@ -177,37 +204,36 @@ pub(crate) fn render(
                 };
                 let to_eye = (basis.position - p).normalize_or_zero();
                 let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
-                for k in &keys {
+                for k in &fast {
                     let q = k.motion[slot].transform_point3(p);
                     let d = q - k.base;
-                    let dist = d.length();
-                    if dist.is_nan() || dist <= 1e-6 {
+                    let dist2 = d.length_squared();
+                    if dist2.is_nan() || dist2 <= 1e-12 {
                         continue;
                     }
-                    let n = k.cubes.ids.face_size;
-                    let ti = cube::direction_to_texel(n, d);
-                    if k.cubes.ids.texels[ti] != o {
+                    let ti = cube::direction_to_texel(k.face, d);
+                    if k.ids[ti] != o {
                         continue;
                     }
-                    let dc = k.cubes.distance.texels[ti];
-                    let expected = match &k.cubes.normal {
-                        Some(nc) => {
-                            // Distance to the texel's surface plane along the lookup direction.
-                            let nrm = nc.texels[ti];
-                            let denom = d.dot(nrm) / dist;
-                            if denom.abs() > 0.05 {
-                                (cube::texel_direction(n, ti) * dc).dot(nrm) / denom
-                            } else {
-                                dc
-                            }
+                    let dist = dist2.sqrt();
+                    let dc = k.distance[ti];
+                    // Fast path: the texel's centre distance agrees. Otherwise compare with
+                    // the distance to the texel's surface plane along the lookup direction
+                    // (grazing surfaces change depth quickly across a texel).
+                    if (dc - dist).abs() > tol * dist {
+                        let Some(nc) = k.normal else { continue };
+                        let nrm = nc[ti];
+                        let denom = d.dot(nrm) / dist;
+                        if denom.abs() <= 0.05 {
+                            continue;
                         }
-                        None => dc,
-                    };
-                    if (expected - dist).abs() > tol * dist {
-                        continue;
+                        let expected = (cube::texel_direction(k.face, ti) * dc).dot(nrm) / denom;
+                        if (expected - dist).abs() > tol * dist {
+                            continue;
+                        }
                     }
                     let wa = if power > 0.0 {
-                        let cos = (-d / dist).dot(to_eye);
+                        let cos = -d.dot(to_eye) / dist;
                         let c = ((1.0 + cos) * 0.5).max(1e-3);
                         if power_int > 0 {
                             c.powi(power_int)
@@ -218,7 +244,7 @@ pub(crate) fn render(
                         1.0
                     };
                     let wt = k.weight * wa;
-                    sum += k.cubes.radiance.texels[ti] * wt;
+                    sum += k.radiance[ti] * wt;
                     ws += wt;
                 }
                 if ws > 0.0 {
