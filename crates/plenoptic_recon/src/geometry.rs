@@ -51,6 +51,9 @@ struct FastKey<'a> {
     radiance: &'a [Vec3],
     normal: Option<&'a [Vec3]>,
     motion: &'a [Affine3A],
+    /// Per object slot: the previous key has the same base view, face size and transform, so
+    /// its lookup direction and texel can be reused.
+    reuse: Vec<bool>,
 }
 
 const DIRECT: u8 = 1;
@@ -160,8 +163,24 @@ pub(crate) fn render(
             radiance: &k.cubes.radiance.texels,
             normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
             motion: &k.motion,
+            reuse: Vec::new(),
         })
         .collect();
+    let fast: Vec<FastKey<'_>> = {
+        let mut fast = fast;
+        for i in 0..fast.len() {
+            let reuse = (0..ids.len())
+                .map(|s| {
+                    i > 0
+                        && fast[i - 1].base == fast[i].base
+                        && fast[i - 1].face == fast[i].face
+                        && fast[i - 1].motion[s] == fast[i].motion[s]
+                })
+                .collect();
+            fast[i].reuse = reuse;
+        }
+        fast
+    };
     let mut class = vec![HOLE; w * h];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
@@ -204,18 +223,22 @@ pub(crate) fn render(
                 };
                 let to_eye = (basis.position - p).normalize_or_zero();
                 let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
+                let (mut d, mut dist, mut ti) = (Vec3::ZERO, 0.0f32, usize::MAX);
                 for k in &fast {
-                    let q = k.motion[slot].transform_point3(p);
-                    let d = q - k.base;
-                    let dist2 = d.length_squared();
-                    if dist2.is_nan() || dist2 <= 1e-12 {
-                        continue;
+                    if !k.reuse[slot] || ti == usize::MAX {
+                        let q = k.motion[slot].transform_point3(p);
+                        d = q - k.base;
+                        let dist2 = d.length_squared();
+                        if dist2.is_nan() || dist2 <= 1e-12 {
+                            ti = usize::MAX;
+                            continue;
+                        }
+                        dist = dist2.sqrt();
+                        ti = cube::direction_to_texel(k.face, d);
                     }
-                    let ti = cube::direction_to_texel(k.face, d);
                     if k.ids[ti] != o {
                         continue;
                     }
-                    let dist = dist2.sqrt();
                     let dc = k.distance[ti];
                     // Fast path: the texel's centre distance agrees. Otherwise compare with
                     // the distance to the texel's surface plane along the lookup direction
