@@ -278,11 +278,12 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
     let accel = SceneAccel::new(&scene)?;
     let clock = Instant::now();
-    let planned = plan::build(&recipe, &scene, &accel)?;
+    let (mut planned, id_rays) = plan::decompose(&recipe, &scene, &accel);
     let secs = clock.elapsed().as_secs_f64().max(1e-6);
-    // Id rays are about as costly as one shading ray; the planning rate stands in for both.
-    let rate = planned.id_rays as f64 / secs;
-    let p = &planned.plan;
+    // Id rays are about as costly as one shading ray; their rate stands in for both.
+    let rate = id_rays as f64 / secs;
+    plan::ambient_phase(&mut planned, &scene, &accel)?;
+    let p = &planned;
     let cost = p.cost(rate);
     let out = out.unwrap_or_else(|| {
         let mut n = recipe.output.as_os_str().to_owned();

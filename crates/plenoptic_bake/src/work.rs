@@ -301,3 +301,57 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_partition() {
+        let s: Shard = "1/3".parse().unwrap();
+        assert_eq!(s, Shard { index: 1, count: 3 });
+        assert_eq!(s.to_string(), "1/3");
+        for bad in ["3/3", "1", "a/2", "0/0", "-1/2"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        let owners: Vec<u32> = (0..7)
+            .map(|i| {
+                (0..3)
+                    .find(|&k| Shard { index: k, count: 3 }.owns(i))
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(owners, vec![0, 1, 2, 0, 1, 2, 0]);
+    }
+
+    #[test]
+    fn item_files_round_trip_and_damage_is_detected() {
+        let dir = tempfile::tempdir().unwrap();
+        let work = WorkDir {
+            path: dir.path().join("x.pack.work"),
+        };
+        work.create().unwrap();
+        let item = WorkItem::RangeImage {
+            base_view: 2,
+            key: 1,
+        };
+        assert!(!work.is_done(&item));
+        let chunks = vec![ItemChunk {
+            kind: ChunkKind::VolumeBlock,
+            base_view: 2,
+            key: 7,
+            uncompressed_length: 99,
+            bytes: vec![1, 2, 3, 4, 5],
+        }];
+        work.write_item(&item, &chunks).unwrap();
+        assert!(work.is_done(&item));
+        assert_eq!(work.read_item(&item).unwrap(), chunks);
+        let path = work.item_path(&item);
+        let mut bytes = fs::read(&path).unwrap();
+        bytes.pop();
+        fs::write(&path, &bytes).unwrap();
+        assert!(!work.is_done(&item), "a truncated item is not done");
+        work.remove().unwrap();
+        assert!(!work.path.exists());
+    }
+}
