@@ -1,0 +1,389 @@
+//! # The architectural tour
+//!
+//! A walk through a small building — two rooms on either side of a tall atrium — while its
+//! animation plays: the sun moves across the sky and its light travels over the floors
+//! through the windows and the skylight, a sliding door opens and closes, a sculpture
+//! revolves on its pedestal, a ceiling fan turns, and a cart crosses a room and comes back.
+//! The building has a mirror, a glass vitrine, columns, stairs and furniture, so the
+//! reconstruction meets reflections, refractions, occlusion and moving shadows. The scene is
+//! generated in code (`scene.rs`); see that module for the layout.
+//!
+//! What the example does:
+//!
+//! 1. Writes `assets/tour.glb` from the generator if the file is missing (the committed
+//!    file is checked against the generator by `tests/tour_scene.rs`).
+//! 2. Bakes the radiance pack from `assets/tour.toml` if it is missing, with progress bars
+//!    (`target/architectural_tour/tour.pack`; the recipe's `output`). At the recipe's draft
+//!    quality this takes minutes in a release build; in a debug build much longer.
+//! 3. Flies the camera path `assets/tour_path.json` (room B, atrium, room A, for the 14 s
+//!    of the animation) and renders every frame with the CPU reconstruction of
+//!    `plenoptic_recon` in geometry-assisted mode, into PNG frames plus an animated GIF
+//!    preview (`tour.gif`) in the output folder (default
+//!    `target/architectural_tour/frames`), with a progress bar.
+//!
+//! **Windowed mode is not available yet.** The Bevy plugin that will show the tour in a
+//! window is still being written; until then the example always renders headless. When a
+//! display is present (`DISPLAY` or `WAYLAND_DISPLAY` set) and `--headless` was not given,
+//! it says so and renders headless anyway.
+//!
+//! Run it (release recommended for the bake):
+//!
+//! ```text
+//! cargo run --release --no-default-features --example architectural_tour
+//! # a short run: 4 frames spread over the tour, small frames
+//! cargo run --no-default-features --example architectural_tour -- --frames 4 --width 160 --height 90
+//! ```
+//!
+//! Options:
+//!
+//! - `--headless`: render to files (the only mode for now).
+//! - `--frames N`: render N frames spread evenly over the whole tour instead of every frame
+//!   of the path (24 per second).
+//! - `--width W`, `--height H`: frame size (default: the path's 640 × 360).
+//! - `--out DIR`: where frames and the preview go.
+//! - `--pack FILE`: use (or bake to) this pack instead of the recipe's output.
+//! - `--mode geometry|image|volume`: reconstruction mode (default geometry-assisted).
+//! - `--plan`: print the bake plan of the recipe (base views, time keys, estimated cost) and
+//!   stop.
+//! - `--quiet`: no progress bars.
+
+#[allow(dead_code, reason = "some items are for tests/tour_scene.rs")]
+mod scene;
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame as GifFrame, RgbaImage};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use plenoptic_bake::BakeOptions;
+use plenoptic_bake::progress::Progress;
+use plenoptic_recon::frame_io::{auto_exposure, tonemap, write_png};
+use plenoptic_recon::tools::frame_name;
+use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor};
+use plenoptic_scene::recipe::Recipe;
+
+type BoxError = Box<dyn std::error::Error>;
+
+/// Command-line options.
+#[derive(Debug)]
+struct Options {
+    headless: bool,
+    frames: Option<usize>,
+    width: Option<u32>,
+    height: Option<u32>,
+    out: Option<PathBuf>,
+    pack: Option<PathBuf>,
+    mode: Mode,
+    quiet: bool,
+    plan: bool,
+}
+
+const USAGE: &str = "usage: architectural_tour [--headless] [--frames N] [--width W] \
+                     [--height H] [--out DIR] [--pack FILE] [--mode geometry|image|volume] \
+                     [--plan] [--quiet]";
+
+fn parse_args() -> Result<Options, String> {
+    let mut o = Options {
+        headless: false,
+        frames: None,
+        width: None,
+        height: None,
+        out: None,
+        pack: None,
+        mode: Mode::GeometryAssisted,
+        quiet: false,
+        plan: false,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value\n{USAGE}"));
+        let number = |name: &str, v: String| {
+            v.parse::<u32>()
+                .ok()
+                .filter(|&n| n > 0)
+                .ok_or(format!("{name}: `{v}` is not a positive whole number"))
+        };
+        match arg.as_str() {
+            "--headless" => o.headless = true,
+            "--quiet" => o.quiet = true,
+            "--plan" => o.plan = true,
+            "--frames" => o.frames = Some(number("--frames", value("--frames")?)? as usize),
+            "--width" => o.width = Some(number("--width", value("--width")?)?),
+            "--height" => o.height = Some(number("--height", value("--height")?)?),
+            "--out" => o.out = Some(value("--out")?.into()),
+            "--pack" => o.pack = Some(value("--pack")?.into()),
+            "--mode" => {
+                let v = value("--mode")?;
+                o.mode = Mode::parse(&v).ok_or(format!("--mode: unknown mode `{v}`"))?;
+            }
+            "-h" | "--help" => return Err(USAGE.to_owned()),
+            other => return Err(format!("unknown argument `{other}`\n{USAGE}")),
+        }
+    }
+    Ok(o)
+}
+
+fn main() -> ExitCode {
+    let options = match parse_args() {
+        Ok(o) => o,
+        Err(message) => {
+            eprintln!("{message}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match run(&options) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("architectural_tour: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The example's asset folder.
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/architectural_tour/assets")
+}
+
+/// Where the example writes by default: `$CARGO_TARGET_DIR/architectural_tour` or
+/// `target/architectural_tour` of the workspace.
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"))
+        .join("architectural_tour")
+}
+
+fn run(options: &Options) -> Result<(), BoxError> {
+    let assets = assets();
+
+    // 1. The scene file.
+    let glb = assets.join("tour.glb");
+    if !glb.exists() {
+        println!("writing {} from the scene generator", glb.display());
+        scene::build().write_glb(&glb)?;
+    }
+
+    // 2. The pack.
+    let recipe_path = assets.join("tour.toml");
+    let recipe = Recipe::from_path(&recipe_path)?;
+    if options.plan {
+        return print_plan(&recipe_path);
+    }
+    let pack = options.pack.clone().unwrap_or(recipe.output.clone());
+    if !pack.exists() {
+        println!(
+            "baking {} → {} (q = {}, {} px range images)",
+            recipe_path.display(),
+            pack.display(),
+            recipe.quality.q,
+            recipe.quality.range_image_size
+        );
+        if cfg!(debug_assertions) {
+            println!("  (a debug build bakes slowly; `--release` bakes in minutes)");
+        }
+        if let Some(dir) = pack.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        let start = Instant::now();
+        let report = plenoptic_bake::bake_recipe(
+            &recipe_path,
+            &BakeOptions {
+                // An interrupted bake continues where it stopped.
+                resume: true,
+                progress: Progress::new(!options.quiet),
+                output: Some(pack.clone()),
+                ..BakeOptions::default()
+            },
+        )?;
+        let size = std::fs::metadata(&pack).map(|m| m.len()).unwrap_or(0);
+        println!(
+            "baked {} base views, {} work items in {:.1} s: {} ({:.1} MiB)",
+            report.plan.base_views.len(),
+            report.items_total,
+            start.elapsed().as_secs_f64(),
+            pack.display(),
+            size as f64 / (1024.0 * 1024.0)
+        );
+    }
+
+    // 3. The tour.
+    let display = std::env::var_os("DISPLAY").is_some_and(|v| !v.is_empty())
+        || std::env::var_os("WAYLAND_DISPLAY").is_some_and(|v| !v.is_empty());
+    if display && !options.headless {
+        println!(
+            "the windowed tour (Bevy plugin) is not available yet; rendering the tour headless"
+        );
+    }
+    render_headless(options, &pack)
+}
+
+/// Prints the bake plan of the recipe at `recipe_path` and its estimated cost.
+fn print_plan(recipe_path: &Path) -> Result<(), BoxError> {
+    let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
+    println!(
+        "scene: {} objects, {} triangles, {} lights, animation {:?} s",
+        scene.objects.len(),
+        scene.triangle_count(),
+        scene.lights.len(),
+        scene.animation_range()
+    );
+    let accel = plenoptic_trace::SceneAccel::new(&scene)?;
+    let clock = Instant::now();
+    let planned = plenoptic_bake::plan::build(&recipe, &scene, &accel)?;
+    let secs = clock.elapsed().as_secs_f64().max(1e-6);
+    let p = &planned.plan;
+    let cost = p.cost(planned.id_rays as f64 / secs);
+    println!(
+        "plan (q = {}, {} px range images, {} spp): {} base views, {} time keys, ambient keys {:?}",
+        p.quality.q,
+        p.quality.range_image_size,
+        p.quality.samples_per_pixel,
+        p.base_views.len(),
+        p.time_key_count(),
+        p.ambient_keys
+    );
+    for v in &p.base_views {
+        println!(
+            "  view {:>3} at ({:6.2}, {:.2}, {:6.2}): {:>3} keys",
+            v.id,
+            v.position.x,
+            v.position.y,
+            v.position.z,
+            v.time_keys.len()
+        );
+    }
+    println!(
+        "cost: {} range images, {} camera samples, {} volume samples, ≤ {:.1} MiB before \
+         compression, about {:.0} s on this machine (planned in {secs:.1} s)",
+        cost.range_images,
+        cost.camera_samples,
+        cost.volume_samples,
+        cost.estimated_bytes as f64 / (1024.0 * 1024.0),
+        cost.estimated_seconds
+    );
+    Ok(())
+}
+
+/// Renders the camera path with the CPU reconstruction into PNG frames and `tour.gif`.
+fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
+    let mut path = CameraPath::load(assets().join("tour_path.json"))?;
+    if let Some(w) = options.width {
+        path.width = w;
+    }
+    if let Some(h) = options.height {
+        path.height = h;
+    }
+    let (start, end) = path.time_range();
+    let samples: Vec<PathSample> = match options.frames {
+        None => path.frames().collect(),
+        Some(1) => vec![path.sample(start)],
+        Some(n) => (0..n)
+            .map(|i| PathSample {
+                index: i,
+                ..path.sample(start + (end - start) * i as f32 / (n - 1) as f32)
+            })
+            .collect(),
+    };
+    let frame_seconds = (end - start) / samples.len().saturating_sub(1).max(1) as f32;
+
+    let out = options
+        .out
+        .clone()
+        .unwrap_or_else(|| target_dir().join("frames"));
+    std::fs::create_dir_all(&out)?;
+    let rec = Reconstructor::open(pack)?;
+    println!(
+        "rendering {} frames of {}×{} ({} mode) into {}",
+        samples.len(),
+        path.width,
+        path.height,
+        options.mode.name(),
+        out.display()
+    );
+
+    let bar = if options.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new(samples.len() as u64);
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template(
+            "{prefix:>14} [{bar:32}] {pos}/{len} {elapsed_precise} ETA {eta_precise} {msg}",
+        ) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_prefix("tour");
+        bar
+    };
+
+    let mut exposure = None;
+    let mut gif_frames = Vec::with_capacity(samples.len());
+    let mut total_ms = 0.0;
+    let mut direct = 0.0;
+    let mut degraded = 0;
+    for s in &samples {
+        let clock = Instant::now();
+        let (frame, report) = rec.render(&s.camera, s.scene_time, options.mode)?;
+        total_ms += clock.elapsed().as_secs_f64() * 1e3;
+        direct += report.fallback.direct;
+        degraded += usize::from(report.degraded());
+        // One exposure for the whole tour, so that the light visibly changes.
+        let e = *exposure.get_or_insert_with(|| auto_exposure(&frame.radiance));
+        write_png(
+            out.join(frame_name(s.index, "png")),
+            frame.width,
+            frame.height,
+            &frame.radiance,
+            e,
+        )?;
+        let rgba: Vec<u8> = frame
+            .radiance
+            .iter()
+            .flat_map(|&c| {
+                let [r, g, b] = tonemap(c, e);
+                [r, g, b, 255]
+            })
+            .collect();
+        let image = RgbaImage::from_raw(frame.width, frame.height, rgba)
+            .ok_or("frame size does not match its pixels")?;
+        gif_frames.push(image);
+        bar.set_message(format!("t = {:.2} s", s.scene_time));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let gif = out.join("tour.gif");
+    write_gif(&gif, gif_frames, frame_seconds)?;
+    let n = samples.len().max(1) as f64;
+    println!(
+        "{} frames, {:.1} ms/frame reconstruction, {:.1}% of pixels direct lookups, {} degraded",
+        samples.len(),
+        total_ms / n,
+        100.0 * f64::from(direct) / n,
+        degraded
+    );
+    println!(
+        "frames: {}  preview: {}",
+        out.join("frame_*.png").display(),
+        gif.display()
+    );
+    Ok(())
+}
+
+/// Writes an endlessly looping GIF, `seconds` per frame.
+fn write_gif(path: &Path, frames: Vec<RgbaImage>, seconds: f32) -> Result<(), BoxError> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    // Speed 10 of 1..=30: good enough colour quantisation at a few ms per frame.
+    let mut encoder = GifEncoder::new_with_speed(file, 10);
+    encoder.set_repeat(Repeat::Infinite)?;
+    let delay = Delay::from_numer_denom_ms((seconds * 1000.0).round().max(20.0) as u32, 1);
+    encoder.encode_frames(
+        frames
+            .into_iter()
+            .map(|image| GifFrame::from_parts(image, 0, 0, delay)),
+    )?;
+    Ok(())
+}
