@@ -42,6 +42,9 @@
 //! - `--width W`, `--height H`: frame size (default: the path's 640 × 360).
 //! - `--out DIR`: where frames and the preview go.
 //! - `--pack FILE`: use (or bake to) this pack instead of the recipe's output.
+//! - `--recipe FILE`: bake this recipe instead of `assets/tour.toml` (for example a copy
+//!   with cheaper quality settings for a quick check; its `[[scene]]` should name
+//!   `tour.glb`).
 //! - `--mode geometry|image|volume`: reconstruction mode (default geometry-assisted).
 //! - `--plan`: print the bake plan of the recipe (base views, time keys, estimated cost) and
 //!   stop.
@@ -76,13 +79,14 @@ struct Options {
     height: Option<u32>,
     out: Option<PathBuf>,
     pack: Option<PathBuf>,
+    recipe: Option<PathBuf>,
     mode: Mode,
     quiet: bool,
     plan: bool,
 }
 
 const USAGE: &str = "usage: architectural_tour [--headless] [--frames N] [--width W] \
-                     [--height H] [--out DIR] [--pack FILE] [--mode geometry|image|volume] \
+                     [--height H] [--out DIR] [--pack FILE] [--recipe FILE] [--mode geometry|image|volume] \
                      [--plan] [--quiet]";
 
 fn parse_args() -> Result<Options, String> {
@@ -93,6 +97,7 @@ fn parse_args() -> Result<Options, String> {
         height: None,
         out: None,
         pack: None,
+        recipe: None,
         mode: Mode::GeometryAssisted,
         quiet: false,
         plan: false,
@@ -115,6 +120,7 @@ fn parse_args() -> Result<Options, String> {
             "--height" => o.height = Some(number("--height", value("--height")?)?),
             "--out" => o.out = Some(value("--out")?.into()),
             "--pack" => o.pack = Some(value("--pack")?.into()),
+            "--recipe" => o.recipe = Some(value("--recipe")?.into()),
             "--mode" => {
                 let v = value("--mode")?;
                 o.mode = Mode::parse(&v).ok_or(format!("--mode: unknown mode `{v}`"))?;
@@ -168,13 +174,22 @@ fn run(options: &Options) -> Result<(), BoxError> {
     }
 
     // 2. The pack.
-    let recipe_path = assets.join("tour.toml");
+    let recipe_path = options
+        .recipe
+        .clone()
+        .unwrap_or_else(|| assets.join("tour.toml"));
     let recipe = Recipe::from_path(&recipe_path)?;
     if options.plan {
         return print_plan(&recipe_path);
     }
-    let pack = options.pack.clone().unwrap_or(recipe.output.clone());
+    let mut pack = options.pack.clone().unwrap_or(recipe.output.clone());
     if !pack.exists() {
+        if let Some(dir) = pack.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+            if let (Ok(dir), Some(name)) = (dir.canonicalize(), pack.file_name()) {
+                pack = dir.join(name);
+            }
+        }
         println!(
             "baking {} → {} (q = {}, {} px range images)",
             recipe_path.display(),
@@ -184,9 +199,6 @@ fn run(options: &Options) -> Result<(), BoxError> {
         );
         if cfg!(debug_assertions) {
             println!("  (a debug build bakes slowly; `--release` bakes in minutes)");
-        }
-        if let Some(dir) = pack.parent() {
-            std::fs::create_dir_all(dir)?;
         }
         let start = Instant::now();
         let report = plenoptic_bake::bake_recipe(
@@ -319,7 +331,11 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
         bar
     };
 
-    let mut exposure = None;
+    // The exposure adapts like an eye going from the bright atrium into a darker room: the
+    // log of the auto exposure, smoothed with a time constant of `ADAPTATION` seconds.
+    const ADAPTATION: f32 = 0.75;
+    let adapt = 1.0 - (-frame_seconds / ADAPTATION).exp();
+    let mut log_exposure: Option<f32> = None;
     let mut gif_frames = Vec::with_capacity(samples.len());
     let mut total_ms = 0.0;
     let mut direct = 0.0;
@@ -330,8 +346,10 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
         total_ms += clock.elapsed().as_secs_f64() * 1e3;
         direct += report.fallback.direct;
         degraded += usize::from(report.degraded());
-        // One exposure for the whole tour, so that the light visibly changes.
-        let e = *exposure.get_or_insert_with(|| auto_exposure(&frame.radiance));
+        let target = auto_exposure(&frame.radiance).ln();
+        let log_e = log_exposure.map_or(target, |prev| prev + (target - prev) * adapt);
+        log_exposure = Some(log_e);
+        let e = log_e.exp();
         write_png(
             out.join(frame_name(s.index, "png")),
             frame.width,
