@@ -197,5 +197,27 @@ fn recipe_and_camera_path_fit_the_scene() {
             "frame {} at {p} leaves the view space",
             s.index
         );
+        // Through the walls between the rooms only by the doorways, and through room B's
+        // doorway only while the sliding door is open (2.5 s to 10 s).
+        if (p.x + 4.0).abs() < 0.3 {
+            assert!(
+                p.z.abs() < 1.2,
+                "frame {} at {p} walks through a wall",
+                s.index
+            );
+        }
+        if (p.x - 4.0).abs() < 0.3 {
+            assert!(
+                p.z.abs() < 0.8,
+                "frame {} at {p} walks through a wall",
+                s.index
+            );
+            assert!(
+                (2.5..=10.0).contains(&s.scene_time),
+                "frame {} at {p} walks through the closed door at t = {}",
+                s.index,
+                s.scene_time
+            );
+        }
     }
 }
