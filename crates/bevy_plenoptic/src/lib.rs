@@ -4,38 +4,107 @@
 //! illuminated frames for the camera's position and the current time (thesis chapters 6–7
 //! and 8.2.3; `design.md`, "The runtime plugin").
 //!
-//! At this stage the crate holds the plugin skeleton: [`PlenopticPlugin`] registers the
-//! settings resource and the public [`PlenopticSystems`] set that later passes (streaming,
-//! geometry mask, reconstruction) run in. The rendering path itself is proven by the crate's
-//! headless tests, which render on Mesa's software Vulkan driver and read the pixels back.
+//! - [`asset`]: the [`RadiancePack`] asset; its loader reads only the header, manifest and
+//!   directory (and the small proxy meshes and tracks), never a cube.
+//! - [`camera`]: the [`PlenopticCamera`] component (pack, time, mode, playback).
+//! - [`proxy`]: the *geometry mask* of thesis §8.2.3 — the pack's proxy meshes spawned as
+//!   ordinary Bevy mesh entities and placed from the animation tracks at the camera's time.
+//!   Rasterising them gives each pixel its object and surface point and writes real depth,
+//!   so ordinary Bevy meshes occlude, and are occluded by, the baked scene.
+//! - [`streaming`]: the working set (nearest base views × time keys bracketing t, prefetch
+//!   along the camera's motion and the playback direction) kept inside
+//!   [`PlenopticSettings::memory_budget_bytes`] with LRU eviction; reads and decodes run on
+//!   the I/O task pool; Bevy diagnostics report resident bytes, hits, misses, stalls
+//!   and decode time.
+//!
+//! Errors never panic the app: a pack that cannot be opened is an asset load failure whose
+//! message names the section or chunk; a chunk that fails its checksum while streaming is a
+//! [`PlenopticEvent::ChunkFailed`] message, and the frame is reconstructed from what is
+//! resident.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use bevy_plenoptic::prelude::*;
+//!
+//! fn setup(mut commands: Commands, assets: Res<AssetServer>) {
+//!     commands.spawn((
+//!         PlenopticCamera::new(assets.load("scene.pack")),
+//!         Transform::from_xyz(0.0, 1.3, 1.0),
+//!     ));
+//! }
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, PlenopticPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
 
+pub mod asset;
+pub mod camera;
+pub mod proxy;
+pub mod streaming;
+
+use bevy::asset::io::file::FileAssetReader;
 use bevy::prelude::*;
 
-/// Adds plenoptic's resources and system sets to an app.
+pub use asset::{RadiancePack, RadiancePackLoader};
+pub use camera::{Playback, PlenopticCamera, ReconMode};
+
+/// The usual imports.
+pub mod prelude {
+    pub use crate::{
+        Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin, PlenopticSettings,
+        PlenopticSystems, RadiancePack, ReconMode,
+    };
+}
+
+/// Adds plenoptic: the pack asset, cameras, proxy geometry and streaming. Add it after
+/// `DefaultPlugins` (the loader resolves packs under the `AssetPlugin`'s directory).
 #[derive(Debug, Default)]
 pub struct PlenopticPlugin;
 
 impl Plugin for PlenopticPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<PlenopticSettings>().configure_sets(
-            Update,
-            (PlenopticSystems::Playback, PlenopticSystems::Streaming).chain(),
-        );
+        let asset_root = app
+            .get_added_plugins::<AssetPlugin>()
+            .first()
+            .map(|p| FileAssetReader::get_base_path().join(&p.file_path));
+        app.init_resource::<PlenopticSettings>()
+            .init_asset::<RadiancePack>()
+            .register_asset_loader(RadiancePackLoader { asset_root })
+            .add_message::<PlenopticEvent>()
+            .configure_sets(
+                Update,
+                (PlenopticSystems::Playback, PlenopticSystems::Streaming).chain(),
+            )
+            .add_plugins((
+                camera::PlenopticCameraPlugin,
+                proxy::PlenopticProxyPlugin,
+                streaming::PlenopticStreamingPlugin,
+            ));
     }
 }
 
 /// Global settings of the plugin.
 #[derive(Resource, Debug, Clone, PartialEq)]
 pub struct PlenopticSettings {
-    /// Upper bound, in bytes, on decoded pack data kept resident (CPU and GPU together).
+    /// Upper bound, in bytes, on decoded pack data kept resident (including reads in flight).
     /// Larger budgets keep more base views and time keys around the camera and stall less.
     pub memory_budget_bytes: u64,
+    /// Base views blended per frame (and kept resident per camera). Each adds its cubes at two
+    /// time keys to the working set and a lookup per pixel.
+    pub max_views: usize,
+    /// How far ahead, in seconds, to prefetch along the camera's velocity and the playback
+    /// direction. Longer hides more latency but spends budget on data that may not be used.
+    pub prefetch_seconds: f32,
 }
 
 impl Default for PlenopticSettings {
     fn default() -> Self {
         Self {
             memory_budget_bytes: 256 * 1024 * 1024,
+            max_views: 4,
+            prefetch_seconds: 0.5,
         }
     }
 }
@@ -44,8 +113,21 @@ impl Default for PlenopticSettings {
 /// against them, e.g. set the playback time `.before(PlenopticSystems::Playback)`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PlenopticSystems {
-    /// Advances or applies the playback time of each plenoptic camera.
+    /// Advances or applies the playback time of each plenoptic camera and places the proxy
+    /// geometry.
     Playback,
     /// Decides the working set and issues reads and decodes off the main thread.
     Streaming,
+}
+
+/// Something that went wrong while streaming; the app keeps running.
+#[derive(Message, Debug, Clone, PartialEq)]
+pub enum PlenopticEvent {
+    /// A chunk could not be read or decoded (checksum mismatch, truncated file, bad KTX2).
+    ChunkFailed {
+        /// The chunk (kind, base view, key).
+        chunk: String,
+        /// Why.
+        reason: String,
+    },
 }

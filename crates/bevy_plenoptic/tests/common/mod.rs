@@ -1,5 +1,8 @@
 //! Headless rendering harness shared by the GPU tests: an app without a window whose camera
 //! renders into an image that is read back to the CPU.
+#![allow(dead_code, reason = "each test binary uses a part of it")]
+
+pub mod pack;
 
 use std::sync::{Arc, Mutex};
 
@@ -32,6 +35,29 @@ pub fn headless_app() -> App {
             })
             .build(),
     );
+    app
+}
+
+/// Like [`headless_app`], with assets read from `dir` and the plenoptic plugin added
+/// (finished and cleaned up, ready to update).
+pub fn headless_app_in(dir: &std::path::Path) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .set(AssetPlugin {
+                file_path: dir.to_string_lossy().into_owned(),
+                ..default()
+            })
+            .build(),
+        bevy_plenoptic::PlenopticPlugin,
+    ));
+    app.finish();
+    app.cleanup();
     app
 }
 

@@ -1,0 +1,387 @@
+//! Streaming: keeps each camera's working set of cubes resident inside the memory budget.
+//!
+//! Every frame, per [`PlenopticCamera`]: the working set ([`schedule::working_set`]) is the
+//! nearest base views × the time keys bracketing t ("needed"), plus the same around where
+//! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
+//! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
+//! bytes) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
+//! on a slow driver those compiles would queue the reads behind them); the main thread never
+//! waits on I/O. A key's bytes
+//! are reserved against the budget *before* its read starts, from the directory's
+//! uncompressed lengths, so resident + in-flight bytes never exceed
+//! [`PlenopticSettings::memory_budget_bytes`]; to make room the least recently used keys
+//! outside the current working set are evicted. While a needed key is missing the frame is
+//! reconstructed from what is resident (a *stall* is counted).
+//!
+//! Each resident key sits in a fixed-size slot (`slot` < budget / key bytes): the index of its
+//! layer range in the cube-array textures the GPU reconstruction samples.
+
+pub mod schedule;
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnostic};
+use bevy::prelude::*;
+use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
+use plenoptic_pack::{ChunkKind, PackReader, ktx, range_image};
+
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+use crate::{PlenopticEvent, PlenopticSettings, PlenopticSystems};
+use schedule::{KeyRef, Lookahead, working_set};
+
+/// Bytes of decoded cube data resident (and reserved for reads in flight).
+pub const RESIDENT_BYTES: DiagnosticPath = DiagnosticPath::const_new("plenoptic/resident_bytes");
+/// Needed keys found resident this frame.
+pub const HITS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/hits");
+/// Needed keys not resident this frame.
+pub const MISSES: DiagnosticPath = DiagnosticPath::const_new("plenoptic/misses");
+/// 1 for a frame in which some needed key was not resident, else 0.
+pub const STALLS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/stalls");
+/// Milliseconds spent reading and decoding the keys that finished this frame.
+pub const DECODE_MS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/decode_ms");
+
+/// Adds the streaming scheduler and its diagnostics.
+#[derive(Debug, Default)]
+pub struct PlenopticStreamingPlugin;
+
+impl Plugin for PlenopticStreamingPlugin {
+    fn build(&self, app: &mut App) {
+        for path in [RESIDENT_BYTES, HITS, MISSES, STALLS, DECODE_MS] {
+            app.register_diagnostic(Diagnostic::new(path));
+        }
+        app.init_resource::<StreamCache>()
+            .init_resource::<StreamingStats>()
+            .add_systems(
+                Update,
+                (collect_finished, schedule_reads)
+                    .chain()
+                    .in_set(PlenopticSystems::Streaming),
+            );
+    }
+}
+
+/// Per-camera streaming state (required by [`PlenopticCamera`]).
+#[derive(Component, Debug, Clone, Default)]
+pub struct StreamState {
+    /// Position last frame (for the velocity estimate).
+    pub last_position: Option<Vec3>,
+    /// This frame's working set.
+    pub working_set: schedule::WorkingSet,
+    /// Whether every needed key was resident this frame.
+    pub complete: bool,
+}
+
+/// Cumulative streaming counters (the diagnostics carry the per-frame values).
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct StreamingStats {
+    /// Resident + reserved bytes now.
+    pub resident_bytes: u64,
+    /// Highest `resident_bytes` seen.
+    pub peak_resident_bytes: u64,
+    /// Needed keys found resident.
+    pub hits: u64,
+    /// Needed keys not resident.
+    pub misses: u64,
+    /// Frames with a needed key missing.
+    pub stalls: u64,
+    /// Keys decoded.
+    pub decoded_keys: u64,
+    /// Bytes decoded.
+    pub decoded_bytes: u64,
+    /// Time spent decoding (summed over worker threads).
+    pub decode_time: Duration,
+    /// Keys evicted.
+    pub evictions: u64,
+}
+
+/// The GPU-ready texel bytes of one key (tightly packed faces +X, −X, +Y, −Y, +Z, −Z).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecodedKey {
+    /// Face size in texels.
+    pub face_size: u32,
+    /// Radiance texels (the pack's format, RGB9E5 by default).
+    pub radiance: Vec<u8>,
+    /// Distance texels (R32F or R16F).
+    pub distance: Vec<u8>,
+    /// Object id texels (R32Uint or R16Uint).
+    pub object_id: Vec<u8>,
+    /// Normal texels, when the pack has them.
+    pub normal: Option<Vec<u8>>,
+}
+
+impl DecodedKey {
+    /// Bytes held.
+    pub fn bytes(&self) -> u64 {
+        (self.radiance.len()
+            + self.distance.len()
+            + self.object_id.len()
+            + self.normal.as_ref().map_or(0, Vec::len)) as u64
+    }
+}
+
+/// Reads and decodes one key: its radiance, distance, object-id (and normal) cubes to
+/// GPU-ready texel bytes. The error names the failing chunk.
+pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, (String, String)> {
+    let name = |kind: ChunkKind| format!("{kind:?} view {view} key {key}");
+    let read = |kind: ChunkKind| -> Result<Option<(u32, Vec<u8>)>, (String, String)> {
+        let Some(i) = pack.find(kind, view, key) else {
+            return Ok(None);
+        };
+        let fail = |e: plenoptic_pack::PackError| (name(kind), e.to_string());
+        let bytes = pack.chunk_bytes(i).map_err(fail)?;
+        let formats = match kind {
+            ChunkKind::RadianceCube => &range_image::RADIANCE_FORMATS[..],
+            ChunkKind::DistanceCube => &range_image::DISTANCE_FORMATS[..],
+            ChunkKind::ObjectIdCube => &range_image::OBJECT_ID_FORMATS[..],
+            _ => &range_image::NORMAL_FORMATS[..],
+        };
+        let (info, raw) = ktx::read_cube(&bytes, formats).map_err(fail)?;
+        Ok(Some((info.face_size, raw)))
+    };
+    let required =
+        |kind: ChunkKind| read(kind)?.ok_or_else(|| (name(kind), "not in the pack".to_string()));
+    let (face_size, radiance) = required(ChunkKind::RadianceCube)?;
+    let distance = required(ChunkKind::DistanceCube)?.1;
+    let object_id = required(ChunkKind::ObjectIdCube)?.1;
+    let normal = read(ChunkKind::NormalCube)?.map(|n| n.1);
+    Ok(DecodedKey {
+        face_size,
+        radiance,
+        distance,
+        object_id,
+        normal,
+    })
+}
+
+/// Bytes a key will occupy once decoded, from the directory (known before reading).
+pub fn key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
+    [
+        ChunkKind::RadianceCube,
+        ChunkKind::DistanceCube,
+        ChunkKind::ObjectIdCube,
+        ChunkKind::NormalCube,
+    ]
+    .into_iter()
+    .filter_map(|k| pack.find(k, view, key))
+    .map(|i| pack.entries()[i].uncompressed_length)
+    .sum()
+}
+
+/// A resident key.
+#[derive(Debug, Clone)]
+pub struct Resident {
+    /// Its texel bytes.
+    pub data: Arc<DecodedKey>,
+    /// Bytes reserved for it.
+    pub bytes: u64,
+    /// Frame it was last in a working set (LRU).
+    pub last_used: u64,
+    /// Its fixed-size slot (layer range in the cube-array textures).
+    pub slot: u32,
+}
+
+type DecodeResult = (Result<DecodedKey, (String, String)>, Duration);
+
+/// Resident and in-flight keys of every pack, keyed by (pack, view, key).
+#[derive(Resource, Default)]
+pub struct StreamCache {
+    /// Resident keys.
+    pub resident: HashMap<(AssetId<RadiancePack>, u32, u32), Resident>,
+    in_flight: HashMap<(AssetId<RadiancePack>, u32, u32), (u64, u32, Task<DecodeResult>)>,
+    failed: HashMap<(AssetId<RadiancePack>, u32, u32), String>,
+    frame: u64,
+    free_slots: Vec<u32>,
+    next_slot: u32,
+}
+
+impl StreamCache {
+    /// Resident plus reserved (in-flight) bytes.
+    pub fn committed_bytes(&self) -> u64 {
+        self.resident.values().map(|r| r.bytes).sum::<u64>()
+            + self.in_flight.values().map(|f| f.0).sum::<u64>()
+    }
+
+    /// The resident key `(view, key)` of `pack`.
+    pub fn get(&self, pack: AssetId<RadiancePack>, k: KeyRef) -> Option<&Resident> {
+        self.resident.get(&(pack, k.0, k.1))
+    }
+
+    fn alloc_slot(&mut self) -> u32 {
+        self.free_slots.pop().unwrap_or_else(|| {
+            self.next_slot += 1;
+            self.next_slot - 1
+        })
+    }
+}
+
+fn collect_finished(
+    mut cache: ResMut<StreamCache>,
+    mut stats: ResMut<StreamingStats>,
+    mut events: MessageWriter<PlenopticEvent>,
+    mut diagnostics: Diagnostics,
+) {
+    let frame = cache.frame;
+    let done: Vec<_> = cache
+        .in_flight
+        .iter_mut()
+        .filter_map(|(k, (_, _, task))| check_ready(task).map(|r| (*k, r)))
+        .collect();
+    let mut decode = Duration::ZERO;
+    for (k, (result, time)) in done {
+        let (bytes, slot, _) = cache.in_flight.remove(&k).expect("in flight");
+        decode += time;
+        match result {
+            Ok(data) => {
+                stats.decoded_keys += 1;
+                stats.decoded_bytes += data.bytes();
+                debug_assert!(data.bytes() <= bytes, "directory under-declared a key");
+                cache.resident.insert(
+                    k,
+                    Resident {
+                        data: Arc::new(data),
+                        bytes,
+                        last_used: frame,
+                        slot,
+                    },
+                );
+            }
+            Err((chunk, reason)) => {
+                warn!("plenoptic: chunk {chunk} failed: {reason}");
+                cache.free_slots.push(slot);
+                cache.failed.insert(k, reason.clone());
+                events.write(PlenopticEvent::ChunkFailed { chunk, reason });
+            }
+        }
+    }
+    stats.decode_time += decode;
+    diagnostics.add_measurement(&DECODE_MS, || decode.as_secs_f64() * 1e3);
+}
+
+/// Most reads in flight at once.
+const MAX_IN_FLIGHT: usize = 8;
+
+#[allow(clippy::too_many_arguments)]
+fn schedule_reads(
+    mut cache: ResMut<StreamCache>,
+    mut stats: ResMut<StreamingStats>,
+    settings: Res<PlenopticSettings>,
+    packs: Res<Assets<RadiancePack>>,
+    time: Res<Time>,
+    mut cameras: Query<(&PlenopticCamera, &mut StreamState, &GlobalTransform)>,
+    mut diagnostics: Diagnostics,
+) {
+    cache.frame += 1;
+    let frame = cache.frame;
+    let budget = settings.memory_budget_bytes;
+    let (mut hits, mut misses, mut stalled) = (0u64, 0u64, false);
+    let look = Lookahead {
+        views: settings.max_views.max(1),
+        seconds: settings.prefetch_seconds,
+    };
+    let mut wanted: Vec<(AssetId<RadiancePack>, Arc<PackReader>, KeyRef, bool)> = Vec::new();
+    for (cam, mut state, transform) in &mut cameras {
+        let Some(pack) = packs.get(&cam.pack) else {
+            continue;
+        };
+        let id = cam.pack.id();
+        let position = transform.translation();
+        let dt = time.delta_secs();
+        let velocity = match state.last_position {
+            Some(p) if dt > 0.0 => (position - p) / dt,
+            _ => Vec3::ZERO,
+        };
+        state.last_position = Some(position);
+        let speed = match cam.playback {
+            crate::Playback::Clock { speed, .. } => speed,
+            crate::Playback::Manual => 0.0,
+        };
+        let set = working_set(
+            pack.reader.manifest(),
+            position,
+            velocity,
+            cam.time,
+            speed,
+            look,
+        );
+        let mut complete = true;
+        for &k in &set.needed {
+            match cache.resident.get_mut(&(id, k.0, k.1)) {
+                Some(r) => {
+                    r.last_used = frame;
+                    hits += 1;
+                }
+                None => {
+                    misses += 1;
+                    complete = false;
+                }
+            }
+            wanted.push((id, pack.reader.clone(), k, true));
+        }
+        for &k in &set.prefetch {
+            if let Some(r) = cache.resident.get_mut(&(id, k.0, k.1)) {
+                r.last_used = frame;
+            }
+            wanted.push((id, pack.reader.clone(), k, false));
+        }
+        stalled |= !complete;
+        state.complete = complete;
+        state.working_set = set;
+    }
+    // Needed keys first, then prefetch, each in the camera's priority order.
+    wanted.sort_by_key(|w| !w.3);
+    let protected: Vec<_> = wanted.iter().map(|w| (w.0, w.2.0, w.2.1)).collect();
+    let pool = IoTaskPool::get();
+    for (id, reader, k, _) in wanted {
+        let key = (id, k.0, k.1);
+        if cache.in_flight.len() >= MAX_IN_FLIGHT {
+            break;
+        }
+        if cache.resident.contains_key(&key)
+            || cache.in_flight.contains_key(&key)
+            || cache.failed.contains_key(&key)
+        {
+            continue;
+        }
+        let bytes = key_bytes(&reader, k);
+        if bytes > budget {
+            continue;
+        }
+        // Evict least recently used keys outside every working set until it fits.
+        while cache.committed_bytes() + bytes > budget {
+            let victim = cache
+                .resident
+                .iter()
+                .filter(|(k, _)| !protected.contains(k))
+                .min_by_key(|(_, r)| r.last_used)
+                .map(|(k, _)| *k);
+            let Some(victim) = victim else { break };
+            let r = cache.resident.remove(&victim).expect("resident");
+            cache.free_slots.push(r.slot);
+            stats.evictions += 1;
+        }
+        if cache.committed_bytes() + bytes > budget {
+            continue;
+        }
+        let slot = cache.alloc_slot();
+        let task = pool.spawn(async move {
+            let start = Instant::now();
+            let r = decode_key(&reader, k);
+            (r, start.elapsed())
+        });
+        cache.in_flight.insert(key, (bytes, slot, task));
+    }
+    let committed = cache.committed_bytes();
+    debug_assert!(committed <= budget, "budget exceeded");
+    stats.resident_bytes = committed;
+    stats.peak_resident_bytes = stats.peak_resident_bytes.max(committed);
+    stats.hits += hits;
+    stats.misses += misses;
+    stats.stalls += stalled as u64;
+    diagnostics.add_measurement(&RESIDENT_BYTES, || committed as f64);
+    diagnostics.add_measurement(&HITS, || hits as f64);
+    diagnostics.add_measurement(&MISSES, || misses as f64);
+    diagnostics.add_measurement(&STALLS, || stalled as u8 as f64);
+}

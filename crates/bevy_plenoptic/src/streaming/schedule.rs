@@ -1,0 +1,141 @@
+//! The working set: which (base view, time key) pairs a camera needs now and which it will
+//! need soon. Pure functions over the manifest, unit-tested without a GPU.
+
+use bevy::math::Vec3;
+use plenoptic_pack::Manifest;
+
+/// One streamable unit: the cubes (radiance, distance, object id, normal) of base view
+/// `view` (index into the manifest's base views) at time key `key`.
+pub type KeyRef = (u32, u32);
+
+/// Indices of the `count` base views nearest `position`, nearest first.
+pub fn nearest_views(manifest: &Manifest, position: Vec3, count: usize) -> Vec<u32> {
+    let mut views: Vec<(f32, u32)> = manifest
+        .base_views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (v.position.distance_squared(position), i as u32))
+        .collect();
+    views.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    views.into_iter().take(count).map(|(_, i)| i).collect()
+}
+
+/// The time keys of `keys` bracketing `t`: the last key ≤ t and the first key ≥ t (one key
+/// where t falls on a key or outside the keys).
+pub fn bracketing_keys(keys: &[f32], t: f32) -> Vec<u32> {
+    if keys.is_empty() {
+        return Vec::new();
+    }
+    let after = keys.partition_point(|&k| k < t);
+    if after < keys.len() && keys[after] == t {
+        return vec![after as u32];
+    }
+    if after == 0 {
+        return vec![0];
+    }
+    if after == keys.len() {
+        return vec![keys.len() as u32 - 1];
+    }
+    vec![after as u32 - 1, after as u32]
+}
+
+/// What a camera needs, in priority order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WorkingSet {
+    /// Needed for this frame: a frame without one of these stalls.
+    pub needed: Vec<KeyRef>,
+    /// Wanted soon (along the camera's motion and the playback direction); loaded only when
+    /// the budget allows, never evicting needed data.
+    pub prefetch: Vec<KeyRef>,
+}
+
+/// Parameters of [`working_set`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lookahead {
+    /// Base views blended per frame.
+    pub views: usize,
+    /// Seconds ahead to prefetch.
+    pub seconds: f32,
+}
+
+/// The working set of a camera at `position` moving with `velocity` (m/s), at time `t`
+/// playing in direction `direction` (seconds of animation per second).
+pub fn working_set(
+    manifest: &Manifest,
+    position: Vec3,
+    velocity: Vec3,
+    t: f32,
+    direction: f32,
+    look: Lookahead,
+) -> WorkingSet {
+    let mut set = WorkingSet::default();
+    let push = |list: &mut Vec<KeyRef>, others: &[KeyRef], k: KeyRef| {
+        if !list.contains(&k) && !others.contains(&k) {
+            list.push(k);
+        }
+    };
+    for v in nearest_views(manifest, position, look.views) {
+        for k in bracketing_keys(&manifest.base_views[v as usize].time_keys, t) {
+            push(&mut set.needed, &[], (v, k));
+        }
+    }
+    let future_pos = position + velocity * look.seconds;
+    let future_t = t + direction * look.seconds;
+    for v in nearest_views(manifest, future_pos, look.views) {
+        let keys = &manifest.base_views[v as usize].time_keys;
+        let mut ks = bracketing_keys(keys, t);
+        ks.extend(bracketing_keys(keys, future_t));
+        for k in ks {
+            let needed = set.needed.clone();
+            push(&mut set.prefetch, &needed, (v, k));
+        }
+    }
+    set
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plenoptic_pack::{BaseView, TimeRange};
+
+    fn manifest() -> Manifest {
+        let mut m = Manifest::new(
+            TimeRange {
+                start: 0.0,
+                end: 2.0,
+            },
+            0.5,
+        );
+        m.base_views = (0..5)
+            .map(|i| BaseView {
+                id: i,
+                position: Vec3::new(i as f32, 0.0, 0.0),
+                time_keys: vec![0.0, 1.0, 2.0],
+            })
+            .collect();
+        m
+    }
+
+    #[test]
+    fn brackets() {
+        assert_eq!(bracketing_keys(&[0.0, 1.0, 2.0], 0.5), vec![0, 1]);
+        assert_eq!(bracketing_keys(&[0.0, 1.0, 2.0], 1.0), vec![1]);
+        assert_eq!(bracketing_keys(&[0.0, 1.0, 2.0], -1.0), vec![0]);
+        assert_eq!(bracketing_keys(&[0.0, 1.0, 2.0], 3.0), vec![2]);
+        assert!(bracketing_keys(&[], 3.0).is_empty());
+    }
+
+    #[test]
+    fn needed_and_prefetch() {
+        let m = manifest();
+        let look = Lookahead {
+            views: 2,
+            seconds: 1.0,
+        };
+        let s = working_set(&m, Vec3::new(0.1, 0.0, 0.0), Vec3::X * 3.0, 0.5, 1.0, look);
+        assert_eq!(s.needed, vec![(0, 0), (0, 1), (1, 0), (1, 1)]);
+        // Moving +x at 3 m/s: views 3 and 4 (near x = 3.1) are prefetched, at t = 0.5 and 1.5.
+        assert!(s.prefetch.contains(&(3, 1)) && s.prefetch.contains(&(3, 2)));
+        assert!(s.prefetch.iter().all(|k| !s.needed.contains(k)));
+    }
+}

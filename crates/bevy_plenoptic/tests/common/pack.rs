@@ -1,0 +1,389 @@
+//! (Copied from plenoptic_recon/tests/common.) Test pack builder: analytic scenes rendered with a deterministic shading function through
+//! `plenoptic_trace`'s accel, written with `PackWriter`. Shared by the tests and (via
+//! `#[path]`) the benchmark, so it uses only crates both can see.
+#![allow(dead_code, reason = "each test binary uses a part of it")]
+
+use std::path::Path;
+
+use plenoptic_pack::{
+    AnimationTracks, BaseView, CubeFormats, CubeImage, Interpolation, Manifest, Motion,
+    ObjectEntry, ObjectTracks, PackWriter, ProxyMesh, RangeImage, TimeRange, Track, ViewSpace,
+    VolumeSample, cube,
+};
+use plenoptic_scene::Scene;
+use plenoptic_trace::glam::{Quat, Vec2, Vec3};
+use plenoptic_trace::{Image, PlacedScene, Ray, SceneAccel, shapes};
+
+/// The point light of the shading function.
+pub const LIGHT: Vec3 = Vec3::new(0.3, 2.3, 0.2);
+
+/// A closed room 4 × 2.6 × 5 m with a static box and (optionally) a box sliding along x from
+/// t = 0 to t = 2. Scene object i has pack id i + 1.
+pub fn room(moving: bool) -> Scene {
+    let mut b = shapes::SceneBuilder::default();
+    let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
+    let wall = |b: &mut shapes::SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3| {
+        let rot = if n.dot(Vec3::Y) < -0.999 {
+            Quat::from_rotation_x(std::f32::consts::PI)
+        } else {
+            Quat::from_rotation_arc(Vec3::Y, n)
+        };
+        b.object_trs(
+            name,
+            shapes::quad(size),
+            m,
+            plenoptic_scene::Trs {
+                translation: pos,
+                rotation: rot,
+                scale: Vec3::ONE,
+            },
+        );
+    };
+    wall(&mut b, "floor", Vec2::new(4.0, 5.0), Vec3::ZERO, Vec3::Y);
+    wall(
+        &mut b,
+        "ceiling",
+        Vec2::new(4.0, 5.0),
+        Vec3::new(0.0, 2.6, 0.0),
+        -Vec3::Y,
+    );
+    wall(
+        &mut b,
+        "back",
+        Vec2::new(4.0, 2.6),
+        Vec3::new(0.0, 1.3, -2.5),
+        Vec3::Z,
+    );
+    wall(
+        &mut b,
+        "front",
+        Vec2::new(4.0, 2.6),
+        Vec3::new(0.0, 1.3, 2.5),
+        -Vec3::Z,
+    );
+    wall(
+        &mut b,
+        "left",
+        Vec2::new(2.6, 5.0),
+        Vec3::new(-2.0, 1.3, 0.0),
+        Vec3::X,
+    );
+    wall(
+        &mut b,
+        "right",
+        Vec2::new(2.6, 5.0),
+        Vec3::new(2.0, 1.3, 0.0),
+        -Vec3::X,
+    );
+    b.object(
+        "box",
+        shapes::cuboid(Vec3::splat(0.7)),
+        m,
+        Vec3::new(0.6, 0.35, -1.0),
+    );
+    b.object(
+        "pillar",
+        shapes::cuboid(Vec3::new(0.3, 1.6, 0.3)),
+        m,
+        Vec3::new(-0.9, 0.8, -0.6),
+    );
+    if moving {
+        let id = b.object(
+            "slider",
+            shapes::cuboid(Vec3::new(0.5, 0.5, 0.5)),
+            m,
+            Vec3::new(-1.2, 0.25, -0.2),
+        );
+        b.animate_translation(
+            id,
+            &[
+                (0.0, Vec3::new(-1.2, 0.25, -0.2)),
+                (2.0, Vec3::new(1.2, 0.25, -0.2)),
+            ],
+        );
+    }
+    // A light so that the reference path tracer (benchmark) sees the room lit like `shade`.
+    b.point_light(LIGHT, Vec3::ONE, 3.0);
+    b.build()
+}
+
+fn object_colour(id: u32) -> Vec3 {
+    let h = id.wrapping_mul(2654435761);
+    Vec3::new(
+        0.35 + 0.6 * ((h & 255) as f32 / 255.0),
+        0.35 + 0.6 * (((h >> 8) & 255) as f32 / 255.0),
+        0.35 + 0.6 * (((h >> 16) & 255) as f32 / 255.0),
+    )
+}
+
+/// Deterministic shading of a hit seen along `ray`: object colour × object-space checker ×
+/// (ambient + shadowed diffuse) + a view-dependent highlight.
+pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<(Vec3, f32, u32, Vec3)> {
+    let hit = placed.intersect(ray)?;
+    let local = placed
+        .object_transform(hit.object)
+        .inverse()
+        .transform_point3(hit.position);
+    let c = ((local * 4.0).floor().dot(Vec3::ONE) as i32).rem_euclid(2) as f32;
+    let albedo = object_colour(hit.object) * (0.6 + 0.4 * c);
+    let mut n = hit.geometric_normal.normalize();
+    if n.dot(ray.direction) > 0.0 {
+        n = -n;
+    }
+    let to_light = LIGHT - hit.position;
+    let dl = to_light.length();
+    let l = to_light / dl;
+    let lit = !placed.segment_occluded(hit.offset_origin(l), LIGHT);
+    let diffuse = if lit {
+        n.dot(l).max(0.0) * 3.0 / (dl * dl)
+    } else {
+        0.0
+    };
+    let refl = (2.0 * n.dot(l) * n - l).normalize();
+    let spec = if lit {
+        refl.dot(-ray.direction).max(0.0).powi(12) * 0.6
+    } else {
+        0.0
+    };
+    Some((
+        albedo * (0.15 + diffuse) + Vec3::splat(spec),
+        hit.distance,
+        hit.object + 1,
+        n,
+    ))
+}
+
+/// Range image of face size `n` from `position` with the scene placed at `placed`.
+pub fn range_image(placed: &PlacedScene<'_>, position: Vec3, n: u32) -> RangeImage {
+    let img = Image::render(n, 6 * n, |x, y| {
+        let i = (y * n + x) as usize;
+        let dir = cube::texel_direction(n, i);
+        shade(placed, &Ray::new(position, dir))
+    });
+    let mut r = RangeImage::new(n);
+    for (i, s) in img.pixels.into_iter().enumerate() {
+        if let Some((c, d, o, nn)) = s {
+            r.radiance.texels[i] = c;
+            r.distance.texels[i] = d;
+            r.object_id.texels[i] = o;
+            r.normal.texels[i] = nn;
+        }
+    }
+    r
+}
+
+/// The reference image of a pinhole camera (1 ray per pixel centre, same shading).
+pub fn reference(placed: &PlacedScene<'_>, camera: &plenoptic_recon::Camera) -> Image<Vec3> {
+    let b = camera.basis();
+    Image::render(camera.width, camera.height, |x, y| {
+        let dir = b.direction(x as f32 + 0.5, y as f32 + 0.5);
+        shade(placed, &Ray::new(camera.position, dir)).map_or(Vec3::ZERO, |s| s.0)
+    })
+}
+
+/// What to put in a test pack.
+#[derive(Clone, Debug)]
+pub struct PackSpec {
+    /// Base view positions.
+    pub views: Vec<Vec3>,
+    /// Time keys (the same for every view).
+    pub keys: Vec<f32>,
+    /// Cube face size.
+    pub face: u32,
+    /// Temporal-volume samples per view and bucket (0: none).
+    pub volume_samples: usize,
+    /// Time range.
+    pub time: (f32, f32),
+    /// Bucket span.
+    pub bucket: f32,
+    /// (view, key) pairs to leave out.
+    pub skip: Vec<(usize, usize)>,
+}
+
+impl PackSpec {
+    /// `count` base views evenly along the segment from (−1, 1.3, 1) to (1, 1.3, 1).
+    pub fn segment(count: usize, keys: Vec<f32>, face: u32) -> Self {
+        let (a, b) = segment_ends();
+        let views = (0..count)
+            .map(|i| {
+                a.lerp(
+                    b,
+                    if count > 1 {
+                        i as f32 / (count - 1) as f32
+                    } else {
+                        0.5
+                    },
+                )
+            })
+            .collect();
+        PackSpec {
+            views,
+            keys,
+            face,
+            volume_samples: 0,
+            time: (0.0, 2.0),
+            bucket: 0.25,
+            skip: Vec::new(),
+        }
+    }
+}
+
+/// Ends of the test view-space segment.
+pub fn segment_ends() -> (Vec3, Vec3) {
+    (Vec3::new(-1.0, 1.3, 1.0), Vec3::new(1.0, 1.3, 1.0))
+}
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+    }
+}
+
+/// Writes a pack of `scene` per `spec` to `path`.
+pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
+    let accel = SceneAccel::new(scene).unwrap();
+    let mut w = PackWriter::create(path).unwrap();
+    let placed: Vec<PlacedScene<'_>> = spec.keys.iter().map(|&t| accel.at_time(t)).collect();
+    for (v, &pos) in spec.views.iter().enumerate() {
+        for (k, p) in placed.iter().enumerate() {
+            if spec.skip.contains(&(v, k)) {
+                continue;
+            }
+            w.add_range_image(
+                v as u32,
+                k as u32,
+                &range_image(p, pos, spec.face),
+                CubeFormats::default(),
+            )
+            .unwrap();
+        }
+    }
+    let mut manifest = Manifest::new(
+        TimeRange {
+            start: spec.time.0,
+            end: spec.time.1,
+        },
+        spec.bucket,
+    );
+    if spec.volume_samples > 0 {
+        let mut rng = Lcg(7);
+        for (v, &pos) in spec.views.iter().enumerate() {
+            for bucket in 0..manifest.bucket_count() {
+                let (t0, t1) = manifest.bucket_range(bucket);
+                let m = spec.volume_samples;
+                let times: Vec<f32> = (0..m).map(|_| t0 + (t1 - t0) * rng.next()).collect();
+                let dirs: Vec<Vec3> = (0..m)
+                    .map(|_| {
+                        let z = 2.0 * rng.next() - 1.0;
+                        let phi = std::f32::consts::TAU * rng.next();
+                        let r = (1.0 - z * z).max(0.0).sqrt();
+                        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+                    })
+                    .collect();
+                let radius = (4.0 * std::f32::consts::PI / m as f32).sqrt();
+                let samples: Vec<VolumeSample> = (0..m)
+                    .filter_map(|i| {
+                        let p = accel.at_time(times[i]);
+                        shade(&p, &Ray::new(pos, dirs[i])).map(|(c, d, o, n)| VolumeSample {
+                            direction: dirs[i],
+                            t: times[i],
+                            radiance: c,
+                            distance: d,
+                            normal: n,
+                            object_id: o,
+                            radius,
+                        })
+                    })
+                    .collect();
+                w.add_volume_block(v as u32, bucket, (t0, t1), &samples, None)
+                    .unwrap();
+            }
+        }
+    }
+    let mut tracks = AnimationTracks::default();
+    for (i, obj) in scene.objects.iter().enumerate() {
+        let id = i as u32 + 1;
+        let animated = scene.object_is_animated(i as u32);
+        let mesh = &scene.meshes[obj.mesh];
+        let to_world = scene.object_transform(i as u32, 0.0);
+        let positions = if animated {
+            mesh.positions.clone()
+        } else {
+            mesh.positions
+                .iter()
+                .map(|&p| to_world.transform_point3(p))
+                .collect()
+        };
+        w.add_proxy_mesh(&ProxyMesh {
+            object_id: id,
+            positions,
+            indices: mesh.triangles.iter().flatten().copied().collect(),
+            normals: None,
+        })
+        .unwrap();
+        if animated {
+            let track = scene.nodes[obj.node]
+                .track
+                .as_ref()
+                .unwrap()
+                .translation
+                .as_ref()
+                .unwrap();
+            tracks.objects.push(ObjectTracks {
+                object_id: id,
+                translation: Some(Track {
+                    interpolation: Interpolation::Linear,
+                    times: track.keys.iter().map(|k| k.time).collect(),
+                    values: track.keys.iter().map(|k| k.value).collect(),
+                }),
+                rotation: None,
+                scale: None,
+            });
+        }
+        manifest.objects.push(ObjectEntry {
+            id,
+            name: obj.name.clone(),
+            node_path: obj.node_path.clone(),
+            motion: if animated {
+                Motion::Animated
+            } else {
+                Motion::Static
+            },
+            proxy_mesh: Some(id),
+        });
+    }
+    w.add_tracks(&tracks).unwrap();
+    let (a, b) = segment_ends();
+    manifest.view_space = ViewSpace::Segment { a, b };
+    manifest.base_views = spec
+        .views
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| BaseView {
+            id: i as u32,
+            position: p,
+            time_keys: spec.keys.clone(),
+        })
+        .collect();
+    manifest.bake.cube_face_size = spec.face;
+    w.finish(&manifest).unwrap();
+}
+
+/// The cube image `cube` sampled (nearest) along every pixel direction of `camera`.
+pub fn sample_cube(cube: &CubeImage<Vec3>, camera: &plenoptic_recon::Camera) -> Vec<Vec3> {
+    let b = camera.basis();
+    (0..camera.pixel_count())
+        .map(|j| {
+            let (x, y) = (
+                (j % camera.width as usize) as f32 + 0.5,
+                (j / camera.width as usize) as f32 + 0.5,
+            );
+            *cube.lookup(b.direction(x, y)).unwrap()
+        })
+        .collect()
+}
