@@ -28,7 +28,13 @@ fn room(view: Vec3, phase: f32) -> RangeImage {
         let hi = (half - view) / d;
         let exit = lo.max(hi);
         let t = exit.min_element();
-        let axis = if exit.x == t { 0 } else if exit.y == t { 1 } else { 2 };
+        let axis = if exit.x == t {
+            0
+        } else if exit.y == t {
+            1
+        } else {
+            2
+        };
         let mut normal = Vec3::ZERO;
         normal[axis] = -d[axis].signum();
         let mut id = 1 + axis as u32 * 2 + (d[axis] > 0.0) as u32;
@@ -75,7 +81,13 @@ struct Fixture {
 }
 
 fn fixture() -> Fixture {
-    let mut manifest = Manifest::new(TimeRange { start: 0.0, end: 2.0 }, 0.5);
+    let mut manifest = Manifest::new(
+        TimeRange {
+            start: 0.0,
+            end: 2.0,
+        },
+        0.5,
+    );
     let mut images = Vec::new();
     let mut blocks = Vec::new();
     for v in 0..VIEWS {
@@ -127,10 +139,12 @@ fn fixture() -> Fixture {
 fn write(f: &Fixture, path: &std::path::Path) -> u64 {
     let mut w = PackWriter::create(path).unwrap();
     for (v, k, img) in &f.images {
-        w.add_range_image(*v, *k, img, CubeFormats::default()).unwrap();
+        w.add_range_image(*v, *k, img, CubeFormats::default())
+            .unwrap();
     }
     for (v, samples, tets) in &f.blocks {
-        w.add_volume_block(*v, 0, (0.0, 0.5), samples, Some(tets)).unwrap();
+        w.add_volume_block(*v, 0, (0.0, 0.5), samples, Some(tets))
+            .unwrap();
     }
     let uncompressed = w.entries().iter().map(|e| e.uncompressed_length).sum();
     w.finish(&f.manifest).unwrap();
@@ -139,7 +153,9 @@ fn write(f: &Fixture, path: &std::path::Path) -> u64 {
 
 fn read_all(path: &std::path::Path) -> usize {
     let r = PackReader::open(path).unwrap();
-    (0..r.entries().len()).map(|i| r.chunk(i).is_ok() as usize).sum()
+    (0..r.entries().len())
+        .map(|i| r.chunk(i).is_ok() as usize)
+        .sum()
 }
 
 fn pack_io(c: &mut Criterion) {
@@ -150,9 +166,12 @@ fn pack_io(c: &mut Criterion) {
     let stored = std::fs::metadata(&path).unwrap().len();
     let r = PackReader::open(&path).unwrap();
     let by_kind = |kind: ChunkKind| {
-        r.entries().iter().filter(|e| e.kind == kind).fold((0u64, 0u64), |a, e| {
-            (a.0 + e.uncompressed_length, a.1 + e.length)
-        })
+        r.entries()
+            .iter()
+            .filter(|e| e.kind == kind)
+            .fold((0u64, 0u64), |a, e| {
+                (a.0 + e.uncompressed_length, a.1 + e.length)
+            })
     };
     println!(
         "pack_io: {} chunks, {:.2} MB uncompressed, {:.2} MB on disk, compression ratio {:.2}:1",

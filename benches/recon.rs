@@ -21,7 +21,15 @@ const T: f32 = 0.75;
 const PATH_SPP: u32 = 4;
 
 fn camera(w: u32, h: u32) -> Camera {
-    Camera::look_at(Vec3::new(0.1, 1.3, 1.2), Vec3::new(0.0, 0.6, -2.0), Vec3::Y, 1.1, w, h).unwrap()
+    Camera::look_at(
+        Vec3::new(0.1, 1.3, 1.2),
+        Vec3::new(0.0, 0.6, -2.0),
+        Vec3::Y,
+        1.1,
+        w,
+        h,
+    )
+    .unwrap()
 }
 
 fn bench(c: &mut Criterion) {
@@ -44,7 +52,10 @@ fn bench(c: &mut Criterion) {
         }
     }
     let accel = SceneAccel::new(&scene).unwrap();
-    let tracer = PathTracer::new(PathTracerSettings { samples_per_pixel: PATH_SPP, ..PathTracerSettings::default() });
+    let tracer = PathTracer::new(PathTracerSettings {
+        samples_per_pixel: PATH_SPP,
+        ..PathTracerSettings::default()
+    });
     let pin = camera(640, 360).to_pinhole().unwrap();
     group.bench_function(format!("path_tracer_{PATH_SPP}spp/640x360"), |b| {
         b.iter(|| {
