@@ -42,6 +42,7 @@
 pub mod asset;
 pub mod camera;
 pub mod proxy;
+pub mod reconstruct;
 pub mod streaming;
 
 use bevy::asset::io::file::FileAssetReader;
@@ -81,6 +82,7 @@ impl Plugin for PlenopticPlugin {
                 camera::PlenopticCameraPlugin,
                 proxy::PlenopticProxyPlugin,
                 streaming::PlenopticStreamingPlugin,
+                reconstruct::PlenopticReconstructPlugin,
             ));
     }
 }

@@ -24,6 +24,11 @@ fn shows_scene(p: [u8; 4]) -> bool {
     p[3] == 255 && p[0] < 200
 }
 
+/// The unlit green of the Bevy cubes.
+fn is_green(p: [u8; 4]) -> bool {
+    p[1] > 240 && p[0] < 15 && p[2] < 15
+}
+
 fn green_cube(app: &mut App, at: Vec3) {
     let world = app.world_mut();
     let mesh = world
@@ -73,11 +78,11 @@ fn centre_with_cube(cube: Vec3) -> [u8; 4] {
             && [(1, 1), (WIDTH - 2, HEIGHT - 2), (WIDTH / 2, HEIGHT / 2)]
                 .iter()
                 .all(|&(x, y)| shows_scene(pixel(d, x, y)))
-            && pixel(d, 12, HEIGHT / 2)[1] > 240
+            && is_green(pixel(d, 12, HEIGHT / 2))
     });
     let corner = pixel(&data, 1, 1);
     assert!(
-        (100..156).contains(&corner[0]) && corner[0].abs_diff(corner[1]) <= 1,
+        shows_scene(corner) && corner[1] < 240,
         "proxy wall {corner:?}"
     );
     pixel(&data, WIDTH / 2, HEIGHT / 2)
@@ -86,7 +91,7 @@ fn centre_with_cube(cube: Vec3) -> [u8; 4] {
 #[test]
 fn bevy_mesh_in_front_of_baked_geometry_is_visible() {
     let centre = centre_with_cube(Vec3::new(0.0, 1.3, -0.5));
-    assert!(centre[1] > 240 && centre[0] < 15, "centre {centre:?}");
+    assert!(is_green(centre), "centre {centre:?}");
 }
 
 #[test]
@@ -94,7 +99,7 @@ fn bevy_mesh_behind_baked_geometry_is_hidden() {
     // Behind the back wall (z = −2.5): the wall's depth hides it.
     let centre = centre_with_cube(Vec3::new(0.0, 1.3, -3.2));
     assert!(
-        centre[1] < 200 && centre[0].abs_diff(centre[1]) <= 1,
+        shows_scene(centre) && !is_green(centre),
         "centre {centre:?}"
     );
 }
@@ -166,5 +171,132 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
     assert!(
         (slider.translation - Vec3::new(1.2, 0.25, -0.2)).length() < 1e-4,
         "{slider:?}"
+    );
+}
+
+/// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
+/// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
+/// camera and time.
+#[test]
+fn gpu_frame_matches_cpu_reconstruction() {
+    use bevy::camera::Hdr;
+    use bevy::render::render_resource::{TextureFormat, TextureUsages};
+    use plenoptic_recon::{Mode, Reconstructor};
+    use std::cell::RefCell;
+
+    let dir = tempfile::tempdir().unwrap();
+    room_pack(dir.path(), 3);
+    let (eye, t) = (Vec3::new(0.3, 1.3, 1.0), 0.7);
+    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y);
+
+    // CPU reference.
+    let rec = Reconstructor::open(dir.path().join("room.pack")).unwrap();
+    let cam = plenoptic_recon::Camera::new(
+        eye,
+        transform.rotation,
+        std::f32::consts::FRAC_PI_4,
+        WIDTH,
+        HEIGHT,
+    )
+    .unwrap();
+    let (cpu, report) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    eprintln!("CPU frame: {:?}", report.fallback);
+
+    // GPU.
+    let mut app = headless_app_in(dir.path());
+    let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
+    let image = {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
+        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        images.add(img)
+    };
+    app.world_mut().spawn((
+        camera_into(image.clone(), transform),
+        Hdr,
+        PlenopticCamera {
+            playback: Playback::Manual,
+            time: t,
+            ..PlenopticCamera::new(handle)
+        },
+    ));
+    let decode = |d: &[u8]| -> Vec<Vec3> {
+        d.chunks_exact(8)
+            .map(|p| {
+                let h = |i: usize| half::f16::from_le_bytes([p[i], p[i + 1]]).to_f32();
+                Vec3::new(h(0), h(2), h(4))
+            })
+            .collect()
+    };
+    // Ready when the frame is stable (streaming done, material uploaded) and the red clear
+    // colour is gone.
+    let cam_entity = {
+        let mut q = app
+            .world_mut()
+            .query_filtered::<Entity, With<PlenopticCamera>>();
+        q.single(app.world()).unwrap()
+    };
+    for _ in 0..500 {
+        app.update();
+        if app.world().get::<StreamState>(cam_entity).unwrap().complete {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(app.world().get::<StreamState>(cam_entity).unwrap().complete);
+    let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
+    let data = render_until(&mut app, image, 600, |d| {
+        let px = decode(d);
+        let shown = px.len() == (WIDTH * HEIGHT) as usize
+            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
+            && px.iter().any(|c| c.max_element() > 0.01);
+        let stable = prev.borrow().as_deref() == Some(d);
+        *prev.borrow_mut() = Some(d.to_vec());
+        shown && stable
+    });
+    let gpu = decode(&data);
+
+    // Error per pixel: the largest channel's |gpu − cpu| / (cpu + 0.02).
+    let (mut sum, mut within, mut within20, mut n) = (0.0f32, 0, 0, 0);
+    for (g, c) in gpu.iter().zip(&cpu.radiance) {
+        let err = ((*g - *c).abs() / (c.abs() + Vec3::splat(0.02))).max_element();
+        sum += err;
+        within += (err < 0.05) as usize;
+        within20 += (err < 0.2) as usize;
+        n += 1;
+    }
+    let mean = sum / n as f32;
+    for y in 0..HEIGHT as usize {
+        let row: String = (0..WIDTH as usize)
+            .map(|x| {
+                let j = y * WIDTH as usize + x;
+                let e = ((gpu[j] - cpu.radiance[j]).abs()
+                    / (cpu.radiance[j].abs() + Vec3::splat(0.02)))
+                .max_element();
+                if e < 0.05 {
+                    '.'
+                } else if e < 0.2 {
+                    'o'
+                } else {
+                    '#'
+                }
+            })
+            .collect();
+        eprintln!("{row}");
+    }
+    let frac = within as f32 / n as f32;
+    let frac20 = within20 as f32 / n as f32;
+    eprintln!(
+        "GPU vs CPU: mean relative error {mean:.4}, {:.1}% within 5%, {:.1}% within 20%",
+        100.0 * frac,
+        100.0 * frac20
+    );
+    // Measured on lavapipe: mean 0.16, 71 % within 5 %. The GPU path has no same-object hole
+    // fill (the CPU fills 15 % of this frame that way; the GPU shows the heaviest view's
+    // texel there), and silhouettes can differ by a pixel between rasterisation and the CPU
+    // mask. The error map above ('.' < 5 %, 'o' < 20 %, '#' worse) shows where.
+    assert!(
+        mean < 0.2 && frac > 0.65 && frac20 > 0.8,
+        "mean {mean}, within 5 %: {frac}, within 20 %: {frac20}"
     );
 }
