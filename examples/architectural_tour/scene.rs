@@ -263,7 +263,7 @@ pub fn build() -> SceneBuilder {
     let steel = b.add_material(MaterialDesc::metal(Vec3::splat(0.6), 0.4).named("steel"));
     let lamp_shade = b.add_material(
         MaterialDesc::diffuse(Vec3::splat(0.9))
-            .emissive(Vec3::new(1.0, 0.85, 0.6), 4.0)
+            .emissive(Vec3::new(1.0, 0.85, 0.6), 0.6)
             .named("lamp_shade"),
     );
 
@@ -606,7 +606,8 @@ pub fn build() -> SceneBuilder {
             .translation(Vec3::new(0.0, 0.85, 0.0)),
     );
 
-    // --- Room B: glass vitrine, shelves, table, lamp, cart, sliding door.
+    // --- Room B: glass vitrine, shelves, table, lamp, cart, sliding door. The lamp is faint
+    // (1.5 cd against the sun's 6 lx-like units) so that daylight dominates the tour.
     b.add_object(
         "RoomB_Plinth",
         shapes::cuboid(Vec3::new(1.2, 0.8, 1.2)),
@@ -648,7 +649,7 @@ pub fn build() -> SceneBuilder {
     b.add_node(
         NodeDesc::new("RoomB_Lamp_Light")
             .translation(Vec3::new(9.0, 1.3, 3.0))
-            .light(LightDesc::point(Vec3::new(1.0, 0.85, 0.6), 60.0).named("RoomB_Lamp_Light")),
+            .light(LightDesc::point(Vec3::new(1.0, 0.85, 0.6), 1.5).named("RoomB_Lamp_Light")),
     );
     let cart = {
         let mut c = Compound::default();
