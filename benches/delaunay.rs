@@ -1,4 +1,4 @@
-//! Throughput of the (x, y, t) Delaunay complex (`plenoptic_bake::delaunay3::tetrahedralize`),
+//! Throughput of the (x, y, t) Delaunay complex (`plenoptic_recon::delaunay3::tetrahedralize`),
 //! in points per second: 10k and 50k uniform random points (a temporal volume holds up to ~50k
 //! samples), and 10k points on a jittered grid (near-degenerate, like regularly spaced samples).
 //! Also slicing a 50k-point complex at one time.
@@ -8,7 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use plenoptic_bake::delaunay3::{slice_at, tetrahedralize};
+use plenoptic_recon::delaunay3::{slice_at, tetrahedralize};
 
 /// Tiny deterministic PRNG (splitmix64), uniform in [0, 1).
 fn uniform(state: &mut u64) -> f64 {

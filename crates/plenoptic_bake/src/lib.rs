@@ -18,7 +18,8 @@
 //!   assembled in a canonical order.
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
 //! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA.
-//! - [`delaunay3`]: the 3D Delaunay complex (x, y, t) of temporal volumes.
+//! - [`delaunay3`]: the 3D Delaunay complex (x, y, t) of temporal volumes (a re-export of
+//!   [`plenoptic_recon::delaunay3`], which also slices it at reconstruction).
 //!
 //! The `plenoptic` command (`src/main.rs`) exposes `plan`, `bake` (`--resume`,
 //! `--shard i/N`, `--volume-complex`), `merge`, `inspect`, `reference` (path-traced frames
@@ -79,7 +80,6 @@
 //! ```
 
 pub mod bake;
-pub mod delaunay3;
 pub mod error;
 pub mod input;
 pub mod plan;
@@ -88,6 +88,8 @@ pub mod render;
 pub mod volume;
 pub mod work;
 pub mod write;
+
+pub use plenoptic_recon::delaunay3;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_recipe, merge, merge_recipe};
 pub use error::{BakeError, Result};

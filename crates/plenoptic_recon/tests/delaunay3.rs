@@ -1,7 +1,7 @@
 //! Tests of the (x, y, t) Delaunay complex: validity (exact empty-circumsphere check),
 //! degenerate inputs, hull coverage, slicing and determinism.
 
-use plenoptic_bake::delaunay3::{
+use plenoptic_recon::delaunay3::{
     DelaunayError, SliceTriangle, Tetrahedralization, signed_volume, slice_at, tetrahedralize,
     validate,
 };
