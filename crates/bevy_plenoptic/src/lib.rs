@@ -50,11 +50,12 @@ use bevy::prelude::*;
 
 pub use asset::{RadiancePack, RadiancePackLoader};
 pub use camera::{Playback, PlenopticCamera, ReconMode};
+pub use reconstruct::cpu;
 
 /// The usual imports.
 pub mod prelude {
     pub use crate::{
-        Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin, PlenopticSettings,
+        Backend, Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin, PlenopticSettings,
         PlenopticSystems, RadiancePack, ReconMode,
     };
 }
@@ -83,6 +84,7 @@ impl Plugin for PlenopticPlugin {
                 proxy::PlenopticProxyPlugin,
                 streaming::PlenopticStreamingPlugin,
                 reconstruct::PlenopticReconstructPlugin,
+                reconstruct::cpu::PlenopticCpuPlugin,
             ));
     }
 }
@@ -99,6 +101,23 @@ pub struct PlenopticSettings {
     /// How far ahead, in seconds, to prefetch along the camera's velocity and the playback
     /// direction. Longer hides more latency but spends budget on data that may not be used.
     pub prefetch_seconds: f32,
+    /// Where frames are reconstructed. Read when a pack's proxy geometry is first shown.
+    pub backend: Backend,
+}
+
+/// Where frames are reconstructed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Backend {
+    /// The WGSL material on the proxy meshes (per-fragment lookups; cost scales with the
+    /// covered pixels × base views × 2 keys).
+    Gpu,
+    /// `plenoptic_recon`'s CPU reconstructor on a worker thread, its frame shown through the
+    /// proxy meshes (screen-space texture; depth still from the rasterised proxies). Far
+    /// slower; a frame lags the camera while it is computed. The reference to compare with.
+    Cpu,
+    /// The GPU unless the device lacks what it needs (then the CPU, with a warning).
+    #[default]
+    Auto,
 }
 
 impl Default for PlenopticSettings {
@@ -107,6 +126,7 @@ impl Default for PlenopticSettings {
             memory_budget_bytes: 256 * 1024 * 1024,
             max_views: 4,
             prefetch_seconds: 0.5,
+            backend: Backend::Auto,
         }
     }
 }

@@ -177,8 +177,9 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
 /// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
 /// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
 /// camera and time.
-#[test]
-fn gpu_frame_matches_cpu_reconstruction() {
+/// Renders the 3-view room at t = 0.7 with `backend` into an Rgba16Float target; returns
+/// (plugin frame, plenoptic_recon's CPU frame) as linear radiance.
+fn plugin_and_cpu_frames(backend: Backend) -> (Vec<Vec3>, Vec<Vec3>) {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::{Mode, Reconstructor};
@@ -204,6 +205,7 @@ fn gpu_frame_matches_cpu_reconstruction() {
 
     // GPU.
     let mut app = headless_app_in(dir.path());
+    app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
     let image = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
@@ -256,6 +258,13 @@ fn gpu_frame_matches_cpu_reconstruction() {
     });
     let gpu = decode(&data);
 
+    (gpu, cpu.radiance)
+}
+
+#[test]
+fn gpu_frame_matches_cpu_reconstruction() {
+    let (gpu, cpu) = plugin_and_cpu_frames(Backend::Gpu);
+    let cpu = Frame { radiance: cpu };
     // Error per pixel: the largest channel's |gpu − cpu| / (cpu + 0.02).
     let (mut sum, mut within, mut within20, mut n) = (0.0f32, 0, 0, 0);
     for (g, c) in gpu.iter().zip(&cpu.radiance) {
@@ -299,4 +308,23 @@ fn gpu_frame_matches_cpu_reconstruction() {
         mean < 0.2 && frac > 0.65 && frac20 > 0.8,
         "mean {mean}, within 5 %: {frac}, within 20 %: {frac20}"
     );
+}
+
+/// The CPU backend shows plenoptic_recon's frame itself (through the proxies, in screen
+/// space): equal up to the f16 target's rounding.
+#[test]
+fn cpu_backend_shows_the_cpu_frame() {
+    let (shown, cpu) = plugin_and_cpu_frames(Backend::Cpu);
+    let within = shown
+        .iter()
+        .zip(&cpu)
+        .filter(|(g, c)| ((**g - **c).abs() / (c.abs() + Vec3::splat(0.02))).max_element() < 0.01)
+        .count() as f32
+        / cpu.len() as f32;
+    eprintln!("CPU backend vs CPU frame: {:.1}% within 1%", 100.0 * within);
+    assert!(within > 0.97, "{within}");
+}
+
+struct Frame {
+    radiance: Vec<Vec3>,
 }

@@ -62,9 +62,9 @@ impl AssetLoader for RadiancePackLoader {
             .as_ref()
             .map(|root| root.join(load_context.path().path()))
             .filter(|p| p.is_file());
-        let pack = match file {
+        let pack = match &file {
             // Random access: only header, manifest and directory are read now.
-            Some(path) => PackReader::open(&path),
+            Some(path) => PackReader::open(path),
             None => {
                 let mut bytes = Vec::new();
                 reader.read_to_end(&mut bytes).await.map_err(|source| {
@@ -130,6 +130,7 @@ impl AssetLoader for RadiancePackLoader {
             reader: Arc::new(pack),
             proxies,
             failed,
+            file,
         })
     }
 

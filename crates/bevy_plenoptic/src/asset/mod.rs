@@ -32,6 +32,9 @@ pub struct RadiancePack {
     /// Chunks that could not be read while loading (a proxy mesh or the tracks), with the
     /// reason. Reported once as [`crate::PlenopticEvent::ChunkFailed`].
     pub failed: Vec<(String, String)>,
+    /// The pack's file, when it was opened from the file system (the CPU backend opens its own
+    /// reader on it).
+    pub file: Option<std::path::PathBuf>,
 }
 
 impl std::fmt::Debug for RadiancePack {

@@ -15,6 +15,8 @@
 //! volume fallback and the same-object hole fill (pixels without an accepted lookup take the
 //! heaviest view's texel, `plenoptic_recon`'s "background" fallback).
 
+pub mod cpu;
+
 use std::collections::HashMap;
 
 use bevy::asset::{RenderAssetUsages, embedded_asset};
@@ -30,7 +32,7 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::streaming::{StreamCache, key_bytes};
-use crate::{PlenopticSettings, PlenopticSystems};
+use crate::{Backend, PlenopticSettings, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
@@ -46,12 +48,58 @@ impl Plugin for PlenopticReconstructPlugin {
         embedded_asset!(app, "geometry.wgsl");
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<KeyTextures>()
+            .init_resource::<ResolvedBackend>()
+            .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
                 (attach_materials, upload_keys, update_materials)
                     .chain()
                     .after(PlenopticSystems::Streaming),
             );
+    }
+
+    fn finish(&self, app: &mut App) {
+        // Like bevy_solari: check the device once; a missing capability is a warning and the
+        // CPU backend, never a panic.
+        let layers = app
+            .get_sub_app(bevy::render::RenderApp)
+            .and_then(|r| {
+                r.world()
+                    .get_resource::<bevy::render::renderer::RenderDevice>()
+            })
+            .map(|d| d.limits().max_texture_array_layers);
+        let supported = layers.is_some_and(|l| l >= 6);
+        if !supported {
+            warn!(
+                "plenoptic: the GPU reconstruction needs 2D array textures of at least 6 layers \
+                 (device: {layers:?}); Backend::Auto uses the CPU backend"
+            );
+        }
+        app.insert_resource(GpuSupport(supported));
+    }
+}
+
+/// Whether the device supports the GPU reconstruction (decided in `Plugin::finish`).
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct GpuSupport(pub bool);
+
+/// The backend in use: [`PlenopticSettings::backend`] with `Auto` resolved.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ResolvedBackend(pub Backend);
+
+fn resolve_backend(
+    settings: Res<PlenopticSettings>,
+    support: Option<Res<GpuSupport>>,
+    mut resolved: ResMut<ResolvedBackend>,
+) {
+    let gpu = support.is_some_and(|s| s.0);
+    let b = match settings.backend {
+        Backend::Auto if gpu => Backend::Gpu,
+        Backend::Auto => Backend::Cpu,
+        b => b,
+    };
+    if resolved.0 != b {
+        resolved.0 = b;
     }
 }
 
@@ -106,11 +154,15 @@ pub struct KeyTexture {
 
 fn attach_materials(
     mut commands: Commands,
+    backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
 ) {
+    if backend.0 != Backend::Gpu {
+        return;
+    }
     for (entity, parent, _) in &proxies {
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;

@@ -1,0 +1,216 @@
+//! The CPU backend ([`crate::Backend::Cpu`]): `plenoptic_recon`'s [`Reconstructor`] renders
+//! each frame on the async compute pool (never on the main thread); the finished frame is
+//! copied into an `Rgba32Float` image that the proxy meshes show in screen space
+//! (`cpu.wgsl`), so depth compositing with Bevy meshes is the same as on the GPU path. The
+//! image lags the camera by the time a frame takes.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use bevy::asset::{RenderAssetUsages, embedded_asset};
+use bevy::prelude::*;
+use bevy::render::render_resource::{AsBindGroup, Extent3d, TextureDimension, TextureFormat};
+use bevy::shader::ShaderRef;
+use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
+use plenoptic_recon::{Camera as ReconCamera, Frame, Reconstructor};
+
+use super::ResolvedBackend;
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::{Backend, PlenopticEvent, PlenopticSystems};
+
+/// Adds the CPU backend.
+#[derive(Debug, Default)]
+pub struct PlenopticCpuPlugin;
+
+impl Plugin for PlenopticCpuPlugin {
+    fn build(&self, app: &mut App) {
+        embedded_asset!(app, "cpu.wgsl");
+        app.add_plugins(MaterialPlugin::<CpuFrameMaterial>::default())
+            .init_resource::<CpuFrames>()
+            .add_systems(
+                Update,
+                (attach_cpu_materials, run_cpu_frames)
+                    .chain()
+                    .after(PlenopticSystems::Streaming),
+            );
+    }
+}
+
+/// Proxy material of the CPU backend: shows the reconstructed frame in screen space.
+#[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
+pub struct CpuFrameMaterial {
+    /// The latest reconstructed frame (linear radiance).
+    #[texture(0, sample_type = "float", filterable = false)]
+    pub frame: Handle<Image>,
+}
+
+impl Material for CpuFrameMaterial {
+    fn fragment_shader() -> ShaderRef {
+        "embedded://bevy_plenoptic/reconstruct/cpu.wgsl".into()
+    }
+}
+
+type FrameTask = Task<Result<Frame, String>>;
+
+/// Per pack: the reconstructor, the frame in flight and the displayed image.
+#[derive(Resource, Default)]
+pub struct CpuFrames(HashMap<AssetId<RadiancePack>, CpuFrame>);
+
+struct CpuFrame {
+    rec: Option<Arc<Reconstructor>>,
+    task: Option<FrameTask>,
+    image: Handle<Image>,
+    /// Frames completed.
+    done: u64,
+}
+
+impl CpuFrames {
+    /// Frames the CPU backend has completed for `pack`.
+    pub fn frames_done(&self, pack: AssetId<RadiancePack>) -> u64 {
+        self.0.get(&pack).map_or(0, |f| f.done)
+    }
+}
+
+fn attach_cpu_materials(
+    mut commands: Commands,
+    backend: Res<ResolvedBackend>,
+    mut frames: ResMut<CpuFrames>,
+    packs: Res<Assets<RadiancePack>>,
+    roots: Query<&PlenopticScene>,
+    proxies: Query<(Entity, &ChildOf), (With<ProxyOf>, With<MeshMaterial3d<StandardMaterial>>)>,
+    mut materials: ResMut<Assets<CpuFrameMaterial>>,
+    mut images: ResMut<Assets<Image>>,
+    mut events: MessageWriter<PlenopticEvent>,
+) {
+    if backend.0 != Backend::Cpu {
+        return;
+    }
+    for (entity, parent) in &proxies {
+        let Ok(scene) = roots.get(parent.parent()) else {
+            continue;
+        };
+        let id = scene.pack.id();
+        let Some(pack) = packs.get(id) else { continue };
+        let frame = frames.0.entry(id).or_insert_with(|| {
+            let rec = match pack.file.as_ref().map(Reconstructor::open) {
+                Some(Ok(r)) => Some(Arc::new(r)),
+                Some(Err(e)) => {
+                    events.write(PlenopticEvent::ChunkFailed {
+                        chunk: "pack (CPU backend)".into(),
+                        reason: e.to_string(),
+                    });
+                    None
+                }
+                None => {
+                    warn!("plenoptic: the CPU backend needs a pack on the file system");
+                    None
+                }
+            };
+            let image = Image::new_fill(
+                Extent3d::default(),
+                TextureDimension::D2,
+                &[0; 16],
+                TextureFormat::Rgba32Float,
+                RenderAssetUsages::default(),
+            );
+            CpuFrame {
+                rec,
+                task: None,
+                image: images.add(image),
+                done: 0,
+            }
+        });
+        let m = materials.add(CpuFrameMaterial {
+            frame: frame.image.clone(),
+        });
+        commands
+            .entity(entity)
+            .remove::<MeshMaterial3d<StandardMaterial>>()
+            .insert(MeshMaterial3d(m));
+    }
+}
+
+fn run_cpu_frames(
+    mut frames: ResMut<CpuFrames>,
+    cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
+    mut images: ResMut<Assets<Image>>,
+    mut materials: ResMut<Assets<CpuFrameMaterial>>,
+    mut events: MessageWriter<PlenopticEvent>,
+) {
+    for (id, f) in frames.0.iter_mut() {
+        if let Some(task) = f.task.as_mut()
+            && let Some(result) = check_ready(task)
+        {
+            f.task = None;
+            match result {
+                Ok(frame) => {
+                    let data: Vec<u8> = frame
+                        .radiance
+                        .iter()
+                        .flat_map(|c| [c.x, c.y, c.z, 1.0])
+                        .flat_map(f32::to_le_bytes)
+                        .collect();
+                    if let Some(mut image) = images.get_mut(&f.image) {
+                        *image = Image::new(
+                            Extent3d {
+                                width: frame.width,
+                                height: frame.height,
+                                depth_or_array_layers: 1,
+                            },
+                            TextureDimension::D2,
+                            data,
+                            TextureFormat::Rgba32Float,
+                            RenderAssetUsages::default(),
+                        );
+                    }
+                    // Touch the materials showing it so their bind groups pick up the new
+                    // texture.
+                    let users: Vec<_> = materials
+                        .iter()
+                        .filter(|(_, m)| m.frame == f.image)
+                        .map(|(id, _)| id)
+                        .collect();
+                    for m in users {
+                        if let Some(mut m) = materials.get_mut(m) {
+                            m.frame = f.image.clone();
+                        }
+                    }
+                    f.done += 1;
+                }
+                Err(reason) => {
+                    events.write(PlenopticEvent::ChunkFailed {
+                        chunk: "frame (CPU backend)".into(),
+                        reason,
+                    });
+                }
+            }
+        }
+        if f.task.is_some() {
+            continue;
+        }
+        let (Some(rec), Some((cam, camera, projection, transform))) = (
+            f.rec.clone(),
+            cameras.iter().find(|(c, ..)| c.pack.id() == *id),
+        ) else {
+            continue;
+        };
+        let Some(size) = camera.physical_viewport_size() else {
+            continue;
+        };
+        let vfov = match projection {
+            Projection::Perspective(p) => p.fov,
+            _ => std::f32::consts::FRAC_PI_4,
+        };
+        let (_, rotation, position) = transform.to_scale_rotation_translation();
+        let (t, mode) = (cam.time, cam.mode.into());
+        f.task = Some(AsyncComputeTaskPool::get().spawn(async move {
+            let c = ReconCamera::new(position, rotation, vfov, size.x, size.y)
+                .map_err(|e| e.to_string())?;
+            rec.render(&c, t, mode)
+                .map(|(frame, _)| frame)
+                .map_err(|e| e.to_string())
+        }));
+    }
+}

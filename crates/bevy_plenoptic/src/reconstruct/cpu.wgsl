@@ -1,0 +1,15 @@
+// The CPU backend's frame, shown through the proxy meshes: each fragment takes the texel of
+// its pixel from the frame plenoptic_recon reconstructed (linear radiance, unlit).
+
+#import bevy_pbr::forward_io::VertexOutput
+#import bevy_pbr::mesh_view_bindings::view
+
+@group(#{MATERIAL_BIND_GROUP}) @binding(0) var frame: texture_2d<f32>;
+
+@fragment
+fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    let size = textureDimensions(frame);
+    let uv = (in.position.xy - view.viewport.xy) / view.viewport.zw;
+    let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+    return vec4<f32>(textureLoad(frame, p, 0).rgb, 1.0);
+}
