@@ -120,21 +120,16 @@ pub fn volume_chunks(plan: &Plan, bv: u32, samples: &[VolumeSample]) -> Result<V
 
 /// The (x, y, t) Delaunay complex of an encoded volume block (thesis §7.4.2), over its samples
 /// as stored (quantized, in stored order): x, y the octahedral coordinates of the direction in
-/// [−1, 1]², t the position in the bucket in [0, 1]. `None` when the samples span no volume
+/// [−1, 1]², t the position in the bucket in [0, 1] — [`plenoptic_recon::volume::complex_point`],
+/// the mapping reconstruction slices the complex with. `None` when the samples span no volume
 /// (fewer than four, or coplanar).
 pub fn complex_chunk(block: &[u8]) -> Result<Option<(Vec<u8>, u64)>> {
     let decoded = decode_volume_block(block)?;
-    let span = (decoded.t_end - decoded.t_start).max(f32::MIN_POSITIVE);
     let points: Vec<[f64; 3]> = decoded
         .samples
         .iter()
         .map(|s| {
-            let o = plenoptic_pack::cube::oct_encode(s.direction);
-            [
-                f64::from(o.x),
-                f64::from(o.y),
-                f64::from((s.t - decoded.t_start) / span),
-            ]
+            plenoptic_recon::volume::complex_point(s.direction, s.t, decoded.t_start, decoded.t_end)
         })
         .collect();
     match crate::delaunay3::tetrahedralize(&points) {

@@ -131,6 +131,10 @@ pub struct Report {
     pub base_views: Vec<(usize, f32)>,
     /// Every chunk that was needed but missing or unreadable, with the reason.
     pub missing: Vec<String>,
+    /// Volume mode: how many base views' cubes were sliced from the baked (x, y, t) complex
+    /// (the others were triangulated per cube face at t, or came from range images).
+    #[serde(default)]
+    pub volume_complex_blocks: usize,
     /// Wall-clock milliseconds of the stages of the reconstruction (diagnostics).
     pub stage_ms: Vec<(String, f64)>,
 }

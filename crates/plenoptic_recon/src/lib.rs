@@ -11,8 +11,9 @@
 //! - [`warp`]: depth reprojection of a base view's cube into the camera with a z-buffer,
 //!   footprint splats (foreground fill) and background fill (appendix A.2, §6.7);
 //! - [`viewspace`]: blending base views by the camera's place in the view space (§6.7);
-//! - [`volume`]: temporal volumes filtered around t and triangulated (§7.4); [`delaunay3`]:
-//!   the (x, y, t) Delaunay complex of temporal volumes (the baker builds it with this module);
+//! - [`volume`]: temporal volumes at t (§7.4): the baked (x, y, t) complex sliced at t, or
+//!   the samples filtered around t and triangulated; [`delaunay3`]: that (x, y, t) Delaunay
+//!   complex (the baker builds it with this module, reconstruction slices it);
 //! - [`proxy`] and the geometry-assisted mode: geometry masks and motion-compensated lookups,
 //!   the improvement the thesis proposes in §8.2.3.
 //!

@@ -82,6 +82,7 @@ pub(crate) enum Cached {
     Ids(Arc<CubeImage<u32>>),
     Normal(Arc<CubeImage<Vec3>>),
     Volume(Arc<VolumeBlock>),
+    Connectivity(Arc<Vec<[u32; 4]>>),
     Failed(String),
 }
 
@@ -93,6 +94,7 @@ impl Cached {
             Cached::Ids(c) => c.texels.len() * 4,
             Cached::Normal(c) => c.texels.len() * 12,
             Cached::Volume(b) => b.samples.len() * 64,
+            Cached::Connectivity(t) => t.len() * 16,
             Cached::Failed(s) => s.len(),
         }
     }
@@ -199,6 +201,10 @@ impl Reconstructor {
                 .pack
                 .normal(view, key)
                 .map(|c| Cached::Normal(Arc::new(c))),
+            ChunkKind::VolumeConnectivity => self
+                .pack
+                .connectivity(view, key)
+                .map(|t| Cached::Connectivity(Arc::new(t))),
             _ => self
                 .pack
                 .volume_block(view, key)
@@ -285,6 +291,28 @@ impl Reconstructor {
             Cached::Failed(e) => {
                 missing.push(format!(
                     "volume block of base view {view}, bucket {bucket}: {e}"
+                ));
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// The connectivity (tetrahedra over stored sample indices) of the volume block of (view,
+    /// bucket), if present and readable (absence is not reported; a read failure is).
+    pub(crate) fn connectivity(
+        &self,
+        view: usize,
+        bucket: u32,
+        missing: &mut Vec<String>,
+    ) -> Option<Arc<Vec<[u32; 4]>>> {
+        self.pack
+            .find(ChunkKind::VolumeConnectivity, view as u32, bucket)?;
+        match self.cached(ChunkKind::VolumeConnectivity, view as u32, bucket) {
+            Cached::Connectivity(t) => Some(t),
+            Cached::Failed(e) => {
+                missing.push(format!(
+                    "volume connectivity of base view {view}, bucket {bucket}: {e}: triangulated the samples at t instead"
                 ));
                 None
             }

@@ -9,25 +9,33 @@
 //!   spade), and every texel interpolates its triangle's samples with weights
 //!   `barycentric · τ`; distance and object id come from the heaviest corner. The cube at t is
 //!   then warped like a range image ([`crate::warp`]). Views without temporal volumes use their
-//!   range images instead. (Slicing the baked (x, y, t) tetrahedral complex at t is not
-//!   implemented yet; the per-time triangulation is used when the connectivity is present
-//!   too.)
+//!   range images instead.
+//! - *Volume mode with the baked complex*: when the pack holds the VolumeConnectivity chunk of
+//!   the block of `bucket_of(t)`, the cube at t is instead the slice of that block's (x, y, t)
+//!   Delaunay complex ([`crate::delaunay3`], coordinates [`complex_point`]) at t
+//!   ([`slice_to_cube`]): every texel's direction is mapped to octahedral (x, y), located in
+//!   the slice triangles, and radiance and distance are interpolated barycentrically (object id
+//!   from the nearest corner). A tetrahedron spans only its own block's samples, so no tent
+//!   filter is applied. A missing, unreadable or inconsistent complex falls back to the
+//!   per-face triangulation (the unreadable one is reported); [`Report::volume_complex_blocks`]
+//!   counts the cubes built from the complex.
 //! - *Geometry-assisted fallback* ([`VolumeIndex`]): samples binned by direction so that a
 //!   pixel's point can find the samples of its object near its direction.
 
 use glam::Vec3;
-use plenoptic_pack::{CubeImage, VolumeSample, cube};
+use plenoptic_pack::{ChunkKind, CubeImage, VolumeBlock, VolumeSample, cube};
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, HasPosition, Point2, PositionInTriangulation, Triangulation};
 
 use crate::camera::Camera;
+use crate::delaunay3::{DelaunayError, Interpolate, SliceTriangle, slice_at};
 use crate::frame::{Frame, Report};
 use crate::reconstructor::Reconstructor;
 use crate::warp::{ViewCubes, Warped, warp_view};
 use crate::{Error, Result};
 
 /// Radiance, distance and object-id cubes.
-type Cubes = (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>);
+pub type Cubes = (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>);
 
 /// Face size of the direction bins of a [`VolumeIndex`].
 const BIN_FACE: u32 = 16;
@@ -253,6 +261,208 @@ pub fn samples_to_cube(samples: &[(VolumeSample, f32)], n: u32) -> Cubes {
     (r, d, o)
 }
 
+/// The (x, y, t) coordinates of a volume sample in its block's Delaunay complex (thesis
+/// §7.4.2): x, y the octahedral coordinates ([`cube::oct_encode`]) of `direction` in [−1, 1]²,
+/// t the position of `t` in the block's span `[t_start, t_end]` ([`complex_time`]). The baker
+/// builds the stored complex over these coordinates of the *stored* (quantized) samples, and
+/// reconstruction slices it with them: this is the one definition both use.
+pub fn complex_point(direction: Vec3, t: f32, t_start: f32, t_end: f32) -> [f64; 3] {
+    let o = cube::oct_encode(direction);
+    [
+        f64::from(o.x),
+        f64::from(o.y),
+        complex_time(t, t_start, t_end),
+    ]
+}
+
+/// The t coordinate of time `t` in the complex of a block spanning `[t_start, t_end]`:
+/// `(t − t_start)/(t_end − t_start)`, in [0, 1] inside the span (see [`complex_point`]).
+pub fn complex_time(t: f32, t_start: f32, t_end: f32) -> f64 {
+    let span = (t_end - t_start).max(f32::MIN_POSITIVE);
+    f64::from((t - t_start) / span)
+}
+
+/// What a slice corner carries: radiance and distance interpolate linearly; the object id is
+/// the nearer edge end's.
+#[derive(Clone, Copy, Debug)]
+struct Corner {
+    radiance: Vec3,
+    distance: f32,
+    id: u32,
+}
+
+impl Interpolate for Corner {
+    fn lerp(&self, other: &Self, s: f64) -> Self {
+        Corner {
+            radiance: Interpolate::lerp(&self.radiance, &other.radiance, s),
+            distance: Interpolate::lerp(&self.distance, &other.distance, s),
+            id: if s <= 0.5 { self.id } else { other.id },
+        }
+    }
+}
+
+/// Barycentric coordinates of `q` in triangle `xy` (`None` when it is degenerate).
+fn barycentric(xy: &[[f64; 2]; 3], q: [f64; 2]) -> Option<[f64; 3]> {
+    let [a, b, c] = *xy;
+    let det = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    if det.abs() <= 1e-300 {
+        return None;
+    }
+    let l1 = ((q[0] - a[0]) * (c[1] - a[1]) - (q[1] - a[1]) * (c[0] - a[0])) / det;
+    let l2 = ((b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])) / det;
+    Some([1.0 - l1 - l2, l1, l2])
+}
+
+/// The cubes (face size `n`) at time `t` sliced from a block's (x, y, t) Delaunay complex
+/// `tets` (stored sample indices; coordinates [`complex_point`]): each texel's direction is
+/// mapped to octahedral (x, y) and located among the slice triangles; radiance and distance
+/// interpolate the triangle's corners barycentrically, the object id is the nearest corner's.
+/// Texels outside the slice take the nearest slice corner in their neighbourhood (within a
+/// grid cell, about √(triangle count)⁻¹ of the square), or stay empty (distance ∞, id 0).
+///
+/// Returns `Ok(None)` when `t` is outside the complex's time extent (no triangle).
+///
+/// # Errors
+///
+/// [`DelaunayError`] when a tetrahedron names a sample the block does not have.
+pub fn slice_to_cube(
+    block: &VolumeBlock,
+    tets: &[[u32; 4]],
+    t: f32,
+    n: u32,
+) -> Result<Option<Cubes>, DelaunayError> {
+    let points: Vec<[f64; 3]> = block
+        .samples
+        .iter()
+        .map(|s| complex_point(s.direction, s.t, block.t_start, block.t_end))
+        .collect();
+    let values: Vec<Corner> = block
+        .samples
+        .iter()
+        .map(|s| Corner {
+            radiance: s.radiance,
+            distance: s.distance,
+            id: s.object_id,
+        })
+        .collect();
+    let tris = slice_at(
+        &points,
+        tets,
+        &values,
+        complex_time(t, block.t_start, block.t_end),
+    )?;
+    let tris: Vec<SliceTriangle<Corner>> = tris.into_iter().filter(|t| t.area() > 0.0).collect();
+    if tris.is_empty() {
+        return Ok(None);
+    }
+    // Uniform grid over [−1, 1]² binning the triangles by bounding box.
+    let g = ((tris.len() as f64).sqrt().ceil() as usize).clamp(1, 512);
+    let cell = |x: f64| (((x + 1.0) * 0.5 * g as f64).floor().max(0.0) as usize).min(g - 1);
+    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); g * g];
+    for (k, tri) in tris.iter().enumerate() {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &tri.xy {
+            for a in 0..2 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        for j in cell(lo[1])..=cell(hi[1]) {
+            for i in cell(lo[0])..=cell(hi[0]) {
+                bins[j * g + i].push(k as u32);
+            }
+        }
+    }
+    let texels: Vec<(Vec3, f32, u32)> = (0..6 * (n * n) as usize)
+        .into_par_iter()
+        .map(|i| {
+            let o = cube::oct_encode(cube::texel_direction(n, i));
+            let q = [f64::from(o.x), f64::from(o.y)];
+            let (ci, cj) = (cell(q[0]), cell(q[1]));
+            // The containing triangle: the candidate whose smallest barycentric coordinate is
+            // largest (≥ −1e-9 counts as inside, for texels on shared edges).
+            let mut best: Option<(f64, u32, [f64; 3])> = None;
+            for &k in &bins[cj * g + ci] {
+                if let Some(b) = barycentric(&tris[k as usize].xy, q) {
+                    let m = b[0].min(b[1]).min(b[2]);
+                    if best.is_none_or(|(bm, _, _)| m > bm) {
+                        best = Some((m, k, b));
+                    }
+                }
+            }
+            if let Some((m, k, b)) = best
+                && m >= -1e-9
+            {
+                let v = &tris[k as usize].values;
+                let b = b.map(|x| x.max(0.0));
+                let s = b[0] + b[1] + b[2];
+                let mut radiance = Vec3::ZERO;
+                let mut distance = 0.0f64;
+                for c in 0..3 {
+                    radiance += v[c].radiance * (b[c] / s) as f32;
+                    distance += f64::from(v[c].distance) * b[c] / s;
+                }
+                let near = (0..3).max_by(|&x, &y| b[x].total_cmp(&b[y])).unwrap_or(0);
+                return (radiance, distance as f32, v[near].id);
+            }
+            // Outside the slice: the nearest corner among the neighbouring cells' triangles.
+            let mut nearest: Option<(f64, Corner)> = None;
+            for j in cj.saturating_sub(1)..=(cj + 1).min(g - 1) {
+                for i in ci.saturating_sub(1)..=(ci + 1).min(g - 1) {
+                    for &k in &bins[j * g + i] {
+                        let tri = &tris[k as usize];
+                        for c in 0..3 {
+                            let d = (tri.xy[c][0] - q[0]).powi(2) + (tri.xy[c][1] - q[1]).powi(2);
+                            if nearest.is_none_or(|(nd, _)| d < nd) {
+                                nearest = Some((d, tri.values[c]));
+                            }
+                        }
+                    }
+                }
+            }
+            match nearest {
+                Some((_, c)) => (c.radiance, c.distance, c.id),
+                None => (Vec3::ZERO, f32::INFINITY, 0),
+            }
+        })
+        .collect();
+    let mut r = CubeImage::filled(n, Vec3::ZERO);
+    let mut d = CubeImage::filled(n, f32::INFINITY);
+    let mut o = CubeImage::filled(n, 0u32);
+    for (i, (rad, dist, id)) in texels.into_iter().enumerate() {
+        r.texels[i] = rad;
+        d.texels[i] = dist;
+        o.texels[i] = id;
+    }
+    Ok(Some((r, d, o)))
+}
+
+/// The cube of `view` at `t` sliced from the baked complex of the block of `bucket_of(t)`, if
+/// the pack has that block's connectivity and it can be used. An unreadable or inconsistent
+/// connectivity chunk is reported in `missing` (the caller falls back to the per-face
+/// triangulation, which reports an unreadable block itself).
+fn complex_cube(
+    rec: &Reconstructor,
+    view: usize,
+    t: f32,
+    missing: &mut Vec<String>,
+) -> Option<Cubes> {
+    let bucket = rec.pack().manifest().bucket_of(t);
+    rec.pack()
+        .find(ChunkKind::VolumeConnectivity, view as u32, bucket)?;
+    let block = rec.volume_block(view, bucket, &mut Vec::new())?;
+    let tets = rec.connectivity(view, bucket, missing)?;
+    match slice_to_cube(&block, &tets, t, rec.settings.volume_face_size) {
+        Ok(cubes) => cubes,
+        Err(e) => {
+            missing.push(format!(
+                "volume connectivity of base view {view}, bucket {bucket}: {e}: triangulated the samples at t instead"
+            ));
+            None
+        }
+    }
+}
+
 /// Volume mode: cubes at t from the temporal volumes of the nearest views, warped and blended.
 pub(crate) fn render(
     rec: &Reconstructor,
@@ -263,6 +473,11 @@ pub(crate) fn render(
     let views = rec.view_weights(camera.position);
     let mut cubes: Vec<(usize, f32, Cubes)> = Vec::new();
     for &(v, w) in &views {
+        if let Some(c) = complex_cube(rec, v, t, &mut report.missing) {
+            report.volume_complex_blocks += 1;
+            cubes.push((v, w, c));
+            continue;
+        }
         match filtered_samples(rec, v, t, &mut report.missing) {
             Some(s) if s.len() >= 3 => {
                 cubes.push((v, w, samples_to_cube(&s, rec.settings.volume_face_size)))
