@@ -14,7 +14,7 @@
 //!   view and time key with the multi-stage renderer, the ambient field interpolated linearly
 //!   in time; [`volume`]: temporal volumes, random and adaptive (direction, t) samples with
 //!   validity radii.
-//! - [`write`]: chunks, proxy geometry, animation tracks, manifest and statistics; the pack is
+//! - [`write`](mod@write): chunks, proxy geometry, animation tracks, manifest and statistics; the pack is
 //!   assembled in a canonical order.
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
 //! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA.
@@ -29,7 +29,7 @@
 //! Decisions the design leaves open, documented in the modules: object ids are stored as scene
 //! id + 1 (0 = none, [`render::pack_object_id`]); the decomposition of space uses the scene at
 //! the start time; a static scene gets one time key per base view and no temporal volume;
-//! timings go to a sidecar file ([`write`]).
+//! timings go to a sidecar file ([`write`](mod@write)).
 //!
 //! Same inputs give a byte-identical pack, whatever the thread count and whether the bake ran
 //! in one go, resumed, or in shards: wall-clock timings are kept out of the pack (sidecar

@@ -213,7 +213,7 @@ impl ProxyGeometry {
 
     /// The geometry mask of `camera` at time `t` by rasterizing the placed proxy triangles
     /// (what the GPU mask pass does): the same object ids and hit points as [`Self::mask`]
-    /// up to pixel-centre edge rules, at a fraction of the cost. See [`crate::raster`].
+    /// up to pixel-centre edge rules, at a fraction of the cost. See the `raster` module.
     pub fn mask_raster(&self, camera: &Camera, t: f32) -> GeometryMask {
         let objects: Vec<(u32, Affine3A, &Mesh)> = self
             .scene
