@@ -112,7 +112,7 @@ fn corrupted_chunk_is_reported_while_streaming() {
     let path = make_pack(dir.path());
     let reader = PackReader::open(&path).unwrap();
     let i = reader.find(ChunkKind::RadianceCube, 0, 0).unwrap();
-    let e = reader.entries()[i].clone();
+    let e = reader.entries()[i];
     drop(reader);
     let mut bytes = std::fs::read(&path).unwrap();
     for b in &mut bytes[e.offset as usize + 40..e.offset as usize + 48] {

@@ -154,6 +154,10 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
         }
     }
     let stats = app.world().resource::<StreamingStats>().clone();
+    eprintln!(
+        "streaming: {stats:?}; decode {:.1} MB/s (debug build)",
+        stats.decoded_bytes as f64 / 1e6 / stats.decode_time.as_secs_f64().max(1e-9)
+    );
     assert!(stats.peak_resident_bytes <= budget, "{stats:?}");
     assert!(stats.decoded_keys >= 5, "{stats:?}");
     assert!(stats.evictions > 0, "{stats:?}");

@@ -73,13 +73,17 @@ impl CpuFrames {
     }
 }
 
+/// Proxies still on the placeholder material.
+type Unattached = (With<ProxyOf>, With<MeshMaterial3d<StandardMaterial>>);
+
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn attach_cpu_materials(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     mut frames: ResMut<CpuFrames>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
-    proxies: Query<(Entity, &ChildOf), (With<ProxyOf>, With<MeshMaterial3d<StandardMaterial>>)>,
+    proxies: Query<(Entity, &ChildOf), Unattached>,
     mut materials: ResMut<Assets<CpuFrameMaterial>>,
     mut images: ResMut<Assets<Image>>,
     mut events: MessageWriter<PlenopticEvent>,

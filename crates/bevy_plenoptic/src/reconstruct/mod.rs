@@ -268,6 +268,7 @@ fn upload_keys(
 }
 
 /// Fills every proxy material's lookups for its pack's (first) camera.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn update_materials(
     keys: Res<KeyTextures>,
     cache: Res<StreamCache>,

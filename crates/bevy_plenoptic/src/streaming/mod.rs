@@ -126,7 +126,8 @@ impl DecodedKey {
 /// GPU-ready texel bytes. The error names the failing chunk.
 pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, (String, String)> {
     let name = |kind: ChunkKind| format!("{kind:?} view {view} key {key}");
-    let read = |kind: ChunkKind| -> Result<Option<(u32, Vec<u8>)>, (String, String)> {
+    type Read = Result<Option<(u32, Vec<u8>)>, (String, String)>;
+    let read = |kind: ChunkKind| -> Read {
         let Some(i) = pack.find(kind, view, key) else {
             return Ok(None);
         };
@@ -184,13 +185,15 @@ pub struct Resident {
 }
 
 type DecodeResult = (Result<DecodedKey, (String, String)>, Duration);
+/// Reserved bytes, slot and the decode task of a key being read.
+type InFlight = (u64, u32, Task<DecodeResult>);
 
 /// Resident and in-flight keys of every pack, keyed by (pack, view, key).
 #[derive(Resource, Default)]
 pub struct StreamCache {
     /// Resident keys.
     pub resident: HashMap<(AssetId<RadiancePack>, u32, u32), Resident>,
-    in_flight: HashMap<(AssetId<RadiancePack>, u32, u32), (u64, u32, Task<DecodeResult>)>,
+    in_flight: HashMap<(AssetId<RadiancePack>, u32, u32), InFlight>,
     failed: HashMap<(AssetId<RadiancePack>, u32, u32), String>,
     frame: u64,
     free_slots: Vec<u32>,
@@ -263,7 +266,6 @@ fn collect_finished(
 /// Most reads in flight at once.
 const MAX_IN_FLIGHT: usize = 8;
 
-#[allow(clippy::too_many_arguments)]
 fn schedule_reads(
     mut cache: ResMut<StreamCache>,
     mut stats: ResMut<StreamingStats>,
