@@ -164,3 +164,8 @@ pub enum PlenopticEvent {
         reason: String,
     },
 }
+
+/// The README's code samples, compiled as doc tests so the README stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;
