@@ -2,6 +2,9 @@
 //! renders into an image that is read back to the CPU.
 #![allow(dead_code, reason = "each test binary uses a part of it")]
 
+/// The reconstruction crate's test pack builder (analytic scenes written with `PackWriter`),
+/// shared so that the GPU is tested on the very packs the CPU reconstruction is.
+#[path = "../../../plenoptic_recon/tests/common/mod.rs"]
 pub mod pack;
 
 use std::sync::{Arc, Mutex};
