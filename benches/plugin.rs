@@ -7,7 +7,7 @@
 //!
 //! `cargo bench --bench plugin` (needs the default `bevy` feature).
 
-#[path = "../crates/bevy_plenoptic/tests/common/pack.rs"]
+#[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
 use std::hint::black_box;
