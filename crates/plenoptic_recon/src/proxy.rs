@@ -84,47 +84,102 @@ impl std::fmt::Debug for ProxyGeometry {
     }
 }
 
+/// One object's proxy geometry as a pack stores it: the object-space mesh and the object's
+/// motion, converted to the scene crate's tracks so it can be evaluated at any time.
+#[derive(Debug, Clone)]
+pub struct PackProxy {
+    /// The object's id in the pack (0 is reserved for "no object").
+    pub id: u32,
+    /// The object's name from the manifest.
+    pub name: String,
+    /// The object's glTF node path from the manifest.
+    pub node_path: String,
+    /// The object-space proxy mesh.
+    pub mesh: plenoptic_pack::ProxyMesh,
+    /// The object's animation; `None` for an object without tracks (placed by the identity).
+    pub track: Option<TrsTrack>,
+}
+
+/// Reads the proxy mesh and the tracks of every object of `pack` that has a proxy mesh.
+/// Returns them with `(chunk, error)` for every chunk that could not be read; missing tracks
+/// count only when some object is animated. Shared by the CPU reconstruction and the Bevy
+/// plugin's asset loader.
+pub fn read_proxies(pack: &PackReader) -> (Vec<PackProxy>, Vec<(String, String)>) {
+    let mut failed = Vec::new();
+    let tracks = match pack.tracks() {
+        Ok(t) => t,
+        Err(e) => {
+            if pack
+                .manifest()
+                .objects
+                .iter()
+                .any(|o| o.motion == plenoptic_pack::Motion::Animated)
+            {
+                failed.push(("animation tracks".to_string(), e.to_string()));
+            }
+            AnimationTracks::default()
+        }
+    };
+    let mut proxies = Vec::new();
+    for entry in &pack.manifest().objects {
+        let Some(key) = entry.proxy_mesh else {
+            continue;
+        };
+        let mesh = match pack.proxy_mesh(key) {
+            Ok(m) => m,
+            Err(e) => {
+                failed.push((
+                    format!("proxy mesh of object {} ({})", entry.id, entry.name),
+                    e.to_string(),
+                ));
+                continue;
+            }
+        };
+        let track = tracks
+            .objects
+            .iter()
+            .find(|o| o.object_id == entry.id)
+            .map(|o| TrsTrack {
+                translation: o.translation.as_ref().and_then(convert_track),
+                rotation: o.rotation.as_ref().and_then(convert_track),
+                scale: o.scale.as_ref().and_then(convert_track),
+            });
+        proxies.push(PackProxy {
+            id: entry.id,
+            name: entry.name.clone(),
+            node_path: entry.node_path.clone(),
+            mesh,
+            track,
+        });
+    }
+    (proxies, failed)
+}
+
 impl ProxyGeometry {
     /// Reads every proxy mesh and the tracks of `pack`. Returns the geometry (None if no
     /// proxy mesh could be read) and a description of every chunk that could not be read.
     pub fn from_pack(pack: &PackReader) -> (Option<Self>, Vec<String>) {
-        let mut missing = Vec::new();
-        let tracks = match pack.tracks() {
-            Ok(t) => t,
-            Err(e) => {
-                if pack
-                    .manifest()
-                    .objects
-                    .iter()
-                    .any(|o| o.motion == plenoptic_pack::Motion::Animated)
-                {
-                    missing.push(format!("animation tracks: {e}"));
-                }
-                AnimationTracks::default()
-            }
-        };
+        let (proxies, failed) = read_proxies(pack);
+        let mut missing: Vec<String> = failed
+            .into_iter()
+            .map(|(chunk, error)| format!("{chunk}: {error}"))
+            .collect();
         let mut scene = Scene::default();
         scene
             .materials
             .push(plenoptic_trace::shapes::diffuse(Vec3::splat(0.5)));
         let mut pack_ids = Vec::new();
-        for entry in &pack.manifest().objects {
-            let Some(key) = entry.proxy_mesh else {
-                continue;
-            };
-            let mesh = match pack.proxy_mesh(key) {
-                Ok(m) => m,
-                Err(e) => {
-                    missing.push(format!(
-                        "proxy mesh of object {} ({}): {e}",
-                        entry.id, entry.name
-                    ));
-                    continue;
-                }
-            };
-            let normals = mesh.normals.clone().unwrap_or_default();
+        for PackProxy {
+            id,
+            name,
+            node_path,
+            mesh,
+            track,
+        } in proxies
+        {
+            let normals = mesh.normals.unwrap_or_default();
             scene.meshes.push(Mesh {
-                positions: mesh.positions.clone(),
+                positions: mesh.positions,
                 normals,
                 uvs: Vec::new(),
                 tangents: Vec::new(),
@@ -134,29 +189,20 @@ impl ProxyGeometry {
                     .map(|c| [c[0], c[1], c[2]])
                     .collect(),
             });
-            let track = tracks
-                .objects
-                .iter()
-                .find(|o| o.object_id == entry.id)
-                .map(|o| TrsTrack {
-                    translation: o.translation.as_ref().and_then(convert_track),
-                    rotation: o.rotation.as_ref().and_then(convert_track),
-                    scale: o.scale.as_ref().and_then(convert_track),
-                });
             scene.nodes.push(Node {
-                name: entry.name.clone(),
+                name: name.clone(),
                 parent: None,
                 rest: Trs::default(),
                 track,
             });
             scene.objects.push(Object {
-                name: entry.name.clone(),
-                node_path: entry.node_path.clone(),
+                name,
+                node_path,
                 node: scene.nodes.len() - 1,
                 mesh: scene.meshes.len() - 1,
                 material: 0,
             });
-            pack_ids.push(entry.id);
+            pack_ids.push(id);
         }
         if scene.objects.is_empty() {
             return (None, missing);

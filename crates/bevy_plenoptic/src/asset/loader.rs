@@ -9,8 +9,6 @@ use bevy::asset::{AssetLoader, LoadContext, RenderAssetUsages};
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
 use plenoptic_pack::{PackError, PackReader};
-use plenoptic_recon::proxy::convert_track;
-use plenoptic_scene::TrsTrack;
 
 use super::{ProxyObject, RadiancePack};
 
@@ -81,49 +79,16 @@ impl AssetLoader for RadiancePackLoader {
             source,
         })?;
 
-        let mut failed = Vec::new();
-        let tracks = match pack.tracks() {
-            Ok(t) => t,
-            Err(e) => {
-                if pack
-                    .manifest()
-                    .objects
-                    .iter()
-                    .any(|o| o.motion == plenoptic_pack::Motion::Animated)
-                {
-                    failed.push(("animation tracks".to_string(), e.to_string()));
-                }
-                Default::default()
-            }
-        };
+        let (read, failed) = plenoptic_recon::proxy::read_proxies(&pack);
         let mut proxies = Vec::new();
-        for entry in &pack.manifest().objects {
-            let Some(key) = entry.proxy_mesh else {
-                continue;
-            };
-            let proxy = match pack.proxy_mesh(key) {
-                Ok(m) => m,
-                Err(e) => {
-                    failed.push((format!("proxy mesh {key} ({})", entry.name), e.to_string()));
-                    continue;
-                }
-            };
-            let mesh = proxy_to_mesh(&proxy);
-            let handle = load_context.add_labeled_asset(format!("proxy{}", entry.id), mesh);
-            let track = tracks
-                .objects
-                .iter()
-                .find(|o| o.object_id == entry.id)
-                .map(|o| TrsTrack {
-                    translation: o.translation.as_ref().and_then(convert_track),
-                    rotation: o.rotation.as_ref().and_then(convert_track),
-                    scale: o.scale.as_ref().and_then(convert_track),
-                });
+        for proxy in read {
+            let mesh = proxy_to_mesh(&proxy.mesh);
+            let handle = load_context.add_labeled_asset(format!("proxy{}", proxy.id), mesh);
             proxies.push(ProxyObject {
-                id: entry.id,
-                name: entry.name.clone(),
+                id: proxy.id,
+                name: proxy.name,
                 mesh: handle,
-                track,
+                track: proxy.track,
             });
         }
         Ok(RadiancePack {
