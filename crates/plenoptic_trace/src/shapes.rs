@@ -29,30 +29,9 @@ pub fn quad(size: Vec2) -> Mesh {
     }
 }
 
-/// An axis-aligned box of `size`, centred, with outward faces (24 vertices, flat normals).
-pub fn cuboid(size: Vec3) -> Mesh {
-    let h = size * 0.5;
-    let mut mesh = Mesh::default();
-    for axis in 0..3 {
-        for sign in [1.0f32, -1.0] {
-            let mut n = Vec3::ZERO;
-            n[axis] = sign;
-            let u = Vec3::from_array(std::array::from_fn(|i| {
-                if i == (axis + 1) % 3 { 1.0 } else { 0.0 }
-            }));
-            let v = n.cross(u);
-            let base = mesh.positions.len() as u32;
-            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                mesh.positions.push((n + u * a + v * b) * h);
-                mesh.normals.push(n);
-                mesh.uvs.push(Vec2::new((a + 1.0) * 0.5, (b + 1.0) * 0.5));
-            }
-            mesh.triangles.push([base, base + 1, base + 2]);
-            mesh.triangles.push([base, base + 2, base + 3]);
-        }
-    }
-    mesh
-}
+/// An axis-aligned box of `size`, centred, with outward faces (24 vertices, flat normals):
+/// the scene builder's box, so test scenes and glTF-built scenes share one mesh.
+pub use plenoptic_scene::builder::shapes::cuboid;
 
 /// A UV sphere of `radius` with `segments` around and `rings` from pole to pole, outward.
 pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
