@@ -22,22 +22,25 @@
 //!    preview (`tour.gif`) in the output folder (default, under `$CARGO_TARGET_DIR` if set,
 //!    `target/architectural_tour/frames`), with a progress bar.
 //!
-//! **Windowed mode is not available yet.** The Bevy plugin that will show the tour in a
-//! window is still being written; until then the example always renders headless. When a
-//! display is present (`DISPLAY` or `WAYLAND_DISPLAY` set) and `--headless` was not given,
-//! it says so and renders headless anyway.
+//! With a display (`DISPLAY` or `WAYLAND_DISPLAY` set), step 3 instead opens a window: the
+//! Bevy plugin (`bevy_plenoptic`) streams the pack and reconstructs the tour on the GPU while
+//! the camera flies the path; `Tab` switches to free-fly controls (see `windowed.rs`). The
+//! windowed mode needs the default `window` feature; `--headless` renders to files anyway.
 //!
 //! Run it (release recommended for the bake):
 //!
 //! ```text
-//! cargo run --release --no-default-features --example architectural_tour
+//! cargo run --release --example architectural_tour
+//! # headless without building Bevy
+//! cargo run --release --no-default-features --example architectural_tour -- --headless
 //! # a short run: 4 frames spread over the tour, small frames
 //! cargo run --no-default-features --example architectural_tour -- --frames 4 --width 160 --height 90
 //! ```
 //!
 //! Options:
 //!
-//! - `--headless`: render to files (the only mode for now).
+//! - `--headless`: render to files even when a display is present.
+//! - `--cpu`: in the window, reconstruct with the CPU backend instead of the GPU.
 //! - `--frames N`: render N frames spread evenly over the whole tour instead of every frame
 //!   of the path (24 per second).
 //! - `--width W`, `--height H`: frame size (default: the path's 640 × 360).
@@ -50,9 +53,16 @@
 //! - `--plan`: print the bake plan of the recipe (base views, time keys, estimated cost) and
 //!   stop.
 //! - `--quiet`: no progress bars.
+//! - `--results DIR`: instead of the tour, the README's results (`results.rs`): path-traced
+//!   reference frames (`--spp N`, default 128) at `--frames` (default 8) frames spread over
+//!   the tour, each mode's reconstruction of them, errors, plot, montage and figures, at
+//!   `--width`/`--height` (default 320 × 180).
 
+mod results;
 #[allow(dead_code, reason = "some items are for tests/tour_scene.rs")]
 mod scene;
+#[cfg(feature = "window")]
+mod windowed;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -75,6 +85,7 @@ type BoxError = Box<dyn std::error::Error>;
 #[derive(Debug)]
 struct Options {
     headless: bool,
+    cpu: bool,
     frames: Option<usize>,
     width: Option<u32>,
     height: Option<u32>,
@@ -84,15 +95,18 @@ struct Options {
     mode: Mode,
     quiet: bool,
     plan: bool,
+    results: Option<PathBuf>,
+    spp: u32,
 }
 
-const USAGE: &str = "usage: architectural_tour [--headless] [--frames N] [--width W] \
+const USAGE: &str = "usage: architectural_tour [--headless] [--cpu] [--frames N] [--width W] \
                      [--height H] [--out DIR] [--pack FILE] [--recipe FILE] [--mode geometry|image|volume] \
-                     [--plan] [--quiet]";
+                     [--plan] [--quiet] [--results DIR [--spp N]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
         headless: false,
+        cpu: false,
         frames: None,
         width: None,
         height: None,
@@ -102,6 +116,8 @@ fn parse_args() -> Result<Options, String> {
         mode: Mode::GeometryAssisted,
         quiet: false,
         plan: false,
+        results: None,
+        spp: 128,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -114,6 +130,7 @@ fn parse_args() -> Result<Options, String> {
         };
         match arg.as_str() {
             "--headless" => o.headless = true,
+            "--cpu" => o.cpu = true,
             "--quiet" => o.quiet = true,
             "--plan" => o.plan = true,
             "--frames" => o.frames = Some(number("--frames", value("--frames")?)? as usize),
@@ -122,6 +139,8 @@ fn parse_args() -> Result<Options, String> {
             "--out" => o.out = Some(value("--out")?.into()),
             "--pack" => o.pack = Some(value("--pack")?.into()),
             "--recipe" => o.recipe = Some(value("--recipe")?.into()),
+            "--results" => o.results = Some(value("--results")?.into()),
+            "--spp" => o.spp = number("--spp", value("--spp")?)?,
             "--mode" => {
                 let v = value("--mode")?;
                 o.mode = Mode::parse(&v).ok_or(format!("--mode: unknown mode `{v}`"))?;
@@ -223,15 +242,66 @@ fn run(options: &Options) -> Result<(), BoxError> {
         );
     }
 
-    // 3. The tour.
+    // 3. The tour, or the results.
+    if let Some(dir) = &options.results {
+        let path = CameraPath::load(assets.join("tour_path.json"))?;
+        return results::run(
+            &pack,
+            &recipe_path,
+            &path,
+            dir,
+            &results::ResultsOptions {
+                frames: options.frames.unwrap_or(8).max(2),
+                spp: options.spp,
+                width: options.width.unwrap_or(320),
+                height: options.height.unwrap_or(180),
+                progress: !options.quiet,
+            },
+        );
+    }
     let display = std::env::var_os("DISPLAY").is_some_and(|v| !v.is_empty())
         || std::env::var_os("WAYLAND_DISPLAY").is_some_and(|v| !v.is_empty());
     if display && !options.headless {
-        println!(
-            "the windowed tour (Bevy plugin) is not available yet; rendering the tour headless"
-        );
+        return windowed(options, &pack);
     }
     render_headless(options, &pack)
+}
+
+/// Opens the window (the `window` feature), exposed like the headless frames.
+#[cfg(feature = "window")]
+fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
+    let mut path = CameraPath::load(assets().join("tour_path.json"))?;
+    if let Some(w) = options.width {
+        path.width = w;
+    }
+    if let Some(h) = options.height {
+        path.height = h;
+    }
+    // The exposure of the first frame, from a small CPU reconstruction.
+    let start = path.sample(path.time_range().0);
+    let mut probe = start.camera;
+    (probe.width, probe.height) = (160, 90);
+    let (frame, _) = Reconstructor::open(pack)?.render(&probe, start.scene_time, options.mode)?;
+    let exposure = auto_exposure(&frame.radiance);
+    let backend = if options.cpu {
+        bevy_plenoptic::Backend::Cpu
+    } else {
+        bevy_plenoptic::Backend::Auto
+    };
+    println!(
+        "opening the tour window ({}): Tab free-fly / tour, Space pause, 1-3 mode, Esc quit",
+        pack.display()
+    );
+    windowed::run(pack, path, exposure, backend)
+}
+
+/// Without the `window` feature the tour renders headless.
+#[cfg(not(feature = "window"))]
+fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
+    println!(
+        "built without the `window` feature (--no-default-features): rendering the tour headless"
+    );
+    render_headless(options, pack)
 }
 
 /// Prints the bake plan of the recipe at `recipe_path` and its estimated cost.
@@ -293,13 +363,7 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
     let (start, end) = path.time_range();
     let samples: Vec<PathSample> = match options.frames {
         None => path.frames().collect(),
-        Some(1) => vec![path.sample(start)],
-        Some(n) => (0..n)
-            .map(|i| PathSample {
-                index: i,
-                ..path.sample(start + (end - start) * i as f32 / (n - 1) as f32)
-            })
-            .collect(),
+        Some(n) => spread_samples(&path, n),
     };
     let frame_seconds = (end - start) / samples.len().saturating_sub(1).max(1) as f32;
 
@@ -390,6 +454,86 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
         gif.display()
     );
     Ok(())
+}
+
+/// `n` samples spread evenly over the whole camera path, numbered 0..n.
+fn spread_samples(path: &CameraPath, n: usize) -> Vec<PathSample> {
+    let (start, end) = path.time_range();
+    if n <= 1 {
+        return vec![path.sample(start)];
+    }
+    (0..n)
+        .map(|i| PathSample {
+            index: i,
+            ..path.sample(start + (end - start) * i as f32 / (n - 1) as f32)
+        })
+        .collect()
+}
+
+/// The plugin's streaming working set along every frame of the tour, with its default
+/// settings: the bytes it must hold for each frame (the nearest base views at the bracketing
+/// time keys) and with prefetch along the camera's motion.
+#[cfg(feature = "bevy")]
+fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, BoxError> {
+    use bevy_plenoptic::PlenopticSettings;
+    use bevy_plenoptic::streaming::key_bytes;
+    use bevy_plenoptic::streaming::schedule::{Lookahead, working_set};
+
+    const MIB: f64 = 1024.0 * 1024.0;
+    let reader = plenoptic_pack::PackReader::open(pack)?;
+    let settings = PlenopticSettings::default();
+    let look = Lookahead {
+        views: settings.max_views,
+        seconds: settings.prefetch_seconds,
+    };
+    let frames: Vec<PathSample> = path.frames().collect();
+    let (mut needed_max, mut needed_sum, mut all_max) = (0u64, 0u64, 0u64);
+    for (i, s) in frames.iter().enumerate() {
+        let next = frames.get(i + 1).unwrap_or(s);
+        let dt = (next.path_time - s.path_time).max(1e-6);
+        let velocity = (next.camera.position - s.camera.position) / dt;
+        let direction = (next.scene_time - s.scene_time) / dt;
+        let set = working_set(
+            reader.manifest(),
+            s.camera.position,
+            velocity,
+            s.scene_time,
+            direction,
+            look,
+        );
+        let needed: u64 = set.needed.iter().map(|&k| key_bytes(&reader, k)).sum();
+        let prefetch: u64 = set.prefetch.iter().map(|&k| key_bytes(&reader, k)).sum();
+        needed_max = needed_max.max(needed);
+        needed_sum += needed;
+        all_max = all_max.max(needed + prefetch);
+    }
+    let decoded: u64 = (0..reader.manifest().base_views.len() as u32)
+        .flat_map(|v| {
+            let keys = reader.manifest().base_views[v as usize].time_keys.len() as u32;
+            (0..keys).map(move |k| (v, k))
+        })
+        .map(|k| key_bytes(&reader, k))
+        .sum();
+    Ok(Some(format!(
+        "Streaming (bevy_plenoptic's working set with its default settings, {} views, {} s \
+         prefetch, along all {} frames of the tour): needed per frame {:.1} MiB mean, {:.1} MiB \
+         at most; with prefetch {:.1} MiB at most — of {:.1} MiB for the whole pack decoded \
+         ({:.1} % resident at the peak).",
+        look.views,
+        look.seconds,
+        frames.len(),
+        needed_sum as f64 / frames.len().max(1) as f64 / MIB,
+        needed_max as f64 / MIB,
+        all_max as f64 / MIB,
+        decoded as f64 / MIB,
+        100.0 * all_max as f64 / decoded.max(1) as f64
+    )))
+}
+
+/// Without the plugin there is no working set to report.
+#[cfg(not(feature = "bevy"))]
+fn streaming_figures(_pack: &Path, _path: &CameraPath) -> Result<Option<String>, BoxError> {
+    Ok(None)
 }
 
 /// Writes an endlessly looping GIF, `seconds` per frame.

@@ -17,7 +17,8 @@
 //! - [`write`](mod@write): chunks, proxy geometry, animation tracks, manifest and statistics; the pack is
 //!   assembled in a canonical order.
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
-//! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA.
+//! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA;
+//!   [`reference`]: path-traced reference frames along a camera path.
 //! - [`delaunay3`]: the 3D Delaunay complex (x, y, t) of temporal volumes (a re-export of
 //!   [`plenoptic_recon::delaunay3`], which also slices it at reconstruction).
 //!
@@ -84,6 +85,7 @@ pub mod error;
 pub mod input;
 pub mod plan;
 pub mod progress;
+pub mod reference;
 pub mod render;
 pub mod volume;
 pub mod work;

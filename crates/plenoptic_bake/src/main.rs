@@ -18,7 +18,7 @@ use clap::{Parser, Subcommand};
 use plenoptic_bake::progress::Progress;
 use plenoptic_bake::{BakeError, BakeOptions, Result, Shard, plan};
 use plenoptic_pack::PackReader;
-use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
+use plenoptic_trace::SceneAccel;
 
 #[derive(Parser)]
 #[command(name = "plenoptic", version, about = "Bake and inspect radiance packs")]
@@ -444,39 +444,21 @@ fn cmd_reference(
     exposure: Option<f32>,
 ) -> Result<()> {
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
-    let camera_path = plenoptic_recon::CameraPath::load(path)
-        .map_err(|e| BakeError::Invalid(format!("{}: {e}", path.display())))?;
-    let accel = SceneAccel::new(&scene)?;
-    std::fs::create_dir_all(out).map_err(|e| BakeError::io(out, e))?;
-    let tracer = PathTracer::new(PathTracerSettings {
-        samples_per_pixel: spp.unwrap_or(recipe.quality.reference_samples_per_pixel),
-        ..Default::default()
-    });
-    let frames: Vec<_> = camera_path.frames().collect();
-    let bar = Progress::new(true).phase("reference", frames.len() as u64);
-    let mut exposure = exposure;
-    for f in frames {
-        let camera = f
-            .camera
-            .to_pinhole()
-            .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
-        let placed = accel.at_time(f.scene_time);
-        let image = tracer.render(&placed, &camera).radiance();
-        let e = *exposure
-            .get_or_insert_with(|| plenoptic_recon::frame_io::auto_exposure(&image.pixels));
-        plenoptic_recon::tools::write_frame_files(
-            out,
-            f.index,
-            image.width,
-            image.height,
-            &image.pixels,
-            None,
-            e,
-        )
-        .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    println!("reference frames written to {}", out.display());
+    let frames = plenoptic_bake::reference::path_frames(path)?;
+    let spp = spp.unwrap_or(recipe.quality.reference_samples_per_pixel);
+    let summary = plenoptic_bake::reference::render_reference(
+        &scene,
+        &frames,
+        spp,
+        out,
+        exposure,
+        &Progress::new(true),
+    )?;
+    println!(
+        "{} reference frames written to {} ({:.1} s per frame at {spp} spp)",
+        summary.frames,
+        out.display(),
+        summary.seconds_per_frame
+    );
     Ok(())
 }

@@ -1,0 +1,258 @@
+//! The windowed tour: a Bevy app with [`PlenopticPlugin`] showing the pack in a window.
+//!
+//! The camera flies the tour's path while the animation plays (the path sets both the pose
+//! and the scene time); `Tab` hands the camera to Bevy's free-fly controller (WASD, Q/E,
+//! mouse with the right button held or `M` to capture, scroll for speed) with the animation
+//! playing on the clock, and back. `Space` pauses, `1`/`2`/`3` switch the reconstruction
+//! mode (geometry-assisted, image, volume), `Esc` quits. The window title shows the frame
+//! rate, the scene time, the mode and the plugin's resident streaming memory; the peak
+//! resident memory is printed when the window closes.
+//!
+//! Exposure: the reconstruction writes linear radiance into the HDR target; the example sets
+//! the camera's colour-grading exposure from the CPU reconstruction's automatic exposure at
+//! the start of the path and tonemaps with ACES, the same curve as the headless frames.
+
+use std::path::Path;
+
+use bevy::camera::Hdr;
+use bevy::camera_controller::free_camera::{FreeCamera, FreeCameraPlugin, FreeCameraState};
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
+use bevy::prelude::*;
+use bevy::render::view::{ColorGrading, ColorGradingGlobal};
+use bevy::window::WindowResolution;
+use bevy_plenoptic::prelude::*;
+use bevy_plenoptic::streaming::RESIDENT_BYTES;
+use plenoptic_recon::CameraPath;
+
+/// What the window shows and how the camera is driven.
+#[derive(Resource)]
+struct Tour {
+    path: CameraPath,
+    /// Seconds along the camera path (advances while flying the tour and not paused).
+    path_time: f32,
+    /// The path drives the camera (else the free-fly controller does).
+    flying_tour: bool,
+    paused: bool,
+    /// Largest resident-bytes diagnostic seen.
+    peak_resident: f64,
+    title_timer: Timer,
+}
+
+/// Opens the window and runs the tour until it is closed.
+pub fn run(
+    pack: &Path,
+    path: CameraPath,
+    exposure: f32,
+    backend: Backend,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let dir = pack
+        .parent()
+        .and_then(|d| d.canonicalize().ok())
+        .ok_or_else(|| format!("{}: no parent folder", pack.display()))?;
+    let file = pack
+        .file_name()
+        .ok_or_else(|| format!("{}: not a file name", pack.display()))?
+        .to_string_lossy()
+        .into_owned();
+    let (width, height) = (path.width.max(320), path.height.max(180));
+
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(AssetPlugin {
+                file_path: dir.to_string_lossy().into_owned(),
+                ..default()
+            })
+            .set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: "plenoptic — architectural tour".into(),
+                    resolution: WindowResolution::new(width * 2, height * 2),
+                    ..default()
+                }),
+                ..default()
+            }),
+    )
+    .add_plugins((
+        PlenopticPlugin,
+        FreeCameraPlugin,
+        FrameTimeDiagnosticsPlugin::default(),
+    ))
+    .insert_resource(PlenopticSettings {
+        memory_budget_bytes: 512 << 20,
+        backend,
+        ..default()
+    })
+    .insert_resource(ClearColor(Color::BLACK))
+    .insert_resource(Tour {
+        path,
+        path_time: 0.0,
+        flying_tour: true,
+        paused: false,
+        peak_resident: 0.0,
+        title_timer: Timer::from_seconds(0.5, TimerMode::Repeating),
+    })
+    .add_systems(
+        Startup,
+        move |mut commands: Commands, assets: Res<AssetServer>, tour: Res<Tour>| {
+            let start = tour.path.sample(tour.path.time_range().0);
+            let mut camera = PlenopticCamera::new(assets.load(file.clone()));
+            camera.playback = Playback::Manual;
+            camera.time = start.scene_time;
+            commands.spawn((
+                camera,
+                Hdr,
+                Tonemapping::AcesFitted,
+                ColorGrading {
+                    global: ColorGradingGlobal {
+                        exposure: exposure.max(1e-6).log2(),
+                        ..default()
+                    },
+                    ..default()
+                },
+                Projection::Perspective(PerspectiveProjection {
+                    fov: start.camera.vfov,
+                    ..default()
+                }),
+                Transform::from_translation(start.camera.position)
+                    .with_rotation(start.camera.orientation),
+                FreeCamera {
+                    walk_speed: 2.0,
+                    run_speed: 6.0,
+                    ..default()
+                },
+            ));
+        },
+    )
+    .add_systems(
+        Update,
+        (keys, fly_tour.before(PlenopticSystems::Playback), title),
+    );
+    app.run();
+
+    let peak = app.world().resource::<Tour>().peak_resident;
+    println!(
+        "peak resident streaming memory: {:.1} MiB",
+        peak / (1024.0 * 1024.0)
+    );
+    Ok(())
+}
+
+/// Tab, Space, 1/2/3, Esc.
+fn keys(
+    input: Res<ButtonInput<KeyCode>>,
+    mut tour: ResMut<Tour>,
+    mut cameras: Query<(&mut PlenopticCamera, &mut FreeCameraState, &Transform)>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    if input.just_pressed(KeyCode::Escape) {
+        exit.write(AppExit::Success);
+    }
+    if input.just_pressed(KeyCode::Space) {
+        tour.paused = !tour.paused;
+    }
+    let toggle = input.just_pressed(KeyCode::Tab);
+    if toggle {
+        tour.flying_tour = !tour.flying_tour;
+    }
+    let mode = [
+        (KeyCode::Digit1, ReconMode::GeometryAssisted),
+        (KeyCode::Digit2, ReconMode::Image),
+        (KeyCode::Digit3, ReconMode::Volume),
+    ]
+    .into_iter()
+    .find(|(k, _)| input.just_pressed(*k))
+    .map(|(_, m)| m);
+    for (mut camera, mut free, transform) in &mut cameras {
+        if let Some(m) = mode {
+            camera.mode = m;
+        }
+        if toggle && !tour.flying_tour {
+            // Hand over where the tour left the camera.
+            let (yaw, pitch, _) = transform.rotation.to_euler(EulerRot::YXZ);
+            free.yaw = yaw;
+            free.pitch = pitch;
+            free.velocity = Vec3::ZERO;
+        }
+        free.enabled = !tour.flying_tour;
+        let speed = if tour.paused { 0.0 } else { 1.0 };
+        camera.playback = if tour.flying_tour {
+            Playback::Manual
+        } else {
+            Playback::Clock {
+                speed,
+                looping: true,
+            }
+        };
+    }
+}
+
+/// While flying the tour, the path sets the camera's pose, field of view and scene time.
+fn fly_tour(
+    time: Res<Time>,
+    mut tour: ResMut<Tour>,
+    mut cameras: Query<(&mut PlenopticCamera, &mut Transform, &mut Projection)>,
+) {
+    if !tour.flying_tour {
+        return;
+    }
+    let (start, end) = tour.path.time_range();
+    if !tour.paused {
+        tour.path_time += time.delta_secs();
+        if tour.path_time > end {
+            tour.path_time = start;
+        }
+    }
+    let s = tour.path.sample(tour.path_time);
+    for (mut camera, mut transform, mut projection) in &mut cameras {
+        camera.time = s.scene_time;
+        *transform =
+            Transform::from_translation(s.camera.position).with_rotation(s.camera.orientation);
+        if let Projection::Perspective(p) = projection.as_mut() {
+            p.fov = s.camera.vfov;
+        }
+    }
+}
+
+/// The window title: frame rate, scene time, mode, resident memory.
+fn title(
+    time: Res<Time>,
+    mut tour: ResMut<Tour>,
+    diagnostics: Res<DiagnosticsStore>,
+    cameras: Query<&PlenopticCamera>,
+    mut windows: Query<&mut Window>,
+) {
+    let resident = diagnostics
+        .get(&RESIDENT_BYTES)
+        .and_then(|d| d.value())
+        .unwrap_or(0.0);
+    tour.peak_resident = tour.peak_resident.max(resident);
+    if !tour.title_timer.tick(time.delta()).just_finished() {
+        return;
+    }
+    let fps = diagnostics
+        .get(&FrameTimeDiagnosticsPlugin::FPS)
+        .and_then(|d| d.smoothed())
+        .unwrap_or(0.0);
+    let Some(camera) = cameras.iter().next() else {
+        return;
+    };
+    let mode = match camera.mode {
+        ReconMode::GeometryAssisted => "geometry-assisted",
+        ReconMode::Image => "image",
+        ReconMode::Volume => "volume",
+    };
+    let driver = if tour.flying_tour {
+        "tour (Tab: free-fly)"
+    } else {
+        "free-fly WASD/QE, right mouse (Tab: tour)"
+    };
+    for mut window in &mut windows {
+        window.title = format!(
+            "plenoptic tour — {fps:.0} fps, t = {:.1} s, {mode}, resident {:.0} MiB — {driver}{}",
+            camera.time,
+            resident / (1024.0 * 1024.0),
+            if tour.paused { " — paused" } else { "" }
+        );
+    }
+}
