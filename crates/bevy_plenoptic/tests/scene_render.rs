@@ -178,19 +178,28 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
     );
 }
 
-/// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
-/// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
-/// camera and time.
-/// Renders the 3-view room at t = 0.7 with `backend` into an Rgba16Float target; returns
-/// (plugin frame, plenoptic_recon's CPU frame) as linear radiance.
-fn plugin_and_cpu_frames(backend: Backend) -> (Vec<Vec3>, Vec<Vec3>) {
+/// Renders the 3-view room (with `volume_samples` temporal-volume samples per view and
+/// bucket, 0 for none) at t = 0.7 with `backend` into an Rgba16Float target (no MSAA: the CPU
+/// frame samples pixel centres); returns (plugin frame, plenoptic_recon's CPU frame) as
+/// linear radiance and the CPU frame's fallback report.
+fn plugin_and_cpu_frames(
+    backend: Backend,
+    volume_samples: usize,
+) -> (Vec<Vec3>, Vec<Vec3>, plenoptic_recon::FallbackReport) {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::{Mode, Reconstructor};
     use std::cell::RefCell;
 
     let dir = tempfile::tempdir().unwrap();
-    room_pack(dir.path(), 3);
+    write_pack(
+        &room(true),
+        &PackSpec {
+            volume_samples,
+            ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
+        },
+        &dir.path().join("room.pack"),
+    );
     let (eye, t) = (Vec3::new(0.3, 1.3, 1.0), 0.7);
     let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y);
 
@@ -220,6 +229,7 @@ fn plugin_and_cpu_frames(backend: Backend) -> (Vec<Vec3>, Vec<Vec3>) {
     app.world_mut().spawn((
         camera_into(image.clone(), transform),
         Hdr,
+        Msaa::Off,
         PlenopticCamera {
             playback: Playback::Manual,
             time: t,
@@ -262,55 +272,67 @@ fn plugin_and_cpu_frames(backend: Backend) -> (Vec<Vec3>, Vec<Vec3>) {
     });
     let gpu = decode(&data);
 
-    (gpu, cpu.radiance)
+    (gpu, cpu.radiance, report.fallback)
 }
 
-#[test]
-fn gpu_frame_matches_cpu_reconstruction() {
-    let (gpu, cpu) = plugin_and_cpu_frames(Backend::Gpu);
-    let cpu = Frame { radiance: cpu };
-    // Error per pixel: the largest channel's |gpu − cpu| / (cpu + 0.02).
-    let (mut sum, mut within, mut within20, mut n) = (0.0f32, 0, 0, 0);
-    for (g, c) in gpu.iter().zip(&cpu.radiance) {
-        let err = ((*g - *c).abs() / (c.abs() + Vec3::splat(0.02))).max_element();
-        sum += err;
-        within += (err < 0.05) as usize;
-        within20 += (err < 0.2) as usize;
-        n += 1;
-    }
-    let mean = sum / n as f32;
+/// Compares the GPU frame with the CPU frame: (mean relative error, fraction of pixels within
+/// 5 %, within 20 %), with the error per pixel the largest channel's |gpu − cpu| / (cpu + 0.02).
+/// Prints an error map ('.' < 5 %, 'o' < 20 %, '#' worse).
+fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
+    let err =
+        |j: usize| ((gpu[j] - cpu[j]).abs() / (cpu[j].abs() + Vec3::splat(0.02))).max_element();
+    let n = cpu.len();
+    assert_eq!(gpu.len(), n);
     for y in 0..HEIGHT as usize {
         let row: String = (0..WIDTH as usize)
-            .map(|x| {
-                let j = y * WIDTH as usize + x;
-                let e = ((gpu[j] - cpu.radiance[j]).abs()
-                    / (cpu.radiance[j].abs() + Vec3::splat(0.02)))
-                .max_element();
-                if e < 0.05 {
-                    '.'
-                } else if e < 0.2 {
-                    'o'
-                } else {
-                    '#'
-                }
+            .map(|x| match err(y * WIDTH as usize + x) {
+                e if e < 0.05 => '.',
+                e if e < 0.2 => 'o',
+                _ => '#',
             })
             .collect();
         eprintln!("{row}");
     }
-    let frac = within as f32 / n as f32;
-    let frac20 = within20 as f32 / n as f32;
+    let mean = (0..n).map(err).sum::<f32>() / n as f32;
+    let frac = |limit: f32| (0..n).filter(|&j| err(j) < limit).count() as f32 / n as f32;
+    let (f5, f20) = (frac(0.05), frac(0.2));
     eprintln!(
-        "GPU vs CPU: mean relative error {mean:.4}, {:.1}% within 5%, {:.1}% within 20%",
-        100.0 * frac,
-        100.0 * frac20
+        "GPU vs CPU: mean relative error {mean:.5}, {:.2}% within 5%, {:.2}% within 20%",
+        100.0 * f5,
+        100.0 * f20
     );
-    // Measured on lavapipe: mean 0.16, 71 % within 5 %. The GPU path has no same-object hole
-    // fill (the CPU fills 15 % of this frame that way; the GPU shows the heaviest view's
-    // texel there), and silhouettes can differ by a pixel between rasterisation and the CPU
-    // mask. The error map above ('.' < 5 %, 'o' < 20 %, '#' worse) shows where.
+    (mean, f5, f20)
+}
+
+/// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
+/// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
+/// camera and time. A sixth of this frame has no accepted lookup and is filled from
+/// neighbouring pixels of the same object (the CPU's ring search; the GPU's in-shader search
+/// over the fragment's surface plane).
+#[test]
+fn gpu_frame_matches_cpu_reconstruction() {
+    let (gpu, cpu, fallback) = plugin_and_cpu_frames(Backend::Gpu, 0);
+    assert!(fallback.hole_fill > 0.1, "{fallback:?}");
+    let (mean, f5, f20) = compare(&gpu, &cpu);
+    // Measured on lavapipe: mean 0.0005, 99.97 % within 5 %, 100 % within 20 % (the rest is
+    // the f16 target's rounding). With Bevy's default 4× MSAA instead, silhouette pixels
+    // blend two objects: mean 0.020, 96.5 % within 5 %.
     assert!(
-        mean < 0.2 && frac > 0.65 && frac20 > 0.8,
-        "mean {mean}, within 5 %: {frac}, within 20 %: {frac20}"
+        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
+/// As above with temporal volumes in the pack: pixels that no time key sees take the volume
+/// samples of their object (on the GPU from the streamed, binned volume blocks).
+#[test]
+fn gpu_frame_matches_cpu_with_volume_fallback() {
+    let (gpu, cpu, fallback) = plugin_and_cpu_frames(Backend::Gpu, 3000);
+    assert!(fallback.volume > 0.02, "{fallback:?}");
+    let (mean, f5, f20) = compare(&gpu, &cpu);
+    assert!(
+        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
 }
 
@@ -318,7 +340,7 @@ fn gpu_frame_matches_cpu_reconstruction() {
 /// space): equal up to the f16 target's rounding.
 #[test]
 fn cpu_backend_shows_the_cpu_frame() {
-    let (shown, cpu) = plugin_and_cpu_frames(Backend::Cpu);
+    let (shown, cpu, _) = plugin_and_cpu_frames(Backend::Cpu, 0);
     let within = shown
         .iter()
         .zip(&cpu)
@@ -327,8 +349,4 @@ fn cpu_backend_shows_the_cpu_frame() {
         / cpu.len() as f32;
     eprintln!("CPU backend vs CPU frame: {:.1}% within 1%", 100.0 * within);
     assert!(within > 0.97, "{within}");
-}
-
-struct Frame {
-    radiance: Vec<Vec3>,
 }

@@ -6,22 +6,34 @@
 #import bevy_pbr::mesh_view_bindings::view
 
 const MAX_LOOKUPS: u32 = 16u;
+const MAX_VOLUMES: u32 = 8u;
+// Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
+const BIN_FACE: u32 = 16u;
 
 struct ReconParams {
     // x: lookup count, y: object id, z: face size (all as floats), w: unused.
     header: vec4<f32>,
     // x: depth tolerance, y: angular power.
     tuning: vec4<f32>,
+    // x: hole-fill radius (pixels), y: index of the heaviest lookup.
+    fill: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
-    // Per lookup: weight (x).
+    // Per lookup: weight (x), whether the key has normals (y).
     weight: array<vec4<f32>, 16>,
     // Per lookup: M_o(τ) M_o(t)⁻¹ of this material's object.
     motion: array<mat4x4<f32>, 16>,
+    // Per volume block: base view position (xyz), view weight (w).
+    volume: array<vec4<f32>, 8>,
+    // Per volume block: first sample (x), first bin offset (y).
+    volume_range: array<vec4<u32>, 8>,
 }
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ReconParams;
+// Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object, -, -).
+@group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
 
 fn rgb9e5_decode(v: u32) -> vec3<f32> {
     let e = f32(v >> 27u) - 15.0 - 9.0;
@@ -81,19 +93,15 @@ fn texel_direction(t: vec3<u32>, n: u32) -> vec3<f32> {
     return normalize(d);
 }
 
-@fragment
-fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+// The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
+fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let count = u32(params.header.x);
-    let object = u32(params.header.y);
     let n = u32(params.header.z);
     let tol = params.tuning.x;
     let power = params.tuning.y;
-    let p = in.world_position.xyz;
-    let to_eye = normalize(view.world_position - p);
+    let to_eye = normalize(eye - p);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
-    var fallback = vec3<f32>(0.0);
-    var fallback_w = -1.0;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let q = (params.motion[k] * vec4<f32>(p, 1.0)).xyz;
         let d = q - params.base[k].xyz;
@@ -104,11 +112,6 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
         let t = cube_texel(d, n);
         let layer = u32(params.base[k].w) + t.z;
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0);
-        let radiance = rgb9e5_decode(texel.x);
-        if params.weight[k].x > fallback_w {
-            fallback_w = params.weight[k].x;
-            fallback = radiance;
-        }
         if texel.z != object {
             continue;
         }
@@ -116,7 +119,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
         // Fast path: the texel's centre distance agrees. Otherwise compare with the distance
         // to the texel's surface plane along the lookup direction (grazing surfaces).
         if abs(dc - dist) > tol * dist {
-            if texel.w == 0u {
+            if params.weight[k].y == 0.0 {
                 continue;
             }
             let nrm = oct_decode(max(unpack2x16snorm(texel.w), vec2<f32>(-1.0)));
@@ -135,12 +138,149 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
             wa = pow(c, power);
         }
         let w = params.weight[k].x * wa;
-        sum += radiance * w;
+        sum += rgb9e5_decode(texel.x) * w;
         ws += w;
     }
-    if ws > 0.0 {
-        return vec4<f32>(sum / ws, 1.0);
+    return vec4<f32>(sum, ws);
+}
+
+// The temporal-volume fallback (plenoptic_recon's VolumeIndex::lookup, summed over the views
+// with their weights): samples of `object` in the direction bin of `p` from each base view,
+// whose cone contains that direction, whose distance agrees within 3× the depth tolerance and
+// whose time is within t ± tε, weighted by the tent filter and the angular falloff.
+// Returns (Σ w·radiance, Σ w).
+fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
+    let count = min(u32(params.header.w), MAX_VOLUMES);
+    let tol = params.tuning.x * 3.0;
+    let t = params.tuning.z;
+    let eps = params.tuning.w;
+    let half_bin = 1.0 / f32(BIN_FACE);
+    var sum = vec3<f32>(0.0);
+    var ws = 0.0;
+    for (var i = 0u; i < count; i++) {
+        let d = p - params.volume[i].xyz;
+        let dist = length(d);
+        if dist <= 1e-6 {
+            continue;
+        }
+        let dir = d / dist;
+        let bt = cube_texel(dir, BIN_FACE);
+        let bin = params.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
+        let first = params.volume_range[i].x;
+        let view_w = params.volume[i].w;
+        for (var j = volume_bins[bin]; j < volume_bins[bin + 1u]; j++) {
+            let s = 3u * (first + j);
+            let c = volume_samples[s + 2u];
+            if c.y != object {
+                continue;
+            }
+            let dt = abs(bitcast<f32>(c.x) - t);
+            if dt > eps {
+                continue;
+            }
+            let b = bitcast<vec4<f32>>(volume_samples[s + 1u]);
+            if abs(b.w - dist) > tol * dist {
+                continue;
+            }
+            let a = bitcast<vec4<f32>>(volume_samples[s]);
+            let angle = acos(clamp(dot(a.xyz, dir), -1.0, 1.0));
+            let r = max(a.w, half_bin);
+            if angle < r {
+                let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
+                sum += b.rgb * w;
+                ws += w;
+            }
+        }
     }
-    // No accepted lookup: the heaviest view's texel in the point's direction.
-    return vec4<f32>(fallback, 1.0);
+    return vec4<f32>(sum, ws);
+}
+
+// Direct lookups, else the temporal-volume fallback: (radiance, 1) or (0, 0) for a hole.
+fn reconstruct(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+    let direct = direct_lookups(p, eye, object);
+    if direct.w > 0.0 {
+        return vec4<f32>(direct.rgb / direct.w, 1.0);
+    }
+    let volume = volume_lookups(p, object);
+    if volume.w > 0.0 {
+        return vec4<f32>(volume.rgb / volume.w, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// The world point where pixel centre `c` (framebuffer coordinates) sees the plane through `p`
+// with normal `nrm`; w = 0 where the ray misses it.
+fn pixel_on_plane(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
+    let uv = (c - view.viewport.xy) / view.viewport.zw;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let a4 = view.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    let b4 = view.world_from_clip * vec4<f32>(ndc, 0.5, 1.0);
+    let a = a4.xyz / a4.w;
+    let dir = normalize(b4.xyz / b4.w - a);
+    let denom = dot(dir, nrm);
+    if abs(denom) < 1e-4 {
+        return vec4<f32>(0.0);
+    }
+    let s = dot(p - a, nrm) / denom;
+    if s <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(a + dir * s, 1.0);
+}
+
+@fragment
+fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    let object = u32(params.header.y);
+    let n = u32(params.header.z);
+    let p = in.world_position.xyz;
+    let eye = view.world_position;
+    // The surface plane (derivatives are taken before any non-uniform branch).
+    var nrm = cross(dpdx(p), dpdy(p));
+    if dot(nrm, nrm) < 1e-20 {
+        nrm = in.world_normal;
+    }
+    nrm = normalize(nrm);
+    let own = reconstruct(p, eye, object);
+    if own.w > 0.0 {
+        return vec4<f32>(own.rgb, 1.0);
+    }
+    // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
+    // this one whose points, on this fragment's surface plane, have a direct or volume
+    // lookup of this object; their mean.
+    let radius = i32(params.fill.x);
+    let centre = in.position.xy;
+    for (var r = 1; r <= radius; r++) {
+        var sum = vec3<f32>(0.0);
+        var count = 0.0;
+        for (var dy = -r; dy <= r; dy++) {
+            // Whole rows at the ring's top and bottom, the two ends elsewhere.
+            let step = select(2 * r, 1, abs(dy) == r);
+            for (var dx = -r; dx <= r; dx += step) {
+                let c = centre + vec2<f32>(f32(dx), f32(dy));
+                if any(c < view.viewport.xy) || any(c >= view.viewport.xy + view.viewport.zw) {
+                    continue;
+                }
+                let q = pixel_on_plane(c, p, nrm);
+                if q.w == 0.0 {
+                    continue;
+                }
+                let got = reconstruct(q.xyz, eye, object);
+                if got.w > 0.0 {
+                    sum += got.rgb;
+                    count += 1.0;
+                }
+            }
+        }
+        if count > 0.0 {
+            return vec4<f32>(sum / count, 1.0);
+        }
+    }
+    // Nothing: the heaviest key's texel in the point's direction ("background").
+    let h = u32(params.fill.y);
+    if h < min(u32(params.header.x), MAX_LOOKUPS) {
+        let t = cube_texel(p - params.base[h].xyz, n);
+        let layer = u32(params.base[h].w) + t.z;
+        return vec4<f32>(rgb9e5_decode(textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0).x), 1.0);
+    }
+    return vec4<f32>(0.0, 0.0, 0.0, 1.0);
 }

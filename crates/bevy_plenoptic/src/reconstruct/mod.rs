@@ -8,22 +8,34 @@
 //! weight `w_view · w_time · ((1 + cos θ)/2)^p`. The result is written unlit into the camera's
 //! HDR target; depth comes from the rasterised proxy mesh.
 //!
+//! Where no lookup is accepted, the same fallbacks as `plenoptic_recon`, in its order:
+//! 1. the temporal volumes ([`volume`]): samples of the object near the point's direction
+//!    from each base view, within `t ± tε`;
+//! 2. the same-object hole fill: the nearest ring of pixels (radius up to
+//!    [`HOLE_FILL_RADIUS`]) whose points have a direct or volume lookup of this object, their
+//!    mean. A fragment cannot read its neighbours' results, so it recomputes them: each ring
+//!    pixel's ray is intersected with the fragment's surface plane (from screen-space
+//!    derivatives) and that point is reconstructed. On planar faces this is the CPU's search
+//!    exactly; it differs where a neighbour pixel shows another face of the object, or another
+//!    object in front of the plane;
+//! 3. the heaviest key's texel in the point's direction ("background").
+//!
 //! Resident keys live in one `Rgba32Uint` 2D-array texture per pack: texel = (radiance as
 //! RGB9E5, distance as f32 bits, object id, oct-encoded RG16Snorm normal), six layers per
 //! streaming slot: the pack's own texel bytes interleaved, one binding and `textureLoad` only
-//! (distances and ids are not filterable anyway). Not implemented on the GPU: the temporal
-//! volume fallback and the same-object hole fill (pixels without an accepted lookup take the
-//! heaviest view's texel, `plenoptic_recon`'s "background" fallback).
+//! (distances and ids are not filterable anyway).
 
 pub mod cpu;
+pub mod volume;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use bevy::asset::{RenderAssetUsages, embedded_asset};
 use bevy::prelude::*;
 use bevy::render::render_resource::{
     AsBindGroup, Extent3d, ShaderType, TextureDimension, TextureFormat,
 };
+use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
 use plenoptic_recon::temporal::bracketing;
 use plenoptic_recon::viewspace::ViewWeights;
@@ -31,11 +43,14 @@ use plenoptic_recon::viewspace::ViewWeights;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::streaming::schedule::{time_epsilon, volume_buckets};
 use crate::streaming::{StreamCache, key_bytes};
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
+/// Radius, pixels, of the same-object hole fill (`plenoptic_recon`'s default).
+pub const HOLE_FILL_RADIUS: u32 = 12;
 /// Most array layers of the key texture (a common device limit is 2048).
 const MAX_LAYERS: u32 = 2046;
 
@@ -49,10 +64,16 @@ impl Plugin for PlenopticReconstructPlugin {
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
+            .init_resource::<volume::VolumeBuffers>()
             .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
-                (attach_materials, upload_keys, update_materials)
+                (
+                    upload_keys,
+                    volume::upload_volumes,
+                    attach_materials,
+                    update_materials,
+                )
                     .chain()
                     .after(PlenopticSystems::Streaming),
             );
@@ -112,6 +133,12 @@ pub struct PlenopticMaterial {
     /// Lookups of this frame for this material's object.
     #[uniform(1)]
     pub params: ReconParams,
+    /// Resident temporal-volume samples of the pack ([`volume::PackVolumes::samples`]).
+    #[storage(2, read_only)]
+    pub volume_samples: Handle<ShaderBuffer>,
+    /// Their bin offsets ([`volume::PackVolumes::bins`]).
+    #[storage(3, read_only)]
+    pub volume_bins: Handle<ShaderBuffer>,
 }
 
 impl Material for PlenopticMaterial {
@@ -123,16 +150,23 @@ impl Material for PlenopticMaterial {
 /// The per-frame uniform of a [`PlenopticMaterial`].
 #[derive(ShaderType, Debug, Clone, Default)]
 pub struct ReconParams {
-    /// x: lookup count, y: object id, z: face size.
+    /// x: lookup count, y: object id, z: face size, w: volume block count.
     pub header: Vec4,
-    /// x: relative depth tolerance, y: angular power.
+    /// x: relative depth tolerance, y: angular power, z: time t, w: temporal window tε.
     pub tuning: Vec4,
+    /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
+    /// "background" fallback; ≥ the lookup count when there is none).
+    pub fill: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
-    /// Weight (x) per lookup.
+    /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
     pub weight: [Vec4; MAX_LOOKUPS],
     /// `M_o(τ) M_o(t)⁻¹` per lookup.
     pub motion: [Mat4; MAX_LOOKUPS],
+    /// Base view position (xyz) and view weight (w) per volume block.
+    pub volume: [Vec4; volume::MAX_VOLUMES],
+    /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
+    pub volume_range: [UVec4; volume::MAX_VOLUMES],
 }
 
 /// The key texture of each pack and which key each slot holds.
@@ -150,12 +184,16 @@ pub struct KeyTexture {
     pub slots: u32,
     /// (view, key) uploaded in each slot.
     pub uploaded: HashMap<u32, (u32, u32)>,
+    /// Slots whose key came with normals (an all-zero texel is the +Z normal, so presence
+    /// cannot be read from the texels).
+    pub normals: HashSet<u32>,
 }
 
 fn attach_materials(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
+    volumes: Res<volume::VolumeBuffers>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
@@ -167,12 +205,17 @@ fn attach_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Some(tex) = keys.0.get(&scene.pack.id()) else {
+        let (Some(tex), Some(vol)) = (
+            keys.0.get(&scene.pack.id()),
+            volumes.0.get(&scene.pack.id()),
+        ) else {
             continue;
         };
         let m = materials.add(PlenopticMaterial {
             cubes: tex.image.clone(),
             params: ReconParams::default(),
+            volume_samples: vol.samples.clone(),
+            volume_bins: vol.bins.clone(),
         });
         commands
             .entity(entity)
@@ -216,6 +259,7 @@ fn upload_keys(
                 face,
                 slots,
                 uploaded: HashMap::new(),
+                normals: HashSet::new(),
             }
         });
         let fresh: Vec<_> = cache
@@ -250,19 +294,25 @@ fn upload_keys(
                 );
                 continue;
             }
+            let normals = d.normal.as_ref().filter(|n| n.len() == texels * 4);
             let base = r.slot as usize * texels * 16;
             for i in 0..texels {
                 let o = base + i * 16;
                 data[o..o + 4].copy_from_slice(&d.radiance[i * 4..i * 4 + 4]);
                 data[o + 4..o + 8].copy_from_slice(&d.distance[i * 4..i * 4 + 4]);
                 data[o + 8..o + 12].copy_from_slice(&d.object_id[i * 4..i * 4 + 4]);
-                // Oct-encoded RG16Snorm normal (zero: none; the shader then skips the plane
-                // test, as plenoptic_recon does without normals).
-                if let Some(n) = d.normal.as_ref().filter(|n| n.len() == texels * 4) {
+                // Oct-encoded RG16Snorm normal (without normals the shader skips the plane
+                // test, as plenoptic_recon does).
+                if let Some(n) = normals {
                     data[o + 12..o + 16].copy_from_slice(&n[i * 4..i * 4 + 4]);
                 }
             }
             tex.uploaded.insert(r.slot, vk);
+            if normals.is_some() {
+                tex.normals.insert(r.slot);
+            } else {
+                tex.normals.remove(&r.slot);
+            }
         }
     }
 }
@@ -271,6 +321,7 @@ fn upload_keys(
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn update_materials(
     keys: Res<KeyTextures>,
+    volumes: Res<volume::VolumeBuffers>,
     cache: Res<StreamCache>,
     settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
@@ -304,9 +355,24 @@ fn update_materials(
             tuning: Vec4::new(0.03, 8.0, 0.0, 0.0),
             ..default()
         };
+        let views: Vec<(usize, f32)> = views
+            .into_iter()
+            .map(|(v, w)| (v, if s > 0.0 { w / s } else { w }))
+            .collect();
+        let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
+        volume::fill_params(
+            &mut params,
+            volumes.0.get(&id),
+            &views,
+            &positions,
+            volume_buckets(m, cam.time),
+            cam.time,
+            time_epsilon(m),
+        );
         let mut n = 0;
+        // (weight, index) of the heaviest lookup.
+        let mut heaviest = (f32::NEG_INFINITY, MAX_LOOKUPS);
         for (v, w) in views {
-            let w = if s > 0.0 { w / s } else { w };
             let bv = &m.base_views[v];
             let Some((k0, k1, f)) = bracketing(&bv.time_keys, cam.time) else {
                 continue;
@@ -333,13 +399,22 @@ fn update_materials(
                     .proxy(of.id)
                     .map_or(Mat4::IDENTITY, |p| p.transform_at(tau).to_matrix())
                     * inv_now;
+                if w * wt / total >= heaviest.0 {
+                    heaviest = (w * wt / total, n);
+                }
                 params.base[n] = bv.position.extend((slot * 6) as f32);
-                params.weight[n] = Vec4::new(w * wt / total, 0.0, 0.0, 0.0);
+                let normals = if tex.normals.contains(&slot) {
+                    1.0
+                } else {
+                    0.0
+                };
+                params.weight[n] = Vec4::new(w * wt / total, normals, 0.0, 0.0);
                 params.motion[n] = motion;
                 n += 1;
             }
         }
         params.header.x = n as f32;
+        params.fill = Vec4::new(HOLE_FILL_RADIUS as f32, heaviest.1 as f32, 0.0, 0.0);
         if let Some(mut mat) = materials.get_mut(&handle.0) {
             mat.params = params;
         }

@@ -13,6 +13,10 @@
 //! outside the current working set are evicted. While a needed key is missing the frame is
 //! reconstructed from what is resident (a *stall* is counted).
 //!
+//! The temporal-volume blocks of the needed base views around t (the GPU reconstruction's
+//! fallback) are streamed the same way, inside the same budget and LRU, when the pack has them:
+//! decoded and binned by direction ([`BinnedVolume`]) off the main thread.
+//!
 //! Each resident key sits in a fixed-size slot (`slot` < budget / key bytes): the index of its
 //! layer range in the cube-array textures the GPU reconstruction samples.
 
@@ -25,12 +29,12 @@ use std::time::{Duration, Instant};
 use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnostic};
 use bevy::prelude::*;
 use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
-use plenoptic_pack::{ChunkKind, PackReader, ktx, range_image};
+use plenoptic_pack::{ChunkKind, PackReader, cube, ktx, range_image};
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::{PlenopticEvent, PlenopticSettings, PlenopticSystems};
-use schedule::{KeyRef, Lookahead, working_set};
+use schedule::{BlockRef, KeyRef, Lookahead, working_set};
 
 /// Bytes of decoded cube data resident (and reserved for reads in flight).
 pub const RESIDENT_BYTES: DiagnosticPath = DiagnosticPath::const_new("plenoptic/resident_bytes");
@@ -171,6 +175,97 @@ pub fn key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
     .sum()
 }
 
+/// Face size of the direction bins of a [`BinnedVolume`] (`plenoptic_recon`'s
+/// `VolumeIndex` bins the same way).
+pub const VOLUME_BIN_FACE: u32 = 16;
+/// Number of bin offsets of a [`BinnedVolume`]: one per bin and the end.
+pub const VOLUME_BIN_OFFSETS: usize = 6 * (VOLUME_BIN_FACE * VOLUME_BIN_FACE) as usize + 1;
+/// 32-bit words per sample of a [`BinnedVolume`].
+pub const VOLUME_SAMPLE_WORDS: usize = 12;
+
+/// A temporal-volume block ready for the GPU: its samples sorted by direction bin (a cube of
+/// [`VOLUME_BIN_FACE`]² texels per face, bin = `cube::direction_to_texel`), each as
+/// [`VOLUME_SAMPLE_WORDS`] words `(direction.xyz, radius, radiance.rgb, distance, t, object
+/// id, 0, 0)` (floats as their bits), and the offset of each bin's first sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BinnedVolume {
+    /// Sample words, bin by bin.
+    pub words: Vec<u32>,
+    /// [`VOLUME_BIN_OFFSETS`] sample offsets: bin `b` holds samples `bins[b]..bins[b + 1]`.
+    pub bins: Vec<u32>,
+}
+
+impl BinnedVolume {
+    /// Bytes held.
+    pub fn bytes(&self) -> u64 {
+        4 * (self.words.len() + self.bins.len()) as u64
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.words.len() / VOLUME_SAMPLE_WORDS
+    }
+
+    /// True if it has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.words.is_empty()
+    }
+}
+
+/// Reads, decodes and bins one temporal-volume block. The error names the chunk.
+pub fn decode_volume(
+    pack: &PackReader,
+    (view, bucket): BlockRef,
+) -> Result<BinnedVolume, (String, String)> {
+    let block = pack.volume_block(view, bucket).map_err(|e| {
+        (
+            format!("VolumeBlock view {view} bucket {bucket}"),
+            e.to_string(),
+        )
+    })?;
+    let bin: Vec<usize> = block
+        .samples
+        .iter()
+        .map(|s| cube::direction_to_texel(VOLUME_BIN_FACE, s.direction))
+        .collect();
+    let mut bins = vec![0u32; VOLUME_BIN_OFFSETS];
+    for &b in &bin {
+        bins[b + 1] += 1;
+    }
+    for i in 0..VOLUME_BIN_OFFSETS - 1 {
+        bins[i + 1] += bins[i];
+    }
+    let mut fill = bins.clone();
+    let mut words = vec![0u32; block.samples.len() * VOLUME_SAMPLE_WORDS];
+    for (s, &b) in block.samples.iter().zip(&bin) {
+        let o = fill[b] as usize * VOLUME_SAMPLE_WORDS;
+        fill[b] += 1;
+        let f = [
+            s.direction.x,
+            s.direction.y,
+            s.direction.z,
+            s.radius,
+            s.radiance.x,
+            s.radiance.y,
+            s.radiance.z,
+            s.distance,
+            s.t,
+        ];
+        for (w, x) in words[o..o + 9].iter_mut().zip(f) {
+            *w = x.to_bits();
+        }
+        words[o + 9] = s.object_id;
+    }
+    Ok(BinnedVolume { words, bins })
+}
+
+/// Bytes a volume block will occupy once binned, from the directory (known before reading):
+/// twice its stored sample bytes (48 against 24 per sample) plus the bin offsets.
+pub fn volume_bytes(pack: &PackReader, (view, bucket): BlockRef) -> Option<u64> {
+    let i = pack.find(ChunkKind::VolumeBlock, view, bucket)?;
+    Some(2 * pack.entries()[i].uncompressed_length + 4 * VOLUME_BIN_OFFSETS as u64)
+}
+
 /// A resident key.
 #[derive(Debug, Clone)]
 pub struct Resident {
@@ -184,17 +279,42 @@ pub struct Resident {
     pub slot: u32,
 }
 
+/// A resident temporal-volume block.
+#[derive(Debug, Clone)]
+pub struct ResidentVolume {
+    /// Its binned samples.
+    pub data: Arc<BinnedVolume>,
+    /// Bytes reserved for it.
+    pub bytes: u64,
+    /// Frame it was last in a working set (LRU).
+    pub last_used: u64,
+}
+
 type DecodeResult = (Result<DecodedKey, (String, String)>, Duration);
 /// Reserved bytes, slot and the decode task of a key being read.
 type InFlight = (u64, u32, Task<DecodeResult>);
+type VolumeResult = (Result<BinnedVolume, (String, String)>, Duration);
+/// (pack, view, key or bucket).
+type CacheKey = (AssetId<RadiancePack>, u32, u32);
 
-/// Resident and in-flight keys of every pack, keyed by (pack, view, key).
+/// What the cache streams.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Unit {
+    Key(KeyRef),
+    Volume(BlockRef),
+}
+
+/// Resident and in-flight keys and volume blocks of every pack, keyed by (pack, view, key)
+/// and (pack, view, bucket).
 #[derive(Resource, Default)]
 pub struct StreamCache {
     /// Resident keys.
-    pub resident: HashMap<(AssetId<RadiancePack>, u32, u32), Resident>,
-    in_flight: HashMap<(AssetId<RadiancePack>, u32, u32), InFlight>,
-    failed: HashMap<(AssetId<RadiancePack>, u32, u32), String>,
+    pub resident: HashMap<CacheKey, Resident>,
+    /// Resident temporal-volume blocks.
+    pub volumes: HashMap<CacheKey, ResidentVolume>,
+    in_flight: HashMap<CacheKey, InFlight>,
+    volumes_in_flight: HashMap<CacheKey, (u64, Task<VolumeResult>)>,
+    failed: HashMap<(AssetId<RadiancePack>, Unit), String>,
     frame: u64,
     free_slots: Vec<u32>,
     next_slot: u32,
@@ -205,6 +325,48 @@ impl StreamCache {
     pub fn committed_bytes(&self) -> u64 {
         self.resident.values().map(|r| r.bytes).sum::<u64>()
             + self.in_flight.values().map(|f| f.0).sum::<u64>()
+            + self.volumes.values().map(|r| r.bytes).sum::<u64>()
+            + self.volumes_in_flight.values().map(|f| f.0).sum::<u64>()
+    }
+
+    /// The resident volume block `(view, bucket)` of `pack`.
+    pub fn volume(&self, pack: AssetId<RadiancePack>, b: BlockRef) -> Option<&ResidentVolume> {
+        self.volumes.get(&(pack, b.0, b.1))
+    }
+
+    /// Evicts the least recently used key or volume block outside `protected`; false when
+    /// there is none.
+    fn evict_one(
+        &mut self,
+        protected: &[(AssetId<RadiancePack>, Unit)],
+        stats: &mut StreamingStats,
+    ) -> bool {
+        let key = self
+            .resident
+            .iter()
+            .filter(|(k, _)| !protected.contains(&(k.0, Unit::Key((k.1, k.2)))))
+            .min_by_key(|(_, r)| r.last_used)
+            .map(|(k, r)| (r.last_used, *k, false));
+        let volume = self
+            .volumes
+            .iter()
+            .filter(|(k, _)| !protected.contains(&(k.0, Unit::Volume((k.1, k.2)))))
+            .min_by_key(|(_, r)| r.last_used)
+            .map(|(k, r)| (r.last_used, *k, true));
+        let victim = match (key, volume) {
+            (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
+            (a, b) => a.or(b),
+        };
+        let Some((_, k, is_volume)) = victim else {
+            return false;
+        };
+        if is_volume {
+            self.volumes.remove(&k);
+        } else if let Some(r) = self.resident.remove(&k) {
+            self.free_slots.push(r.slot);
+        }
+        stats.evictions += 1;
+        true
     }
 
     /// The resident key `(view, key)` of `pack`.
@@ -254,7 +416,39 @@ fn collect_finished(
             Err((chunk, reason)) => {
                 warn!("plenoptic: chunk {chunk} failed: {reason}");
                 cache.free_slots.push(slot);
-                cache.failed.insert(k, reason.clone());
+                cache
+                    .failed
+                    .insert((k.0, Unit::Key((k.1, k.2))), reason.clone());
+                events.write(PlenopticEvent::ChunkFailed { chunk, reason });
+            }
+        }
+    }
+    let done: Vec<_> = cache
+        .volumes_in_flight
+        .iter_mut()
+        .filter_map(|(k, (_, task))| check_ready(task).map(|r| (*k, r)))
+        .collect();
+    for (k, (result, time)) in done {
+        let (bytes, _) = cache.volumes_in_flight.remove(&k).expect("in flight");
+        decode += time;
+        match result {
+            Ok(data) => {
+                stats.decoded_bytes += data.bytes();
+                debug_assert!(data.bytes() <= bytes, "directory under-declared a block");
+                cache.volumes.insert(
+                    k,
+                    ResidentVolume {
+                        data: Arc::new(data),
+                        bytes,
+                        last_used: frame,
+                    },
+                );
+            }
+            Err((chunk, reason)) => {
+                warn!("plenoptic: chunk {chunk} failed: {reason}");
+                cache
+                    .failed
+                    .insert((k.0, Unit::Volume((k.1, k.2))), reason.clone());
                 events.write(PlenopticEvent::ChunkFailed { chunk, reason });
             }
         }
@@ -283,7 +477,7 @@ fn schedule_reads(
         views: settings.max_views.max(1),
         seconds: settings.prefetch_seconds,
     };
-    let mut wanted: Vec<(AssetId<RadiancePack>, Arc<PackReader>, KeyRef, bool)> = Vec::new();
+    let mut wanted: Vec<(AssetId<RadiancePack>, Arc<PackReader>, Unit, bool)> = Vec::new();
     for (cam, mut state, transform) in &mut cameras {
         let Some(pack) = packs.get(&cam.pack) else {
             continue;
@@ -300,7 +494,7 @@ fn schedule_reads(
             crate::Playback::Clock { speed, .. } => speed,
             crate::Playback::Manual => 0.0,
         };
-        let set = working_set(
+        let mut set = working_set(
             pack.reader.manifest(),
             position,
             velocity,
@@ -308,6 +502,9 @@ fn schedule_reads(
             speed,
             look,
         );
+        // Volume blocks are optional: only those the pack has.
+        set.volumes
+            .retain(|b| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some());
         let mut complete = true;
         for &k in &set.needed {
             match cache.resident.get_mut(&(id, k.0, k.1)) {
@@ -320,60 +517,81 @@ fn schedule_reads(
                     complete = false;
                 }
             }
-            wanted.push((id, pack.reader.clone(), k, true));
+            wanted.push((id, pack.reader.clone(), Unit::Key(k), true));
+        }
+        for &b in &set.volumes {
+            match cache.volumes.get_mut(&(id, b.0, b.1)) {
+                Some(r) => {
+                    r.last_used = frame;
+                    hits += 1;
+                }
+                None => {
+                    misses += 1;
+                    complete = false;
+                }
+            }
+            wanted.push((id, pack.reader.clone(), Unit::Volume(b), true));
         }
         for &k in &set.prefetch {
             if let Some(r) = cache.resident.get_mut(&(id, k.0, k.1)) {
                 r.last_used = frame;
             }
-            wanted.push((id, pack.reader.clone(), k, false));
+            wanted.push((id, pack.reader.clone(), Unit::Key(k), false));
         }
         stalled |= !complete;
         state.complete = complete;
         state.working_set = set;
     }
-    // Needed keys first, then prefetch, each in the camera's priority order.
+    // Needed keys and blocks first, then prefetch, each in the camera's priority order.
     wanted.sort_by_key(|w| !w.3);
-    let protected: Vec<_> = wanted.iter().map(|w| (w.0, w.2.0, w.2.1)).collect();
+    let protected: Vec<_> = wanted.iter().map(|w| (w.0, w.2)).collect();
     let pool = IoTaskPool::get();
-    for (id, reader, k, _) in wanted {
-        let key = (id, k.0, k.1);
-        if cache.in_flight.len() >= MAX_IN_FLIGHT {
+    for (id, reader, unit, _) in wanted {
+        let (Unit::Key((a, b)) | Unit::Volume((a, b))) = unit;
+        let is_volume = matches!(unit, Unit::Volume(_));
+        let key = (id, a, b);
+        if cache.in_flight.len() + cache.volumes_in_flight.len() >= MAX_IN_FLIGHT {
             break;
         }
-        if cache.resident.contains_key(&key)
-            || cache.in_flight.contains_key(&key)
-            || cache.failed.contains_key(&key)
-        {
+        let present = if is_volume {
+            cache.volumes.contains_key(&key) || cache.volumes_in_flight.contains_key(&key)
+        } else {
+            cache.resident.contains_key(&key) || cache.in_flight.contains_key(&key)
+        };
+        if present || cache.failed.contains_key(&(id, unit)) {
             continue;
         }
-        let bytes = key_bytes(&reader, k);
+        let bytes = match unit {
+            Unit::Key(k) => key_bytes(&reader, k),
+            Unit::Volume(v) => volume_bytes(&reader, v).unwrap_or(u64::MAX),
+        };
         if bytes > budget {
             continue;
         }
-        // Evict least recently used keys outside every working set until it fits.
-        while cache.committed_bytes() + bytes > budget {
-            let victim = cache
-                .resident
-                .iter()
-                .filter(|(k, _)| !protected.contains(k))
-                .min_by_key(|(_, r)| r.last_used)
-                .map(|(k, _)| *k);
-            let Some(victim) = victim else { break };
-            let r = cache.resident.remove(&victim).expect("resident");
-            cache.free_slots.push(r.slot);
-            stats.evictions += 1;
-        }
+        // Evict least recently used keys and blocks outside every working set until it fits.
+        while cache.committed_bytes() + bytes > budget && cache.evict_one(&protected, &mut stats) {}
         if cache.committed_bytes() + bytes > budget {
             continue;
         }
-        let slot = cache.alloc_slot();
-        let task = pool.spawn(async move {
-            let start = Instant::now();
-            let r = decode_key(&reader, k);
-            (r, start.elapsed())
-        });
-        cache.in_flight.insert(key, (bytes, slot, task));
+        match unit {
+            Unit::Key(k) => {
+                let slot = cache.alloc_slot();
+                let task = pool.spawn(async move {
+                    let start = Instant::now();
+                    let r = decode_key(&reader, k);
+                    (r, start.elapsed())
+                });
+                cache.in_flight.insert(key, (bytes, slot, task));
+            }
+            Unit::Volume(v) => {
+                let task = pool.spawn(async move {
+                    let start = Instant::now();
+                    let r = decode_volume(&reader, v);
+                    (r, start.elapsed())
+                });
+                cache.volumes_in_flight.insert(key, (bytes, task));
+            }
+        }
     }
     let committed = cache.committed_bytes();
     debug_assert!(committed <= budget, "budget exceeded");

@@ -8,6 +8,24 @@ use plenoptic_pack::Manifest;
 /// `view` (index into the manifest's base views) at time key `key`.
 pub type KeyRef = (u32, u32);
 
+/// One temporal-volume block: (base view, time bucket).
+pub type BlockRef = (u32, u32);
+
+/// The buckets whose samples can fall in the temporal filter window `t ± tε`, with
+/// `plenoptic_recon`'s default `tε` (half the bucket span, [`time_epsilon`]).
+pub fn volume_buckets(manifest: &Manifest, t: f32) -> std::ops::RangeInclusive<u32> {
+    let eps = time_epsilon(manifest);
+    let b0 = manifest.bucket_of(t - eps);
+    let b1 = manifest.bucket_of(t + eps);
+    b0..=b1.min(b0.saturating_add(64))
+}
+
+/// Half-width tε of the temporal filter window: half the bucket span, as in
+/// `plenoptic_recon`'s default settings.
+pub fn time_epsilon(manifest: &Manifest) -> f32 {
+    (manifest.bucket_span * 0.5).max(1e-6)
+}
+
 /// Indices of the `count` base views nearest `position`, nearest first.
 pub fn nearest_views(manifest: &Manifest, position: Vec3, count: usize) -> Vec<u32> {
     let mut views: Vec<(f32, u32)> = manifest
@@ -47,6 +65,9 @@ pub struct WorkingSet {
     /// Wanted soon (along the camera's motion and the playback direction); loaded only when
     /// the budget allows, never evicting needed data.
     pub prefetch: Vec<KeyRef>,
+    /// Temporal-volume blocks of the needed base views around t (the GPU reconstruction's
+    /// fallback where no time key sees a point); only those the pack has are read.
+    pub volumes: Vec<BlockRef>,
 }
 
 /// Parameters of [`working_set`].
@@ -77,6 +98,9 @@ pub fn working_set(
     for v in nearest_views(manifest, position, look.views) {
         for k in bracketing_keys(&manifest.base_views[v as usize].time_keys, t) {
             push(&mut set.needed, &[], (v, k));
+        }
+        for b in volume_buckets(manifest, t) {
+            set.volumes.push((v, b));
         }
     }
     let future_pos = position + velocity * look.seconds;
@@ -137,5 +161,9 @@ mod tests {
         // Moving +x at 3 m/s: views 3 and 4 (near x = 3.1) are prefetched, at t = 0.5 and 1.5.
         assert!(s.prefetch.contains(&(3, 1)) && s.prefetch.contains(&(3, 2)));
         assert!(s.prefetch.iter().all(|k| !s.needed.contains(k)));
+        // Buckets of 0.5 s, tε = 0.25 s: t = 0.5 needs buckets 0 and 1 of both views.
+        assert_eq!(s.volumes, vec![(0, 0), (0, 1), (1, 0), (1, 1)]);
+        assert_eq!(volume_buckets(&m, 0.2), 0..=0);
+        assert_eq!(volume_buckets(&m, 0.8), 1..=2);
     }
 }

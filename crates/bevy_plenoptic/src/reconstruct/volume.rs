@@ -1,0 +1,139 @@
+//! The temporal-volume fallback of the GPU reconstruction (`plenoptic_recon`'s
+//! `VolumeIndex`): where no time key has an accepted lookup, the fragment blends the volume
+//! samples of its object whose cone contains its direction from a base view, whose distance
+//! agrees (3× the depth tolerance) and whose time is within `t ± tε` (tent filter).
+//!
+//! Every resident volume block of a pack ([`crate::streaming::BinnedVolume`]: samples sorted
+//! by direction bin, and the bins' offsets) is packed into two storage buffers per pack,
+//! rebuilt when the set of resident blocks changes; each block's place in them is passed
+//! per frame in the material's uniform ([`ReconParams::volume_range`]).
+
+use std::collections::HashMap;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::storage::ShaderBuffer;
+
+use super::ReconParams;
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+use crate::streaming::schedule::BlockRef;
+use crate::streaming::{StreamCache, VOLUME_BIN_OFFSETS, VOLUME_SAMPLE_WORDS};
+
+/// Most (base view, bucket) volume blocks a fragment searches.
+pub const MAX_VOLUMES: usize = 8;
+
+/// The volume storage buffers of each pack.
+#[derive(Resource, Debug, Default)]
+pub struct VolumeBuffers(pub HashMap<AssetId<RadiancePack>, PackVolumes>);
+
+/// One pack's volume buffers.
+#[derive(Debug, Clone)]
+pub struct PackVolumes {
+    /// Sample words of every resident block, block after block (`array<vec4<u32>>`, three
+    /// per sample).
+    pub samples: Handle<ShaderBuffer>,
+    /// Bin offsets of every resident block ([`VOLUME_BIN_OFFSETS`] per block).
+    pub bins: Handle<ShaderBuffer>,
+    /// Per block in the buffers: (first sample, first bin offset).
+    pub layout: HashMap<BlockRef, (u32, u32)>,
+}
+
+impl PackVolumes {
+    fn new(buffers: &mut Assets<ShaderBuffer>) -> Self {
+        // Bindings may not be empty: one zero sample and one zero bin block.
+        PackVolumes {
+            samples: buffers.add(storage(&[0; VOLUME_SAMPLE_WORDS])),
+            bins: buffers.add(storage(&[0; VOLUME_BIN_OFFSETS])),
+            layout: HashMap::new(),
+        }
+    }
+}
+
+fn storage(words: &[u32]) -> ShaderBuffer {
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    ShaderBuffer::new(&bytes, RenderAssetUsages::RENDER_WORLD)
+}
+
+/// Creates each shown pack's volume buffers and repacks them when its set of resident
+/// volume blocks changes.
+pub(super) fn upload_volumes(
+    mut volumes: ResMut<VolumeBuffers>,
+    cache: Res<StreamCache>,
+    cameras: Query<&PlenopticCamera>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+) {
+    for cam in &cameras {
+        let id = cam.pack.id();
+        let pv = volumes
+            .0
+            .entry(id)
+            .or_insert_with(|| PackVolumes::new(&mut buffers));
+        let mut resident: Vec<_> = cache
+            .volumes
+            .iter()
+            .filter(|(k, _)| k.0 == id)
+            .map(|(k, r)| ((k.1, k.2), r))
+            .collect();
+        if resident.len() == pv.layout.len()
+            && resident.iter().all(|(b, _)| pv.layout.contains_key(b))
+        {
+            continue;
+        }
+        resident.sort_by_key(|(b, _)| *b);
+        let mut words = Vec::new();
+        let mut bins = Vec::new();
+        let mut layout = HashMap::new();
+        for (b, r) in resident {
+            layout.insert(
+                b,
+                (
+                    (words.len() / VOLUME_SAMPLE_WORDS) as u32,
+                    bins.len() as u32,
+                ),
+            );
+            words.extend_from_slice(&r.data.words);
+            bins.extend_from_slice(&r.data.bins);
+        }
+        words.resize(words.len().max(VOLUME_SAMPLE_WORDS), 0);
+        bins.resize(bins.len().max(VOLUME_BIN_OFFSETS), 0);
+        if let Some(mut s) = buffers.get_mut(&pv.samples) {
+            *s = storage(&words);
+        }
+        if let Some(mut s) = buffers.get_mut(&pv.bins) {
+            *s = storage(&bins);
+        }
+        pv.layout = layout;
+    }
+}
+
+/// Fills the volume entries of `params` for the views `views` (index, normalised weight)
+/// at the buckets `buckets`, from the blocks uploaded in `pv`; `eps` is tε.
+pub(super) fn fill_params(
+    params: &mut ReconParams,
+    pv: Option<&PackVolumes>,
+    views: &[(usize, f32)],
+    positions: &[Vec3],
+    buckets: std::ops::RangeInclusive<u32>,
+    t: f32,
+    eps: f32,
+) {
+    let Some(pv) = pv else { return };
+    let mut n = 0;
+    for &(v, w) in views {
+        for b in buckets.clone() {
+            let Some(&(sample, bin)) = pv.layout.get(&(v as u32, b)) else {
+                continue;
+            };
+            if n == MAX_VOLUMES {
+                break;
+            }
+            params.volume[n] = positions[v].extend(w);
+            params.volume_range[n] = UVec4::new(sample, bin, 0, 0);
+            n += 1;
+        }
+    }
+    params.header.w = n as f32;
+    params.tuning.z = t;
+    params.tuning.w = eps;
+}
