@@ -7,7 +7,8 @@ mod common;
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::proxy::ProxyOf;
-use bevy_plenoptic::streaming::{StreamState, StreamingStats};
+use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
+use bevy_plenoptic::streaming::{StreamState, StreamingStats, key_bytes};
 use common::pack::{PackSpec, room, write_pack};
 use common::*;
 
@@ -178,33 +179,51 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
     );
 }
 
+/// What [`plugin_and_cpu_frames`] returns.
+struct Frames {
+    /// The plugin's frame, linear radiance.
+    gpu: Vec<Vec3>,
+    /// plenoptic_recon's CPU frame.
+    cpu: Vec<Vec3>,
+    /// The CPU frame's fallbacks.
+    fallback: plenoptic_recon::FallbackReport,
+    /// Streaming counters at the end.
+    stats: StreamingStats,
+    /// Key uploads at the end.
+    uploads: KeyUploadStats,
+}
+
 /// Renders the 3-view room (with `volume_samples` temporal-volume samples per view and
 /// bucket, 0 for none) at t = 0.7 with `backend` into an Rgba16Float target (no MSAA: the CPU
-/// frame samples pixel centres); returns (plugin frame, plenoptic_recon's CPU frame) as
-/// linear radiance and the CPU frame's fallback report.
+/// frame samples pixel centres), and plenoptic_recon's CPU frame of the same pack, camera and
+/// time. With `budget_keys`, the memory budget holds that many keys and the camera first
+/// shows t = 1.7 then t = 0.3, each until its keys are resident, so that keys are evicted and
+/// their slots of the key texture reused before the compared frame.
 fn plugin_and_cpu_frames(
     backend: Backend,
     volume_samples: usize,
-) -> (Vec<Vec3>, Vec<Vec3>, plenoptic_recon::FallbackReport) {
+    budget_keys: Option<u64>,
+) -> Frames {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::{Mode, Reconstructor};
     use std::cell::RefCell;
 
     let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("room.pack");
     write_pack(
         &room(true),
         &PackSpec {
             volume_samples,
             ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
         },
-        &dir.path().join("room.pack"),
+        &path,
     );
     let (eye, t) = (Vec3::new(0.3, 1.3, 1.0), 0.7);
     let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y);
 
     // CPU reference.
-    let rec = Reconstructor::open(dir.path().join("room.pack")).unwrap();
+    let rec = Reconstructor::open(&path).unwrap();
     let cam = plenoptic_recon::Camera::new(
         eye,
         transform.rotation,
@@ -218,7 +237,14 @@ fn plugin_and_cpu_frames(
 
     // GPU.
     let mut app = headless_app_in(dir.path());
-    app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
+    {
+        let mut settings = app.world_mut().resource_mut::<PlenopticSettings>();
+        settings.backend = backend;
+        if let Some(n) = budget_keys {
+            let reader = plenoptic_pack::PackReader::open(&path).unwrap();
+            settings.memory_budget_bytes = n * key_bytes(&reader, (0, 0));
+        }
+    }
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
     let image = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
@@ -226,13 +252,18 @@ fn plugin_and_cpu_frames(
         img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         images.add(img)
     };
+    let detour: &[f32] = if budget_keys.is_some() {
+        &[1.7, 0.3, t]
+    } else {
+        &[t]
+    };
     app.world_mut().spawn((
         camera_into(image.clone(), transform),
         Hdr,
         Msaa::Off,
         PlenopticCamera {
             playback: Playback::Manual,
-            time: t,
+            time: detour[0],
             ..PlenopticCamera::new(handle)
         },
     ));
@@ -244,22 +275,34 @@ fn plugin_and_cpu_frames(
             })
             .collect()
     };
-    // Ready when the frame is stable (streaming done, material uploaded) and the red clear
-    // colour is gone.
     let cam_entity = {
         let mut q = app
             .world_mut()
             .query_filtered::<Entity, With<PlenopticCamera>>();
         q.single(app.world()).unwrap()
     };
-    for _ in 0..500 {
-        app.update();
-        if app.world().get::<StreamState>(cam_entity).unwrap().complete {
-            break;
+    for &time in detour {
+        app.world_mut()
+            .get_mut::<PlenopticCamera>(cam_entity)
+            .unwrap()
+            .time = time;
+        // A few frames at each time so that its keys are uploaded and drawn.
+        let mut complete_frames = 0;
+        for _ in 0..500 {
+            app.update();
+            if app.world().get::<StreamState>(cam_entity).unwrap().complete {
+                complete_frames += 1;
+                if complete_frames == 3 {
+                    break;
+                }
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        std::thread::sleep(std::time::Duration::from_millis(5));
+        assert!(
+            app.world().get::<StreamState>(cam_entity).unwrap().complete,
+            "t = {time}"
+        );
     }
-    assert!(app.world().get::<StreamState>(cam_entity).unwrap().complete);
     let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
     let data = render_until(&mut app, image, 600, |d| {
         let px = decode(d);
@@ -270,9 +313,13 @@ fn plugin_and_cpu_frames(
         *prev.borrow_mut() = Some(d.to_vec());
         shown && stable
     });
-    let gpu = decode(&data);
-
-    (gpu, cpu.radiance, report.fallback)
+    Frames {
+        gpu: decode(&data),
+        cpu: cpu.radiance,
+        fallback: report.fallback,
+        stats: app.world().resource::<StreamingStats>().clone(),
+        uploads: *app.world().resource::<KeyUploadStats>(),
+    }
 }
 
 /// Compares the GPU frame with the CPU frame: (mean relative error, fraction of pixels within
@@ -311,9 +358,9 @@ fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
 /// over the fragment's surface plane).
 #[test]
 fn gpu_frame_matches_cpu_reconstruction() {
-    let (gpu, cpu, fallback) = plugin_and_cpu_frames(Backend::Gpu, 0);
-    assert!(fallback.hole_fill > 0.1, "{fallback:?}");
-    let (mean, f5, f20) = compare(&gpu, &cpu);
+    let f = plugin_and_cpu_frames(Backend::Gpu, 0, None);
+    assert!(f.fallback.hole_fill > 0.1, "{:?}", f.fallback);
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     // Measured on lavapipe: mean 0.0005, 99.97 % within 5 %, 100 % within 20 % (the rest is
     // the f16 target's rounding). With Bevy's default 4× MSAA instead, silhouette pixels
     // blend two objects: mean 0.020, 96.5 % within 5 %.
@@ -327,9 +374,34 @@ fn gpu_frame_matches_cpu_reconstruction() {
 /// samples of their object (on the GPU from the streamed, binned volume blocks).
 #[test]
 fn gpu_frame_matches_cpu_with_volume_fallback() {
-    let (gpu, cpu, fallback) = plugin_and_cpu_frames(Backend::Gpu, 3000);
-    assert!(fallback.volume > 0.02, "{fallback:?}");
-    let (mean, f5, f20) = compare(&gpu, &cpu);
+    let f = plugin_and_cpu_frames(Backend::Gpu, 3000, None);
+    assert!(f.fallback.volume > 0.02, "{:?}", f.fallback);
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    assert!(
+        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
+/// Keys stream in, are evicted and their slots of the key texture reused (the budget holds 7
+/// keys; t = 1.7, then 0.3, then 0.7 each need 6): each key is written into its own slot's
+/// layers only, once, and the frame is still the CPU frame.
+#[test]
+fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
+    let f = plugin_and_cpu_frames(Backend::Gpu, 0, Some(7));
+    eprintln!("{:?}; {:?}", f.stats, f.uploads);
+    assert!(f.stats.evictions >= 2, "{:?}", f.stats);
+    assert!(f.stats.decoded_keys >= 9, "{:?}", f.stats);
+    // Only the keys' own layers travel: 6 faces of 8² texels of 16 bytes per key, one
+    // upload per decoded key (not the whole 7-slot texture per arrival).
+    assert_eq!(f.uploads.keys, f.stats.decoded_keys, "{:?}", f.uploads);
+    assert_eq!(
+        f.uploads.bytes,
+        f.uploads.keys * 6 * 64 * 16,
+        "{:?}",
+        f.uploads
+    );
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(
         mean < 0.005 && f5 > 0.99 && f20 > 0.995,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
@@ -340,7 +412,9 @@ fn gpu_frame_matches_cpu_with_volume_fallback() {
 /// space): equal up to the f16 target's rounding.
 #[test]
 fn cpu_backend_shows_the_cpu_frame() {
-    let (shown, cpu, _) = plugin_and_cpu_frames(Backend::Cpu, 0);
+    let Frames {
+        gpu: shown, cpu, ..
+    } = plugin_and_cpu_frames(Backend::Cpu, 0, None);
     let within = shown
         .iter()
         .zip(&cpu)

@@ -26,15 +26,14 @@
 //! (distances and ids are not filterable anyway).
 
 pub mod cpu;
+pub mod upload;
 pub mod volume;
 
 use std::collections::{HashMap, HashSet};
 
-use bevy::asset::{RenderAssetUsages, embedded_asset};
+use bevy::asset::embedded_asset;
 use bevy::prelude::*;
-use bevy::render::render_resource::{
-    AsBindGroup, Extent3d, ShaderType, TextureDimension, TextureFormat,
-};
+use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
 use plenoptic_recon::temporal::bracketing;
@@ -43,8 +42,8 @@ use plenoptic_recon::viewspace::ViewWeights;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::streaming::StreamCache;
 use crate::streaming::schedule::{time_epsilon, volume_buckets};
-use crate::streaming::{StreamCache, key_bytes};
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
@@ -61,6 +60,7 @@ pub struct PlenopticReconstructPlugin;
 impl Plugin for PlenopticReconstructPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "geometry.wgsl");
+        upload::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
@@ -69,7 +69,7 @@ impl Plugin for PlenopticReconstructPlugin {
             .add_systems(
                 Update,
                 (
-                    upload_keys,
+                    upload::upload_keys,
                     volume::upload_volumes,
                     attach_materials,
                     update_materials,
@@ -221,99 +221,6 @@ fn attach_materials(
             .entity(entity)
             .remove::<MeshMaterial3d<StandardMaterial>>()
             .insert(MeshMaterial3d(m));
-    }
-}
-
-/// Copies newly resident keys into their slot's layers of the pack's key texture.
-fn upload_keys(
-    mut keys: ResMut<KeyTextures>,
-    cache: Res<StreamCache>,
-    settings: Res<PlenopticSettings>,
-    packs: Res<Assets<RadiancePack>>,
-    cameras: Query<&PlenopticCamera>,
-    mut images: ResMut<Assets<Image>>,
-) {
-    for cam in &cameras {
-        let id = cam.pack.id();
-        let Some(pack) = packs.get(id) else { continue };
-        let tex = keys.0.entry(id).or_insert_with(|| {
-            let face = pack.reader.manifest().bake.cube_face_size.max(1);
-            let per_key = key_bytes(&pack.reader, (0, 0)).max(1);
-            let slots =
-                (settings.memory_budget_bytes / per_key).clamp(1, (MAX_LAYERS / 6) as u64) as u32;
-            let mut image = Image::new_fill(
-                Extent3d {
-                    width: face,
-                    height: face,
-                    depth_or_array_layers: 6 * slots,
-                },
-                TextureDimension::D2,
-                &[0; 16],
-                TextureFormat::Rgba32Uint,
-                // Kept in the main world too: newly resident keys are written into it.
-                RenderAssetUsages::default(),
-            );
-            image.texture_view_descriptor = None;
-            KeyTexture {
-                image: images.add(image),
-                face,
-                slots,
-                uploaded: HashMap::new(),
-                normals: HashSet::new(),
-            }
-        });
-        let fresh: Vec<_> = cache
-            .resident
-            .iter()
-            .filter(|((p, v, k), r)| {
-                *p == id && r.slot < tex.slots && tex.uploaded.get(&r.slot) != Some(&(*v, *k))
-            })
-            .map(|((_, v, k), r)| ((*v, *k), r.clone()))
-            .collect();
-        if fresh.is_empty() {
-            continue;
-        }
-        let Some(mut image) = images.get_mut(&tex.image) else {
-            continue;
-        };
-        let Some(data) = image.data.as_mut() else {
-            continue;
-        };
-        for (vk, r) in fresh {
-            let d = &r.data;
-            let texels = (6 * d.face_size * d.face_size) as usize;
-            if d.face_size != tex.face
-                || d.radiance.len() != texels * 4
-                || d.distance.len() != texels * 4
-                || d.object_id.len() != texels * 4
-            {
-                warn_once!(
-                    "plenoptic: GPU reconstruction needs RGB9E5 radiance, R32F distance and \
-                     R32Uint ids at face size {}; key {vk:?} not shown",
-                    tex.face
-                );
-                continue;
-            }
-            let normals = d.normal.as_ref().filter(|n| n.len() == texels * 4);
-            let base = r.slot as usize * texels * 16;
-            for i in 0..texels {
-                let o = base + i * 16;
-                data[o..o + 4].copy_from_slice(&d.radiance[i * 4..i * 4 + 4]);
-                data[o + 4..o + 8].copy_from_slice(&d.distance[i * 4..i * 4 + 4]);
-                data[o + 8..o + 12].copy_from_slice(&d.object_id[i * 4..i * 4 + 4]);
-                // Oct-encoded RG16Snorm normal (without normals the shader skips the plane
-                // test, as plenoptic_recon does).
-                if let Some(n) = normals {
-                    data[o + 12..o + 16].copy_from_slice(&n[i * 4..i * 4 + 4]);
-                }
-            }
-            tex.uploaded.insert(r.slot, vk);
-            if normals.is_some() {
-                tex.normals.insert(r.slot);
-            } else {
-                tex.normals.remove(&r.slot);
-            }
-        }
     }
 }
 

@@ -1,0 +1,224 @@
+//! Uploads of newly resident keys into a pack's key texture, layer range by layer range.
+//!
+//! The key texture ([`KeyTexture`]) exists only on the GPU: its `Image` asset has no texel data
+//! (render world only), so Bevy creates the texture once and never re-uploads it. When a key
+//! becomes resident, its six faces are interleaved into the texture's `Rgba32Uint` layout in
+//! the main world and queued ([`KeyUploads`]); the render world takes the queue at extraction
+//! and writes each key into its slot's six layers with `RenderQueue::write_texture`, before the
+//! frame's passes. A key evicted from a slot is simply overwritten by the slot's next key.
+
+use std::collections::{HashMap, HashSet};
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::{
+    Extent3d, Origin3d, TexelCopyBufferLayout, TexelCopyTextureInfo, TextureAspect,
+    TextureDimension, TextureFormat,
+};
+use bevy::render::renderer::RenderQueue;
+use bevy::render::texture::GpuImage;
+use bevy::render::{MainWorld, Render, RenderApp, RenderSystems};
+
+use super::{KeyTexture, KeyTextures, MAX_LAYERS};
+use crate::PlenopticSettings;
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+use crate::streaming::{DecodedKey, StreamCache, key_bytes};
+
+/// Bytes per texel of the key texture (`Rgba32Uint`).
+const TEXEL_BYTES: usize = 16;
+
+/// One key's texels, interleaved, waiting to be written into its slot.
+#[derive(Debug, Clone)]
+pub struct KeyUpload {
+    /// The key texture.
+    pub image: AssetId<Image>,
+    /// First array layer (6 × slot).
+    pub first_layer: u32,
+    /// Face size.
+    pub face: u32,
+    /// Six faces of `face`² texels of [`TEXEL_BYTES`] bytes.
+    pub data: Vec<u8>,
+}
+
+/// Key uploads queued this frame (main world; taken by the render world at extraction).
+#[derive(Resource, Debug, Default)]
+pub struct KeyUploads(pub Vec<KeyUpload>);
+
+/// Key uploads taken from the main world, written once their texture exists on the GPU.
+#[derive(Resource, Debug, Default)]
+struct PendingKeyUploads(Vec<KeyUpload>);
+
+/// Statistics of the key uploads (render world figures, mirrored for tests and tools).
+#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct KeyUploadStats {
+    /// Keys queued for upload.
+    pub keys: u64,
+    /// Bytes queued for upload (only the keys' own layers).
+    pub bytes: u64,
+}
+
+/// Adds the queue and the render-world writer.
+pub(super) fn build(app: &mut App) {
+    app.init_resource::<KeyUploads>()
+        .init_resource::<KeyUploadStats>();
+    if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+        render_app
+            .init_resource::<PendingKeyUploads>()
+            .add_systems(ExtractSchedule, extract_key_uploads)
+            .add_systems(
+                Render,
+                write_key_uploads.in_set(RenderSystems::PrepareResources),
+            );
+    }
+}
+
+/// Creates each shown pack's key texture and queues newly resident keys for upload into their
+/// slot's layers.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+pub(super) fn upload_keys(
+    mut keys: ResMut<KeyTextures>,
+    mut uploads: ResMut<KeyUploads>,
+    mut stats: ResMut<KeyUploadStats>,
+    cache: Res<StreamCache>,
+    settings: Res<PlenopticSettings>,
+    packs: Res<Assets<RadiancePack>>,
+    cameras: Query<&PlenopticCamera>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    for cam in &cameras {
+        let id = cam.pack.id();
+        let Some(pack) = packs.get(id) else { continue };
+        let tex = keys.0.entry(id).or_insert_with(|| {
+            let face = pack.reader.manifest().bake.cube_face_size.max(1);
+            let per_key = key_bytes(&pack.reader, (0, 0)).max(1);
+            let slots =
+                (settings.memory_budget_bytes / per_key).clamp(1, (MAX_LAYERS / 6) as u64) as u32;
+            let mut image = Image::new_uninit(
+                Extent3d {
+                    width: face,
+                    height: face,
+                    depth_or_array_layers: 6 * slots,
+                },
+                TextureDimension::D2,
+                TextureFormat::Rgba32Uint,
+                // GPU only: keys are written into it in place (wgpu zero-initialises it).
+                RenderAssetUsages::RENDER_WORLD,
+            );
+            image.texture_view_descriptor = None;
+            KeyTexture {
+                image: images.add(image),
+                face,
+                slots,
+                uploaded: HashMap::new(),
+                normals: HashSet::new(),
+            }
+        });
+        let mut fresh: Vec<_> = cache
+            .resident
+            .iter()
+            .filter(|((p, v, k), r)| {
+                *p == id && r.slot < tex.slots && tex.uploaded.get(&r.slot) != Some(&(*v, *k))
+            })
+            .map(|((_, v, k), r)| ((*v, *k), r.clone()))
+            .collect();
+        fresh.sort_by_key(|f| f.1.slot);
+        for (vk, r) in fresh {
+            let Some((data, normals)) = interleave(&r.data, tex.face) else {
+                warn_once!(
+                    "plenoptic: GPU reconstruction needs RGB9E5 radiance, R32F distance and \
+                     R32Uint ids at face size {}; key {vk:?} not shown",
+                    tex.face
+                );
+                continue;
+            };
+            stats.keys += 1;
+            stats.bytes += data.len() as u64;
+            uploads.0.push(KeyUpload {
+                image: tex.image.id(),
+                first_layer: 6 * r.slot,
+                face: tex.face,
+                data,
+            });
+            tex.uploaded.insert(r.slot, vk);
+            if normals {
+                tex.normals.insert(r.slot);
+            } else {
+                tex.normals.remove(&r.slot);
+            }
+        }
+    }
+}
+
+/// A key's texels in the key texture's layout: per texel (radiance RGB9E5, distance f32 bits,
+/// object id, oct-encoded RG16Snorm normal or 0), and whether it had normals. `None` when
+/// its formats or face size do not fit.
+pub fn interleave(d: &DecodedKey, face: u32) -> Option<(Vec<u8>, bool)> {
+    let texels = (6 * d.face_size * d.face_size) as usize;
+    if d.face_size != face
+        || d.radiance.len() != texels * 4
+        || d.distance.len() != texels * 4
+        || d.object_id.len() != texels * 4
+    {
+        return None;
+    }
+    // Without normals the shader skips the plane test, as plenoptic_recon does.
+    let normals = d.normal.as_ref().filter(|n| n.len() == texels * 4);
+    let mut data = vec![0u8; texels * TEXEL_BYTES];
+    for (i, o) in data.chunks_exact_mut(TEXEL_BYTES).enumerate() {
+        let src = i * 4..i * 4 + 4;
+        o[0..4].copy_from_slice(&d.radiance[src.clone()]);
+        o[4..8].copy_from_slice(&d.distance[src.clone()]);
+        o[8..12].copy_from_slice(&d.object_id[src.clone()]);
+        if let Some(n) = normals {
+            o[12..16].copy_from_slice(&n[src]);
+        }
+    }
+    Some((data, normals.is_some()))
+}
+
+fn extract_key_uploads(mut main: ResMut<MainWorld>, mut pending: ResMut<PendingKeyUploads>) {
+    if let Some(mut uploads) = main.get_resource_mut::<KeyUploads>() {
+        pending.0.append(&mut uploads.0);
+    }
+}
+
+/// Writes the pending keys into their layers, in the order they were queued (a slot reused
+/// later in the queue ends with its latest key); keys whose texture is not on the GPU yet
+/// wait.
+fn write_key_uploads(
+    mut pending: ResMut<PendingKeyUploads>,
+    images: Res<RenderAssets<GpuImage>>,
+    queue: Res<RenderQueue>,
+) {
+    pending.0.retain(|u| {
+        let Some(gpu) = images.get(u.image) else {
+            return true;
+        };
+        queue.write_texture(
+            TexelCopyTextureInfo {
+                texture: &gpu.texture,
+                mip_level: 0,
+                origin: Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: u.first_layer,
+                },
+                aspect: TextureAspect::All,
+            },
+            &u.data,
+            TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(u.face * TEXEL_BYTES as u32),
+                rows_per_image: Some(u.face),
+            },
+            Extent3d {
+                width: u.face,
+                height: u.face,
+                depth_or_array_layers: 6,
+            },
+        );
+        false
+    });
+}
