@@ -16,44 +16,35 @@
 //!    object in screen space (same-object hole fill); then the nearest view's cube in the
 //!    point's direction regardless of id ("background").
 //!
-//! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key; the pixel
-//! loop is parallel over rows and allocates nothing.
+//! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key. The pixel
+//! loop is parallel over bands of rows: each band of the mask is rasterized and then looked up
+//! while it is in cache, a row at a time as a structure of arrays ([`crate::lookup`]), with the
+//! keys' cubes interleaved per texel (cached by the reconstructor). The volume fallback and
+//! the hole fill then visit only the pixels that need them.
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
-use plenoptic_pack::{CubeImage, cube};
+use plenoptic_pack::CubeImage;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Report};
+use crate::lookup::{FastKey, NO_SLOT, PackedTexels, Scratch, Shade};
+use crate::proxy::GeometryMask;
 use crate::reconstructor::{KeyCubes, MaskMethod, Reconstructor};
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
-use crate::{Error, Result};
+use crate::{Error, Result, sample};
 
 struct ViewKey {
     base: Vec3,
     weight: f32,
     cubes: KeyCubes,
+    packed: Arc<PackedTexels>,
     /// Per object slot: M(τ) M(t)⁻¹.
     motion: Vec<Affine3A>,
-}
-
-/// A key's data as flat slices for the pixel loop.
-struct FastKey<'a> {
-    base: Vec3,
-    weight: f32,
-    face: u32,
-    ids: &'a [u32],
-    distance: &'a [f32],
-    radiance: &'a [Vec3],
-    normal: Option<&'a [Vec3]>,
-    motion: &'a [Affine3A],
-    /// Per object slot: the previous key has the same base view, face size and transform, so
-    /// its lookup direction and texel can be reused.
-    reuse: Vec<bool>,
 }
 
 const DIRECT: u8 = 1;
@@ -125,6 +116,7 @@ pub(crate) fn render(
             keys.push(ViewKey {
                 base: bv.position,
                 weight: w * wt / total,
+                packed: rec.packed_texels(v, k, &c),
                 cubes: c,
                 motion,
             });
@@ -142,51 +134,47 @@ pub(crate) fn render(
     report.base_views = views;
     report.stage_ms.push(("setup".into(), ms(start)));
     let start = Instant::now();
-    let mask = match rec.settings.mask {
-        MaskMethod::Raster => proxy.mask_raster(camera, t),
-        MaskMethod::RayCast => proxy.mask(camera, t),
+    // The mask: rasterized band by band inside the pixel loop (the default), or ray cast
+    // beforehand.
+    let source = match rec.settings.mask {
+        MaskMethod::Raster => MaskSource::Raster(proxy.project(camera, t)),
+        MaskMethod::RayCast => MaskSource::Mask(proxy.mask(camera, t)),
     };
-    report.stage_ms.push(("mask".into(), ms(start)));
+    report.stage_ms.push(("mask_setup".into(), ms(start)));
     let start = Instant::now();
     let (w, h) = (camera.width as usize, camera.height as usize);
     let mut frame = Frame::new(camera.width, camera.height);
     // Flat views of the cubes for the pixel loop; keys of negligible weight are skipped.
-    let fast: Vec<FastKey<'_>> = keys
+    let mut fast: Vec<FastKey<'_>> = keys
         .iter()
         .filter(|k| k.weight > 1e-4)
         .map(|k| FastKey {
             base: k.base,
             weight: k.weight,
             face: k.cubes.ids.face_size,
-            ids: &k.cubes.ids.texels,
-            distance: &k.cubes.distance.texels,
-            radiance: &k.cubes.radiance.texels,
+            texels: &k.packed.texels,
             normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
             motion: &k.motion,
             reuse: Vec::new(),
         })
         .collect();
-    let fast: Vec<FastKey<'_>> = {
-        let mut fast = fast;
-        for i in 0..fast.len() {
-            let reuse = (0..ids.len())
-                .map(|s| {
-                    i > 0
-                        && fast[i - 1].base == fast[i].base
-                        && fast[i - 1].face == fast[i].face
-                        && fast[i - 1].motion[s] == fast[i].motion[s]
-                })
-                .collect();
-            fast[i].reuse = reuse;
-        }
-        fast
-    };
+    for i in 0..fast.len() {
+        let reuse = (0..ids.len())
+            .map(|s| {
+                i > 0
+                    && fast[i - 1].base == fast[i].base
+                    && fast[i - 1].face == fast[i].face
+                    && fast[i - 1].motion[s] == fast[i].motion[s]
+            })
+            .collect();
+        fast[i].reuse = reuse;
+    }
     let mut class = vec![HOLE; w * h];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
     let power = rec.settings.angular_power;
-    let power_int = if power.fract() == 0.0 && power <= 64.0 {
-        power as i32
+    let power_int = if power.fract() == 0.0 && (1.0..=64.0).contains(&power) {
+        power as u32
     } else {
         0
     };
@@ -195,114 +183,146 @@ pub(crate) fn render(
         .iter()
         .max_by(|a, b| a.weight.total_cmp(&b.weight))
         .map(|k| (k.base, k.cubes.radiance.clone()));
+    let shade = Shade {
+        fast: &fast,
+        tol,
+        power,
+        power_int,
+    };
+    let band = ROWS * w.max(1);
     frame
         .radiance
-        .par_chunks_mut(w)
-        .zip(frame.depth.par_chunks_mut(w))
-        .zip(frame.object.par_chunks_mut(w))
-        .zip(class.par_chunks_mut(w))
+        .par_chunks_mut(band)
+        .zip(frame.depth.par_chunks_mut(band))
+        .zip(frame.object.par_chunks_mut(band))
+        .zip(class.par_chunks_mut(band))
         .enumerate()
-        .for_each(|(y, (((rad, dep), obj), cls))| {
-            for x in 0..w {
-                let j = y * w + x;
-                let o = mask.object[j];
-                if o == 0 {
-                    cls[x] = NONE;
-                    if let Some((_, env)) = &env {
-                        let dir = basis.direction(x as f32 + 0.5, y as f32 + 0.5);
-                        rad[x] = env.lookup(dir).copied().unwrap_or(Vec3::ZERO);
-                    }
-                    continue;
-                }
-                let p = mask.position[j];
-                dep[x] = mask.depth[j];
-                obj[x] = o;
-                let Some(slot) = slot_of.get(o) else {
-                    cls[x] = NONE;
-                    continue;
-                };
-                let to_eye = (basis.position - p).normalize_or_zero();
-                let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
-                let (mut d, mut dist, mut ti) = (Vec3::ZERO, 0.0f32, usize::MAX);
-                for k in &fast {
-                    if !k.reuse[slot] || ti == usize::MAX {
-                        let q = k.motion[slot].transform_point3(p);
-                        d = q - k.base;
-                        let dist2 = d.length_squared();
-                        if dist2.is_nan() || dist2 <= 1e-12 {
-                            ti = usize::MAX;
-                            continue;
+        .for_each_init(Scratch::default, |s, (i, (((rad, dep), obj), cls))| {
+            let y0 = i * ROWS;
+            if let MaskSource::Raster(tris) = &source {
+                // Camera-space depth into `dep`, object into `obj`.
+                crate::raster::raster_band(tris, w, y0, dep, obj);
+            }
+            let rows = rad
+                .chunks_mut(w)
+                .zip(dep.chunks_mut(w))
+                .zip(obj.chunks_mut(w))
+                .zip(cls.chunks_mut(w));
+            for (r, (((rad, dep), obj), cls)) in rows.enumerate() {
+                let y = y0 + r;
+                s.resize(w);
+                s.directions(&basis, y, w);
+                // The hit point of every pixel of the row.
+                match &source {
+                    MaskSource::Raster(_) => {
+                        for (z, &o) in dep.iter_mut().zip(obj.iter()) {
+                            if o == 0 {
+                                *z = f32::INFINITY;
+                            }
                         }
-                        dist = dist2.sqrt();
-                        ti = cube::direction_to_texel(k.face, d);
+                        s.points_from_depth(&basis, dep);
                     }
-                    if k.ids[ti] != o {
+                    MaskSource::Mask(m) => {
+                        for x in 0..w {
+                            let o = m.object[y * w + x];
+                            if o != 0 {
+                                obj[x] = o;
+                                dep[x] = m.depth[y * w + x];
+                            }
+                            s.set_p(x, m.position[y * w + x]);
+                        }
+                        s.eye_directions(basis.position, w);
+                    }
+                }
+                for x in 0..w {
+                    let o = obj[x];
+                    s.slot[x] = NO_SLOT;
+                    if o == 0 {
+                        cls[x] = NONE;
+                        if let Some((_, env)) = &env {
+                            rad[x] = env.texels[sample::texel(env.face_size, s.dir_at(x))];
+                        }
                         continue;
                     }
-                    let dc = k.distance[ti];
-                    // Fast path: the texel's centre distance agrees. Otherwise compare with
-                    // the distance to the texel's surface plane along the lookup direction
-                    // (grazing surfaces change depth quickly across a texel).
-                    if (dc - dist).abs() > tol * dist {
-                        let Some(nc) = k.normal else { continue };
-                        let nrm = nc[ti];
-                        let denom = d.dot(nrm) / dist;
-                        if denom.abs() <= 0.05 {
-                            continue;
-                        }
-                        let expected = (cube::texel_direction(k.face, ti) * dc).dot(nrm) / denom;
-                        if (expected - dist).abs() > tol * dist {
-                            continue;
-                        }
+                    match slot_of.get(o) {
+                        Some(slot) => s.slot[x] = slot as u32,
+                        None => cls[x] = NONE,
                     }
-                    let wa = if power > 0.0 {
-                        let cos = -d.dot(to_eye) / dist;
-                        let c = ((1.0 + cos) * 0.5).max(1e-3);
-                        if power_int > 0 {
-                            c.powi(power_int)
-                        } else {
-                            c.powf(power)
-                        }
+                }
+                shade.row(s, obj);
+                for x in 0..w {
+                    if s.slot[x] == NO_SLOT {
+                        continue;
+                    }
+                    if s.ws[x] > 0.0 {
+                        let c = Vec3::new(s.sum[0][x], s.sum[1][x], s.sum[2][x]);
+                        rad[x] = c / s.ws[x];
+                        cls[x] = DIRECT;
                     } else {
-                        1.0
-                    };
-                    let wt = k.weight * wa;
-                    sum += k.radiance[ti] * wt;
-                    ws += wt;
+                        cls[x] = HOLE;
+                    }
                 }
-                if ws > 0.0 {
-                    rad[x] = sum / ws;
-                    cls[x] = DIRECT;
-                    continue;
-                }
+            }
+        });
+    report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
+    let start = Instant::now();
+    // The hit point of a pixel (for the fallbacks), as the pixel loop computed it.
+    let depth = std::mem::take(&mut frame.depth);
+    let point = |j: usize| match &source {
+        MaskSource::Mask(m) => m.position[j],
+        MaskSource::Raster(_) => {
+            let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+            basis.position + dir * depth[j]
+        }
+    };
+    // Volume fallback where no lookup was accepted.
+    let misses: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
+    if !volumes.is_empty() && !misses.is_empty() {
+        let found: Vec<(usize, Vec3)> = misses
+            .par_iter()
+            .filter_map(|&j| {
+                let (p, o) = (point(j), frame.object[j]);
                 let (mut vs, mut vw) = (Vec3::ZERO, 0.0f32);
                 for (base, w, index) in &volumes {
-                    let d = p - *base;
-                    if let Some((c, wt)) = index.lookup(d, o, tol * 3.0) {
+                    if let Some((c, wt)) = index.lookup(p - *base, o, tol * 3.0) {
                         vs += c * wt * *w;
                         vw += wt * *w;
                     }
                 }
-                if vw > 0.0 {
-                    rad[x] = vs / vw;
-                    cls[x] = VOLUME;
-                }
-            }
-        });
-    report.stage_ms.push(("lookups".into(), ms(start)));
+                (vw > 0.0).then(|| (j, vs / vw))
+            })
+            .collect();
+        for (j, c) in found {
+            frame.radiance[j] = c;
+            class[j] = VOLUME;
+        }
+    }
+    report.stage_ms.push(("volume".into(), ms(start)));
     let start = Instant::now();
     let (hole, background) = hole_fill(
         &mut frame,
         &mut class,
         rec.settings.hole_fill_radius as i64,
         &keys,
-        &mask.position,
+        &point,
     );
+    frame.depth = depth;
     report.stage_ms.push(("hole_fill".into(), ms(start)));
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
     report.fallback =
         FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
     Ok(frame)
+}
+
+/// Rows per band of the pixel loop (a band is rasterized, then shaded, while in cache).
+const ROWS: usize = 4;
+
+/// Where the geometry mask comes from.
+enum MaskSource {
+    /// Projected proxy triangles, rasterized per band.
+    Raster(crate::raster::Projected),
+    /// A mask computed beforehand.
+    Mask(GeometryMask),
 }
 
 /// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search);
@@ -312,7 +332,7 @@ fn hole_fill(
     class: &mut [u8],
     radius: i64,
     keys: &[ViewKey],
-    points: &[Vec3],
+    point: &(dyn Fn(usize) -> Vec3 + Sync),
 ) -> (usize, usize) {
     let (w, h) = (frame.width as i64, frame.height as i64);
     let holes: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
@@ -364,10 +384,8 @@ fn hole_fill(
                 rest += 1;
                 class[j] = NONE + 1;
                 if let Some((base, cube)) = &env {
-                    frame.radiance[j] = cube
-                        .lookup(points[j] - *base)
-                        .copied()
-                        .unwrap_or(Vec3::ZERO);
+                    frame.radiance[j] =
+                        cube.lookup(point(j) - *base).copied().unwrap_or(Vec3::ZERO);
                 }
             }
         }

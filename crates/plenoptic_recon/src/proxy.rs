@@ -261,8 +261,18 @@ impl ProxyGeometry {
     /// (what the GPU mask pass does): the same object ids and hit points as [`Self::mask`]
     /// up to pixel-centre edge rules, at a fraction of the cost. See the `raster` module.
     pub fn mask_raster(&self, camera: &Camera, t: f32) -> GeometryMask {
-        let objects: Vec<(u32, Affine3A, &Mesh)> = self
-            .scene
+        crate::raster::rasterize(camera, &self.placed_meshes(t))
+    }
+
+    /// The proxy triangles placed at `t` and projected for `camera`, for band-wise
+    /// rasterization fused with the per-pixel work.
+    pub(crate) fn project(&self, camera: &Camera, t: f32) -> crate::raster::Projected {
+        crate::raster::project(camera, &self.placed_meshes(t))
+    }
+
+    /// (pack id, object-to-world transform at `t`, mesh) of every object.
+    fn placed_meshes(&self, t: f32) -> Vec<(u32, Affine3A, &Mesh)> {
+        self.scene
             .objects
             .iter()
             .enumerate()
@@ -273,8 +283,7 @@ impl ProxyGeometry {
                     &self.scene.meshes[o.mesh],
                 )
             })
-            .collect();
-        crate::raster::rasterize(camera, &objects)
+            .collect()
     }
 
     /// The geometry mask of `camera` over already placed geometry.

@@ -28,39 +28,42 @@ struct Tri {
     ymax: f32,
 }
 
-/// Rasterizes `objects` (pack id, object-to-world transform, mesh) for `camera`.
-pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> GeometryMask {
+/// Triangles of `objects` (pack id, object-to-world transform, mesh) placed, clipped against
+/// the near plane and projected for `camera`: what [`raster_band`] scan-converts.
+pub(crate) struct Projected {
+    tris: Vec<Tri>,
+}
+
+/// Places, clips and projects `objects` for `camera`.
+pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> Projected {
     let b = camera.basis();
-    let (w, h) = (camera.width as usize, camera.height as usize);
     let (sx, sy) = (0.5 * b.width / b.tan_x, 0.5 * b.height / b.tan_y);
     let mut tris = Vec::new();
+    let mut cam: Vec<Vec3> = Vec::new();
     for &(object, xf, mesh) in objects {
-        let cam: Vec<Vec3> = mesh
-            .positions
-            .iter()
-            .map(|&p| {
-                let d = xf.transform_point3(p) - b.position;
-                Vec3::new(d.dot(b.right), d.dot(b.up), d.dot(b.forward))
-            })
-            .collect();
+        cam.clear();
+        cam.extend(mesh.positions.iter().map(|&p| {
+            let d = xf.transform_point3(p) - b.position;
+            Vec3::new(d.dot(b.right), d.dot(b.up), d.dot(b.forward))
+        }));
         for t in &mesh.triangles {
-            let Some(v) = t
-                .map(|i| cam.get(i as usize).copied())
-                .into_iter()
-                .collect::<Option<Vec<Vec3>>>()
-            else {
+            let [Some(v0), Some(v1), Some(v2)] = t.map(|i| cam.get(i as usize).copied()) else {
                 continue;
             };
+            let v = [v0, v1, v2];
             // Clip against z ≥ NEAR (Sutherland–Hodgman on one plane).
-            let mut poly: Vec<Vec3> = Vec::with_capacity(4);
+            let mut poly = [Vec3::ZERO; 4];
+            let mut len = 0;
             for k in 0..3 {
                 let (a, c) = (v[k], v[(k + 1) % 3]);
                 if a.z >= NEAR {
-                    poly.push(a);
+                    poly[len] = a;
+                    len += 1;
                 }
                 if (a.z >= NEAR) != (c.z >= NEAR) {
                     let f = (NEAR - a.z) / (c.z - a.z);
-                    poly.push(a + (c - a) * f);
+                    poly[len] = a + (c - a) * f;
+                    len += 1;
                 }
             }
             let proj = |p: Vec3| {
@@ -70,7 +73,7 @@ pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> 
                     1.0 / p.z,
                 )
             };
-            for k in 1..poly.len().saturating_sub(1) {
+            for k in 1..len.saturating_sub(1) {
                 let (p0, p1, p2) = (proj(poly[0]), proj(poly[k]), proj(poly[k + 1]));
                 let x = [p0.0, p1.0, p2.0];
                 let y = [p0.1, p1.1, p2.1];
@@ -97,6 +100,95 @@ pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> 
             }
         }
     }
+    Projected { tris }
+}
+
+/// Scan-converts the rows `y0..y0 + zbuf.len() / width` of `tris`: `zbuf` (camera-space depth,
+/// ∞ initially) and `obj` (the nearest object) are that band of the image.
+///
+/// Each triangle row visits only the span where its edge functions can be non-negative
+/// (solved in f64, widened by two pixels), and tests every pixel of the span exactly as a
+/// full bounding-box scan would: the result is the same, at a cost proportional to the
+/// covered area instead of the bounding box.
+pub(crate) fn raster_band(
+    tris: &Projected,
+    width: usize,
+    y0: usize,
+    zbuf: &mut [f32],
+    obj: &mut [u32],
+) {
+    let w = width;
+    let rows = zbuf.len() / w.max(1);
+    for t in &tris.tris {
+        if t.ymax < y0 as f32 || t.ymin > (y0 + rows) as f32 {
+            continue;
+        }
+        let area = (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.x[2] - t.x[0]) * (t.y[1] - t.y[0]);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        let inv = 1.0 / area;
+        let xmin = t.x[0].min(t.x[1]).min(t.x[2]).floor().max(0.0) as usize;
+        let xmax = (t.x[0].max(t.x[1]).max(t.x[2]).ceil() as usize).min(w);
+        let ylo = (t.ymin.floor().max(y0 as f32) as usize).max(y0);
+        let yhi = (t.ymax.ceil() as usize).min(y0 + rows);
+        let sign = if inv > 0.0 { 1.0f64 } else { -1.0 };
+        for py in ylo..yhi {
+            let cy = py as f32 + 0.5;
+            // The span of pixel centres where every edge function has the sign of the area.
+            let (mut lo, mut hi) = (xmin as f64, xmax as f64);
+            let mut empty = false;
+            for (i, j) in [(1usize, 2usize), (2, 0), (0, 1)] {
+                let (xi, yi) = (t.x[i] as f64, t.y[i] as f64);
+                let (dx, dy) = (t.x[j] as f64 - xi, t.y[j] as f64 - yi);
+                // e(cx) = dx (cy − yi) − dy (cx − xi) = a + b·cx, to be ≥ 0 after × sign.
+                let a = sign * (dx * (cy as f64 - yi) + dy * xi);
+                let bb = -sign * dy;
+                if bb > 0.0 {
+                    lo = lo.max(-a / bb);
+                } else if bb < 0.0 {
+                    hi = hi.min(-a / bb);
+                } else if a < 0.0 {
+                    empty = true;
+                }
+            }
+            if empty || lo > hi + 4.0 {
+                continue;
+            }
+            let x0 = ((lo - 0.5).floor() - 2.0).max(xmin as f64) as usize;
+            let x1 = (((hi - 0.5).ceil() + 3.0) as usize).min(xmax);
+            let row = (py - y0) * w;
+            for px in x0..x1 {
+                let cx = px as f32 + 0.5;
+                let e = |i: usize, j: usize| {
+                    (t.x[j] - t.x[i]) * (cy - t.y[i]) - (t.y[j] - t.y[i]) * (cx - t.x[i])
+                };
+                let b0 = e(1, 2) * inv;
+                let b1 = e(2, 0) * inv;
+                let b2 = e(0, 1) * inv;
+                if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
+                    continue;
+                }
+                let iz = b0 * t.iz[0] + b1 * t.iz[1] + b2 * t.iz[2];
+                if iz <= 0.0 {
+                    continue;
+                }
+                let z = 1.0 / iz;
+                let j = row + px;
+                if z < zbuf[j] {
+                    zbuf[j] = z;
+                    obj[j] = t.object;
+                }
+            }
+        }
+    }
+}
+
+/// Rasterizes `objects` (pack id, object-to-world transform, mesh) for `camera`.
+pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> GeometryMask {
+    let b = camera.basis();
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let tris = project(camera, objects);
     let mut object = vec![0u32; w * h];
     let mut depth = vec![f32::INFINITY; w * h];
     let mut position = vec![Vec3::ZERO; w * h];
@@ -107,55 +199,14 @@ pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> 
         .enumerate()
         .for_each(|(band, ((obj, dep), pos))| {
             let y0 = band * BAND;
-            let rows = obj.len() / w;
-            let mut zbuf = vec![f32::INFINITY; rows * w];
-            for t in &tris {
-                if t.ymax < y0 as f32 || t.ymin > (y0 + rows) as f32 {
-                    continue;
-                }
-                let area =
-                    (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.x[2] - t.x[0]) * (t.y[1] - t.y[0]);
-                if area.abs() < 1e-12 {
-                    continue;
-                }
-                let inv = 1.0 / area;
-                let xmin = t.x[0].min(t.x[1]).min(t.x[2]).floor().max(0.0) as usize;
-                let xmax = (t.x[0].max(t.x[1]).max(t.x[2]).ceil() as usize).min(w);
-                let ylo = (t.ymin.floor().max(y0 as f32) as usize).max(y0);
-                let yhi = (t.ymax.ceil() as usize).min(y0 + rows);
-                for py in ylo..yhi {
-                    let cy = py as f32 + 0.5;
-                    for px in xmin..xmax {
-                        let cx = px as f32 + 0.5;
-                        let e = |i: usize, j: usize| {
-                            (t.x[j] - t.x[i]) * (cy - t.y[i]) - (t.y[j] - t.y[i]) * (cx - t.x[i])
-                        };
-                        let b0 = e(1, 2) * inv;
-                        let b1 = e(2, 0) * inv;
-                        let b2 = e(0, 1) * inv;
-                        if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
-                            continue;
-                        }
-                        let iz = b0 * t.iz[0] + b1 * t.iz[1] + b2 * t.iz[2];
-                        if iz <= 0.0 {
-                            continue;
-                        }
-                        let z = 1.0 / iz;
-                        let j = (py - y0) * w + px;
-                        if z < zbuf[j] {
-                            zbuf[j] = z;
-                            obj[j] = t.object;
-                        }
-                    }
-                }
-            }
-            for (j, &z) in zbuf.iter().enumerate() {
+            raster_band(&tris, w, y0, dep, obj);
+            for (j, (z, p)) in dep.iter_mut().zip(pos.iter_mut()).enumerate() {
                 if z.is_finite() {
                     let (px, py) = ((j % w) as f32 + 0.5, (y0 + j / w) as f32 + 0.5);
                     let dir = b.direction(px, py);
-                    let dist = z / dir.dot(b.forward);
-                    dep[j] = dist;
-                    pos[j] = b.position + dir * dist;
+                    let dist = *z / dir.dot(b.forward);
+                    *z = dist;
+                    *p = b.position + dir * dist;
                 }
             }
         });

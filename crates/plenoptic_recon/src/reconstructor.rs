@@ -15,9 +15,11 @@ use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
 
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
+use crate::lookup::PackedTexels;
 use crate::proxy::ProxyGeometry;
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::viewspace::ViewWeights;
+use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
 use crate::{Error, Result};
 
@@ -115,6 +117,12 @@ pub struct Reconstructor {
     /// Settings (may be changed between frames).
     pub settings: ReconSettings,
     cache: Mutex<Cache>,
+    /// Volume blocks binned by direction for the geometry-assisted fallback, by (view,
+    /// bucket); an entry is rebuilt when the chunk cache has reloaded its block.
+    bins: Mutex<HashMap<(u32, u32), Arc<BlockBins>>>,
+    /// Interleaved texels of (view, key) for the geometry-assisted lookups; an entry is
+    /// rebuilt when the chunk cache has reloaded its cubes.
+    packed: Mutex<HashMap<(u32, u32), Arc<PackedTexels>>>,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -152,6 +160,8 @@ impl Reconstructor {
             proxy_missing,
             settings,
             cache: Mutex::new(Cache::default()),
+            bins: Mutex::new(HashMap::new()),
+            packed: Mutex::new(HashMap::new()),
         }
     }
 
@@ -296,6 +306,55 @@ impl Reconstructor {
             }
             _ => None,
         }
+    }
+
+    /// The volume block of (view, bucket) binned by direction (built once per decoded block).
+    pub(crate) fn block_bins(
+        &self,
+        view: usize,
+        bucket: u32,
+        missing: &mut Vec<String>,
+    ) -> Option<Arc<BlockBins>> {
+        let block = self.volume_block(view, bucket, missing)?;
+        let key = (view as u32, bucket);
+        let mut bins = self.bins.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(b) = bins.get(&key)
+            && Arc::ptr_eq(&b.block, &block)
+        {
+            return Some(b.clone());
+        }
+        // Bound what stale entries can hold: the index is cheap to rebuild.
+        let held: usize = bins.values().map(|b| b.bytes()).sum();
+        if held > self.settings.cache_bytes / 8 {
+            bins.clear();
+        }
+        let b = Arc::new(BlockBins::new(block));
+        bins.insert(key, b.clone());
+        Some(b)
+    }
+
+    /// The cubes of (view, key) interleaved per texel (built once per decoded key).
+    pub(crate) fn packed_texels(
+        &self,
+        view: usize,
+        key: usize,
+        cubes: &KeyCubes,
+    ) -> Arc<PackedTexels> {
+        let k = (view as u32, key as u32);
+        let mut packed = self.packed.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(p) = packed.get(&k)
+            && p.built_from(cubes)
+        {
+            return p.clone();
+        }
+        // Bound what stale entries can hold: they are cheap to rebuild.
+        let held: usize = packed.values().map(|p| p.bytes()).sum();
+        if held > self.settings.cache_bytes / 2 {
+            packed.clear();
+        }
+        let p = Arc::new(PackedTexels::new(cubes));
+        packed.insert(k, p.clone());
+        p
     }
 
     /// The connectivity (tetrahedra over stored sample indices) of the volume block of (view,

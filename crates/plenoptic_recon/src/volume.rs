@@ -22,6 +22,8 @@
 //! - *Geometry-assisted fallback* ([`VolumeIndex`]): samples binned by direction so that a
 //!   pixel's point can find the samples of its object near its direction.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 use plenoptic_pack::{ChunkKind, CubeImage, VolumeBlock, VolumeSample, cube};
 use rayon::prelude::*;
@@ -40,12 +42,59 @@ pub type Cubes = (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>);
 /// Face size of the direction bins of a [`VolumeIndex`].
 const BIN_FACE: u32 = 16;
 
-/// The filtered samples of one base view around time t, binned by direction.
+/// The samples of one base view around time t, binned by direction: the blocks overlapping
+/// t ± tε, each binned once and cached by the [`Reconstructor`] ([`BlockBins`]); the tent
+/// filter is applied at lookup.
 #[derive(Clone, Debug)]
 pub struct VolumeIndex {
-    samples: Vec<(VolumeSample, f32)>,
+    blocks: Vec<Arc<BlockBins>>,
+    t: f32,
+    eps: f32,
+    len: usize,
+}
+
+/// One volume block's samples binned by direction (cube of face size `BIN_FACE`), stable in
+/// the stored order.
+#[derive(Debug)]
+pub(crate) struct BlockBins {
+    pub(crate) block: Arc<VolumeBlock>,
     offsets: Vec<u32>,
     order: Vec<u32>,
+}
+
+impl BlockBins {
+    pub(crate) fn new(block: Arc<VolumeBlock>) -> Self {
+        let bins = 6 * (BIN_FACE * BIN_FACE) as usize;
+        let bin: Vec<usize> = block
+            .samples
+            .iter()
+            .map(|s| crate::sample::texel(BIN_FACE, s.direction))
+            .collect();
+        let mut offsets = vec![0u32; bins + 1];
+        for &b in &bin {
+            offsets[b + 1] += 1;
+        }
+        for i in 0..bins {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut fill = offsets.clone();
+        let mut order = vec![0u32; bin.len()];
+        for (i, &b) in bin.iter().enumerate() {
+            order[fill[b] as usize] = i as u32;
+            fill[b] += 1;
+        }
+        BlockBins {
+            block,
+            offsets,
+            order,
+        }
+    }
+
+    /// Bytes held, the block included.
+    pub(crate) fn bytes(&self) -> usize {
+        (self.offsets.len() + self.order.len()) * 4
+            + self.block.samples.len() * std::mem::size_of::<VolumeSample>()
+    }
 }
 
 /// The samples of `view` with |t_s − t| ≤ tε and their tent weights; `None` if the view has no
@@ -77,75 +126,82 @@ pub(crate) fn filtered_samples(
 }
 
 impl VolumeIndex {
-    /// Reads and bins the samples of `view` around `t`.
+    /// The binned samples of `view` around `t`; `None` if no readable block overlapping the
+    /// window has a sample in it.
     pub(crate) fn build(
         rec: &Reconstructor,
         view: usize,
         t: f32,
         missing: &mut Vec<String>,
     ) -> Option<Self> {
-        let samples = filtered_samples(rec, view, t, missing)?;
-        if samples.is_empty() {
-            return None;
+        let m = rec.pack().manifest();
+        let eps = rec.time_epsilon();
+        let (b0, b1) = (m.bucket_of(t - eps), m.bucket_of(t + eps));
+        let mut blocks = Vec::new();
+        let mut len = 0;
+        for b in b0..=b1.min(b0.saturating_add(64)) {
+            let Some(bins) = rec.block_bins(view, b, missing) else {
+                continue;
+            };
+            let n = bins
+                .block
+                .samples
+                .iter()
+                .filter(|s| (s.t - t).abs() <= eps)
+                .count();
+            if n > 0 {
+                len += n;
+                blocks.push(bins);
+            }
         }
-        let bins = 6 * (BIN_FACE * BIN_FACE) as usize;
-        let bin: Vec<usize> = samples
-            .iter()
-            .map(|(s, _)| cube::direction_to_texel(BIN_FACE, s.direction))
-            .collect();
-        let mut offsets = vec![0u32; bins + 1];
-        for &b in &bin {
-            offsets[b + 1] += 1;
-        }
-        for i in 0..bins {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut fill = offsets.clone();
-        let mut order = vec![0u32; samples.len()];
-        for (i, &b) in bin.iter().enumerate() {
-            order[fill[b] as usize] = i as u32;
-            fill[b] += 1;
-        }
-        Some(VolumeIndex {
-            samples,
-            offsets,
-            order,
+        (len > 0).then_some(VolumeIndex {
+            blocks,
+            t,
+            eps,
+            len,
         })
     }
 
     /// Number of samples in the window.
     pub fn len(&self) -> usize {
-        self.samples.len()
+        self.len
     }
 
     /// True if the window has no samples.
     pub fn is_empty(&self) -> bool {
-        self.samples.is_empty()
+        self.len == 0
     }
 
     /// The filtered radiance of object `object`'s samples whose cone contains direction `d`
     /// (from the base view; its length is the expected distance) and whose distance agrees
-    /// within `tol` (relative): `(radiance, total weight)`.
+    /// within `tol` (relative): `(radiance, total weight)`. Samples weigh by the tent filter
+    /// `1 − |t_s − t|/tε` times their cone's falloff.
     pub fn lookup(&self, d: Vec3, object: u32, tol: f32) -> Option<(Vec3, f32)> {
         let dist = d.length();
         if dist.is_nan() || dist <= 1e-6 {
             return None;
         }
         let dir = d / dist;
-        let b = cube::direction_to_texel(BIN_FACE, dir);
+        let b = crate::sample::texel(BIN_FACE, dir);
         let bin_angle = 2.0 / BIN_FACE as f32;
         let (mut sum, mut ws) = (Vec3::ZERO, 0.0);
-        for &i in &self.order[self.offsets[b] as usize..self.offsets[b + 1] as usize] {
-            let (s, tw) = &self.samples[i as usize];
-            if s.object_id != object || (s.distance - dist).abs() > tol * dist {
-                continue;
-            }
-            let angle = s.direction.dot(dir).clamp(-1.0, 1.0).acos();
-            let r = s.radius.max(bin_angle * 0.5);
-            if angle < r {
-                let w = tw * (1.0 - angle / r).max(1e-3);
-                sum += s.radiance * w;
-                ws += w;
+        for bins in &self.blocks {
+            let range = bins.offsets[b] as usize..bins.offsets[b + 1] as usize;
+            for &i in &bins.order[range] {
+                let s = &bins.block.samples[i as usize];
+                let dt = (s.t - self.t).abs();
+                if dt > self.eps || s.object_id != object || (s.distance - dist).abs() > tol * dist
+                {
+                    continue;
+                }
+                let tw = 1.0 - dt / self.eps;
+                let angle = s.direction.dot(dir).clamp(-1.0, 1.0).acos();
+                let r = s.radius.max(bin_angle * 0.5);
+                if angle < r {
+                    let w = tw * (1.0 - angle / r).max(1e-3);
+                    sum += s.radiance * w;
+                    ws += w;
+                }
             }
         }
         (ws > 0.0).then(|| (sum / ws, ws))

@@ -1,0 +1,470 @@
+//! The per-pixel work of the geometry-assisted mode, a row of pixels at a time.
+//!
+//! The row is held as a structure of arrays ([`Scratch`]) and processed in passes: the hit
+//! points of all pixels, then, key by key, the lookup directions and texels of all pixels
+//! (branch-free arithmetic the compiler vectorises), then the tests and sums (gathers from the
+//! cubes). Every value is computed with the same operations in the same order as a
+//! pixel-at-a-time loop over glam's `Vec3` would (no fused multiply-adds, the same
+//! association), so the frames are identical to such a loop's, bit for bit.
+
+use glam::{Affine3A, BVec4A, Vec3, Vec4};
+use plenoptic_pack::cube;
+
+use std::sync::Arc;
+
+use crate::camera::CameraBasis;
+use crate::reconstructor::KeyCubes;
+
+/// One texel of a key's cubes: what an accepted lookup reads, together.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Texel {
+    pub id: u32,
+    pub distance: f32,
+    pub radiance: Vec3,
+}
+
+/// The object-id, distance and radiance cubes of one (view, key) interleaved texel by texel
+/// (a lookup touches one cache line instead of three); built once per decoded key and cached
+/// by the [`crate::Reconstructor`].
+pub(crate) struct PackedTexels {
+    pub texels: Vec<Texel>,
+    /// The cubes it was built from (to tell when the chunk cache has reloaded them).
+    from: KeyCubes,
+}
+
+impl PackedTexels {
+    pub fn new(cubes: &KeyCubes) -> Self {
+        let texels = cubes
+            .ids
+            .texels
+            .iter()
+            .zip(&cubes.distance.texels)
+            .zip(&cubes.radiance.texels)
+            .map(|((&id, &distance), &radiance)| Texel {
+                id,
+                distance,
+                radiance,
+            })
+            .collect();
+        PackedTexels {
+            texels,
+            from: cubes.clone(),
+        }
+    }
+
+    /// Whether it was built from these very cubes.
+    pub fn built_from(&self, cubes: &KeyCubes) -> bool {
+        Arc::ptr_eq(&self.from.ids, &cubes.ids)
+            && Arc::ptr_eq(&self.from.distance, &cubes.distance)
+            && Arc::ptr_eq(&self.from.radiance, &cubes.radiance)
+    }
+
+    /// Bytes held, the cubes it keeps alive included.
+    pub fn bytes(&self) -> usize {
+        self.texels.len() * (std::mem::size_of::<Texel>() + 20)
+    }
+}
+
+/// A key's data as flat slices for the pixel loop.
+pub(crate) struct FastKey<'a> {
+    pub base: Vec3,
+    pub weight: f32,
+    pub face: u32,
+    /// Id, distance and radiance per texel.
+    pub texels: &'a [Texel],
+    pub normal: Option<&'a [Vec3]>,
+    /// Per object slot: M(τ) M(t)⁻¹.
+    pub motion: &'a [Affine3A],
+    /// Per object slot: the previous key has the same base view, face size and transform, so
+    /// its lookup direction and texel can be reused.
+    pub reuse: Vec<bool>,
+}
+
+/// No object slot: nothing to look up for this pixel.
+pub(crate) const NO_SLOT: u32 = u32::MAX;
+
+/// Per-row arrays (one set per rayon job, reused from row to row).
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// Object slot per pixel ([`NO_SLOT`]: nothing to look up).
+    pub slot: Vec<u32>,
+    /// Unit ray direction per pixel.
+    pub dir: [Vec<f32>; 3],
+    /// Hit point.
+    pub p: [Vec<f32>; 3],
+    /// Unit direction from the hit point to the eye.
+    e: [Vec<f32>; 3],
+    /// The current lookup: direction from the base view, its length, the texel index as f32 (−1:
+    /// none), the angular weight.
+    d: [Vec<f32>; 3],
+    dist: Vec<f32>,
+    ti: Vec<f32>,
+    wa: Vec<f32>,
+    /// Weighted radiance sum and weight sum.
+    pub sum: [Vec<f32>; 3],
+    pub ws: Vec<f32>,
+}
+
+impl Scratch {
+    /// Sizes every array for rows of `n` pixels.
+    pub fn resize(&mut self, n: usize) {
+        // Whole groups of four lanes; the padding is never fresh.
+        let n = n.next_multiple_of(4);
+        self.slot.resize(n, NO_SLOT);
+        for a in [
+            &mut self.dir,
+            &mut self.p,
+            &mut self.e,
+            &mut self.d,
+            &mut self.sum,
+        ] {
+            for c in a {
+                c.resize(n, 0.0);
+            }
+        }
+        self.dist.resize(n, 0.0);
+        self.ti.resize(n, -1.0);
+        self.wa.resize(n, 0.0);
+        self.ws.resize(n, 0.0);
+    }
+
+    /// The unit ray directions of row `y` (what [`CameraBasis::direction`] gives at the pixel
+    /// centres).
+    #[inline(never)]
+    pub fn directions(&mut self, b: &CameraBasis, y: usize, n: usize) {
+        let sy = (1.0 - 2.0 * (y as f32 + 0.5) / b.height) * b.tan_y;
+        let [dx, dy, dz] = &mut self.dir;
+        let (dx, dy, dz) = (&mut dx[..n], &mut dy[..n], &mut dz[..n]);
+        for x in 0..n {
+            let sx = (2.0 * (x as f32 + 0.5) / b.width - 1.0) * b.tan_x;
+            let rx = b.right.x * sx + b.up.x * sy + b.forward.x;
+            let ry = b.right.y * sx + b.up.y * sy + b.forward.y;
+            let rz = b.right.z * sx + b.up.z * sy + b.forward.z;
+            let r = 1.0 / (rx * rx + ry * ry + rz * rz).sqrt();
+            dx[x] = rx * r;
+            dy[x] = ry * r;
+            dz[x] = rz * r;
+        }
+    }
+
+    /// The direction of pixel `x` as a vector.
+    #[inline]
+    pub fn dir_at(&self, x: usize) -> Vec3 {
+        Vec3::new(self.dir[0][x], self.dir[1][x], self.dir[2][x])
+    }
+
+    /// Hit points from camera-space depths `z` (∞: none): writes the distance along the ray
+    /// back into `z` (∞ stays ∞) and the points and eye directions into the scratch.
+    #[inline(never)]
+    pub fn points_from_depth(&mut self, b: &CameraBasis, z: &mut [f32]) {
+        let n = z.len();
+        let [dx, dy, dz] = &self.dir;
+        let (dx, dy, dz) = (&dx[..n], &dy[..n], &dz[..n]);
+        let [px, py, pz] = &mut self.p;
+        let (px, py, pz) = (&mut px[..n], &mut py[..n], &mut pz[..n]);
+        let (f, o) = (b.forward, b.position);
+        for x in 0..n {
+            let dist = z[x] / (dx[x] * f.x + dy[x] * f.y + dz[x] * f.z);
+            z[x] = if z[x] == f32::INFINITY {
+                f32::INFINITY
+            } else {
+                dist
+            };
+            px[x] = o.x + dx[x] * dist;
+            py[x] = o.y + dy[x] * dist;
+            pz[x] = o.z + dz[x] * dist;
+        }
+        self.eye_directions(o, n);
+    }
+
+    /// Unit directions from the hit points to the eye (`normalize_or_zero`).
+    pub fn eye_directions(&mut self, o: Vec3, n: usize) {
+        let [px, py, pz] = &self.p;
+        let (px, py, pz) = (&px[..n], &py[..n], &pz[..n]);
+        let [ex, ey, ez] = &mut self.e;
+        let (ex, ey, ez) = (&mut ex[..n], &mut ey[..n], &mut ez[..n]);
+        for x in 0..n {
+            let (vx, vy, vz) = (o.x - px[x], o.y - py[x], o.z - pz[x]);
+            let r = 1.0 / (vx * vx + vy * vy + vz * vz).sqrt();
+            let ok = r.is_finite() && r > 0.0;
+            ex[x] = if ok { vx * r } else { 0.0 };
+            ey[x] = if ok { vy * r } else { 0.0 };
+            ez[x] = if ok { vz * r } else { 0.0 };
+        }
+    }
+
+    /// Sets the hit point of pixel `x` (the eye directions must be recomputed after).
+    #[inline]
+    pub fn set_p(&mut self, x: usize, p: Vec3) {
+        self.p[0][x] = p.x;
+        self.p[1][x] = p.y;
+        self.p[2][x] = p.z;
+    }
+}
+
+/// What the per-pixel lookups need.
+pub(crate) struct Shade<'a> {
+    pub fast: &'a [FastKey<'a>],
+    /// Relative distance tolerance.
+    pub tol: f32,
+    /// Angular power, and the same as an integer when it is one (else 0).
+    pub power: f32,
+    pub power_int: u32,
+}
+
+impl Shade<'_> {
+    /// The blends of the accepted lookups of a row of pixels (`s.slot`, `s.p` and the eye
+    /// directions filled; `obj`: their objects) into `s.sum` and `s.ws`.
+    ///
+    /// Key by key: the lookups of the whole row, then their tests and sums. A key that has the
+    /// same base view, face size and motion as the previous one for a pixel's object keeps the
+    /// previous lookup. The sums are in key order, as one pixel at a time would make them.
+    pub fn row(&self, s: &mut Scratch, obj: &[u32]) {
+        let n = obj.len();
+        for a in &mut s.sum {
+            a[..n].fill(0.0);
+        }
+        s.ws[..n].fill(0.0);
+        for (ki, k) in self.fast.iter().enumerate() {
+            self.lookups(s, k, ki == 0, n);
+            self.accumulate(s, k, obj);
+        }
+    }
+
+    /// The lookups of key `k` for the pixels that do not reuse the previous key's, four
+    /// pixels at a time.
+    #[inline(never)]
+    fn lookups(&self, s: &mut Scratch, k: &FastKey<'_>, first: bool, n: usize) {
+        let n4 = n.next_multiple_of(4);
+        let slots = &s.slot[..n4];
+        let [px, py, pz] = &s.p;
+        let (px, py, pz) = (&px[..n4], &py[..n4], &pz[..n4]);
+        let [ex, ey, ez] = &s.e;
+        let (ex, ey, ez) = (&ex[..n4], &ey[..n4], &ez[..n4]);
+        let [dx, dy, dz] = &mut s.d;
+        let (dx, dy, dz) = (&mut dx[..n4], &mut dy[..n4], &mut dz[..n4]);
+        let (dist, ti, wa) = (&mut s.dist[..n4], &mut s.ti[..n4], &mut s.wa[..n4]);
+        let geometry = CubeLanes::new(k.face);
+        let b = k.base;
+        let (bx, by, bz) = (Vec4::splat(b.x), Vec4::splat(b.y), Vec4::splat(b.z));
+        let load = |a: &[f32], x: usize| Vec4::from_slice(&a[x..x + 4]);
+        for x in (0..n4).step_by(4) {
+            let sl = [slots[x], slots[x + 1], slots[x + 2], slots[x + 3]];
+            let fresh = sl.map(|s| s != NO_SLOT && (first || !k.reuse[s as usize]));
+            if fresh == [false; 4] {
+                continue;
+            }
+            let (p0, p1, p2) = (load(px, x), load(py, x), load(pz, x));
+            // The points at the key's time: M(τ) M(t)⁻¹ p, as `Affine3A::transform_point3`
+            // computes it, lane by lane.
+            let (qx, qy, qz) = if sl[1..].iter().all(|&s| s == sl[0]) {
+                let m = &k.motion[sl[0] as usize];
+                let (a, bb, c, t) = (
+                    m.matrix3.x_axis,
+                    m.matrix3.y_axis,
+                    m.matrix3.z_axis,
+                    m.translation,
+                );
+                let row = |a: f32, bb: f32, c: f32, t: f32| {
+                    Vec4::splat(a) * p0
+                        + Vec4::splat(bb) * p1
+                        + Vec4::splat(c) * p2
+                        + Vec4::splat(t)
+                };
+                (
+                    row(a.x, bb.x, c.x, t.x),
+                    row(a.y, bb.y, c.y, t.y),
+                    row(a.z, bb.z, c.z, t.z),
+                )
+            } else {
+                let (mut qx, mut qy, mut qz) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
+                for i in 0..4 {
+                    if fresh[i] {
+                        let q = k.motion[sl[i] as usize].transform_point3(Vec3::new(
+                            px[x + i],
+                            py[x + i],
+                            pz[x + i],
+                        ));
+                        (qx[i], qy[i], qz[i]) = (q.x, q.y, q.z);
+                    }
+                }
+                (Vec4::from(qx), Vec4::from(qy), Vec4::from(qz))
+            };
+            let (vx, vy, vz) = (qx - bx, qy - by, qz - bz);
+            let dist2 = vx * vx + vy * vy + vz * vz;
+            let invalid = dist2.is_nan_mask() | dist2.cmple(Vec4::splat(1e-12));
+            let l = dist2.sqrt();
+            let t = Vec4::select(invalid, Vec4::splat(-1.0), geometry.texels(vx, vy, vz));
+            let e = load(ex, x) * vx + load(ey, x) * vy + load(ez, x) * vz;
+            let cos = -e / l;
+            let c = ((Vec4::ONE + cos) * 0.5).max(Vec4::splat(1e-3));
+            let w = if self.power <= 0.0 {
+                Vec4::ONE
+            } else if self.power_int > 0 {
+                powi4(c, self.power_int)
+            } else {
+                Vec4::from(c.to_array().map(|c| c.powf(self.power)))
+            };
+            let f = BVec4A::new(fresh[0], fresh[1], fresh[2], fresh[3]);
+            let put = |a: &mut [f32], v: Vec4| {
+                Vec4::select(f, v, load(a, x)).write_to_slice(&mut a[x..x + 4]);
+            };
+            put(dx, vx);
+            put(dy, vy);
+            put(dz, vz);
+            put(dist, l);
+            put(ti, t);
+            put(wa, w);
+        }
+    }
+
+    /// Tests the current lookups of key `k` and adds the accepted ones to the sums.
+    #[inline(never)]
+    fn accumulate(&self, s: &mut Scratch, k: &FastKey<'_>, obj: &[u32]) {
+        let n = obj.len();
+        let tol = self.tol;
+        let (slots, ti, dist, wa) = (&s.slot[..n], &s.ti[..n], &s.dist[..n], &s.wa[..n]);
+        let [sx, sy, sz] = &mut s.sum;
+        let ws = &mut s.ws[..n];
+        for x in 0..n {
+            if slots[x] == NO_SLOT || ti[x] < 0.0 {
+                continue;
+            }
+            let t = ti[x] as usize;
+            let Some(tx) = k.texels.get(t) else { continue };
+            if tx.id != obj[x] {
+                continue;
+            }
+            let (dc, l) = (tx.distance, dist[x]);
+            // Fast path: the texel's centre distance agrees. Otherwise compare with the
+            // distance to the texel's surface plane along the lookup direction (grazing
+            // surfaces change depth quickly across a texel).
+            if (dc - l).abs() > tol * l {
+                let Some(nc) = k.normal else { continue };
+                let nrm = nc[t];
+                let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
+                let denom = d.dot(nrm) / l;
+                if denom.abs() <= 0.05 {
+                    continue;
+                }
+                let expected = (cube::texel_direction(k.face, t) * dc).dot(nrm) / denom;
+                if (expected - l).abs() > tol * l {
+                    continue;
+                }
+            }
+            let wt = k.weight * wa[x];
+            let r = tx.radiance;
+            sx[x] += r.x * wt;
+            sy[x] += r.y * wt;
+            sz[x] += r.z * wt;
+            ws[x] += wt;
+        }
+    }
+}
+
+/// `c^k` for `k ≥ 1` by repeated squaring, lane by lane as `f32::powi` multiplies.
+#[inline(always)]
+fn powi4(mut c: Vec4, mut k: u32) -> Vec4 {
+    let mut r = Vec4::ONE;
+    loop {
+        if k & 1 == 1 {
+            r *= c;
+        }
+        k >>= 1;
+        if k == 0 {
+            return r;
+        }
+        c *= c;
+    }
+}
+
+/// Cube texel addressing four directions at a time: [`sample::texel`] with selects instead
+/// of branches, and the index computed in f32 (exact below 2²⁴ texels).
+struct CubeLanes {
+    n: Vec4,
+    n_minus_1: Vec4,
+    face_texels: Vec4,
+}
+
+impl CubeLanes {
+    fn new(face_size: u32) -> Self {
+        let n = face_size.max(1) as f32;
+        CubeLanes {
+            n: Vec4::splat(n),
+            n_minus_1: Vec4::splat(n - 1.0),
+            face_texels: Vec4::splat(n * n),
+        }
+    }
+
+    /// The texel indices (as f32) of directions (x, y, z).
+    #[inline(always)]
+    fn texels(&self, x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
+        let sel = Vec4::select;
+        let zero = Vec4::ZERO;
+        let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+        let xm = ax.cmpge(ay) & ax.cmpge(az);
+        let ym = !xm & ay.cmpge(az);
+        let (px, py, pz) = (x.cmpge(zero), y.cmpge(zero), z.cmpge(zero));
+        let face = sel(
+            xm,
+            sel(px, zero, Vec4::splat(1.0)),
+            sel(
+                ym,
+                sel(py, Vec4::splat(2.0), Vec4::splat(3.0)),
+                sel(pz, Vec4::splat(4.0), Vec4::splat(5.0)),
+            ),
+        );
+        let sc = sel(xm, sel(px, -z, z), sel(ym | pz, x, -x));
+        let tc = sel(ym, sel(py, z, -z), -y);
+        let ma = sel(xm, ax, sel(ym, ay, az));
+        let ok = ma.cmpgt(zero) & ma.is_finite_mask();
+        let half = Vec4::splat(0.5);
+        let u = sel(ok, half * (sc / ma + Vec4::ONE), half);
+        let v = sel(ok, half * (tc / ma + Vec4::ONE), half);
+        let face = sel(ok, face, zero);
+        // `(u n) as usize` then `min(n − 1)`; NaN → 0 (maxps returns its second operand).
+        let i = (u * self.n).trunc().max(zero).min(self.n_minus_1);
+        let j = (v * self.n).trunc().max(zero).min(self.n_minus_1);
+        face * self.face_texels + j * self.n + i
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample;
+
+    #[test]
+    fn branch_free_texel_matches_the_reference() {
+        let mut s = 987654321u32;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut dirs: Vec<Vec3> = (0..20000).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        dirs.extend([
+            Vec3::ZERO,
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 1.0),
+            Vec3::new(0.0, -1.0, -1.0),
+            Vec3::new(f32::NAN, 1.0, 0.0),
+            Vec3::new(f32::INFINITY, 1.0, 0.0),
+        ]);
+        for d in dirs {
+            for n in [1u32, 16, 128] {
+                let lanes =
+                    CubeLanes::new(n).texels(Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
+                assert_eq!(lanes.x as usize, sample::texel(n, d), "{d} {n}");
+            }
+        }
+        for c in [0.0f32, 1e-3, 0.3, 0.77, 1.0] {
+            for k in [1, 2, 3, 8, 13] {
+                assert_eq!(powi4(Vec4::splat(c), k).x, c.powi(k as i32));
+            }
+        }
+    }
+}
