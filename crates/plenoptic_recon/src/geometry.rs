@@ -254,9 +254,9 @@ pub(crate) fn render(
                     if s.slot[x] == NO_SLOT {
                         continue;
                     }
-                    if s.ws[x] > 0.0 {
-                        let c = Vec3::new(s.sum[0][x], s.sum[1][x], s.sum[2][x]);
-                        rad[x] = c / s.ws[x];
+                    let c = s.sum[x];
+                    if c.w > 0.0 {
+                        rad[x] = c.truncate() / c.w;
                         cls[x] = DIRECT;
                     } else {
                         cls[x] = HOLE;

@@ -14,13 +14,15 @@ use std::sync::Arc;
 
 use crate::camera::CameraBasis;
 use crate::reconstructor::KeyCubes;
+use crate::sample;
 
-/// One texel of a key's cubes: what an accepted lookup reads, together.
+/// One texel of a key's cubes: what an accepted lookup reads, together (half a cache line).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Texel {
+    /// Radiance and 1: weighted, it adds to the radiance sum and the weight sum at once.
+    pub radiance: Vec4,
     pub id: u32,
     pub distance: f32,
-    pub radiance: Vec3,
 }
 
 /// The object-id, distance and radiance cubes of one (view, key) interleaved texel by texel
@@ -41,9 +43,9 @@ impl PackedTexels {
             .zip(&cubes.distance.texels)
             .zip(&cubes.radiance.texels)
             .map(|((&id, &distance), &radiance)| Texel {
+                radiance: radiance.extend(1.0),
                 id,
                 distance,
-                radiance,
             })
             .collect();
         PackedTexels {
@@ -82,6 +84,8 @@ pub(crate) struct FastKey<'a> {
 
 /// No object slot: nothing to look up for this pixel.
 pub(crate) const NO_SLOT: u32 = u32::MAX;
+/// No texel.
+const NO_TEXEL: u32 = u32::MAX;
 
 /// Per-row arrays (one set per rayon job, reused from row to row).
 #[derive(Default)]
@@ -94,15 +98,14 @@ pub(crate) struct Scratch {
     pub p: [Vec<f32>; 3],
     /// Unit direction from the hit point to the eye.
     e: [Vec<f32>; 3],
-    /// The current lookup: direction from the base view, its length, the texel index as f32 (−1:
+    /// The current lookup: direction from the base view, its length, the texel ([`NO_TEXEL`]:
     /// none), the angular weight.
     d: [Vec<f32>; 3],
     dist: Vec<f32>,
-    ti: Vec<f32>,
+    ti: Vec<u32>,
     wa: Vec<f32>,
-    /// Weighted radiance sum and weight sum.
-    pub sum: [Vec<f32>; 3],
-    pub ws: Vec<f32>,
+    /// Weighted radiance sum and, in `w`, the weight sum.
+    pub sum: Vec<Vec4>,
 }
 
 impl Scratch {
@@ -111,21 +114,15 @@ impl Scratch {
         // Whole groups of four lanes; the padding is never fresh.
         let n = n.next_multiple_of(4);
         self.slot.resize(n, NO_SLOT);
-        for a in [
-            &mut self.dir,
-            &mut self.p,
-            &mut self.e,
-            &mut self.d,
-            &mut self.sum,
-        ] {
+        for a in [&mut self.dir, &mut self.p, &mut self.e, &mut self.d] {
             for c in a {
                 c.resize(n, 0.0);
             }
         }
         self.dist.resize(n, 0.0);
-        self.ti.resize(n, -1.0);
+        self.ti.resize(n, NO_TEXEL);
         self.wa.resize(n, 0.0);
-        self.ws.resize(n, 0.0);
+        self.sum.resize(n, Vec4::ZERO);
     }
 
     /// The unit ray directions of row `y` (what [`CameraBasis::direction`] gives at the pixel
@@ -221,10 +218,7 @@ impl Shade<'_> {
     /// previous lookup. The sums are in key order, as one pixel at a time would make them.
     pub fn row(&self, s: &mut Scratch, obj: &[u32]) {
         let n = obj.len();
-        for a in &mut s.sum {
-            a[..n].fill(0.0);
-        }
-        s.ws[..n].fill(0.0);
+        s.sum[..n].fill(Vec4::ZERO);
         for (ki, k) in self.fast.iter().enumerate() {
             self.lookups(s, k, ki == 0, n);
             self.accumulate(s, k, obj);
@@ -250,8 +244,17 @@ impl Shade<'_> {
         let load = |a: &[f32], x: usize| Vec4::from_slice(&a[x..x + 4]);
         for x in (0..n4).step_by(4) {
             let sl = [slots[x], slots[x + 1], slots[x + 2], slots[x + 3]];
-            let fresh = sl.map(|s| s != NO_SLOT && (first || !k.reuse[s as usize]));
+            let is_fresh = |s: u32| s != NO_SLOT && (first || !k.reuse[s as usize]);
+            let fresh = [
+                is_fresh(sl[0]),
+                is_fresh(sl[1]),
+                is_fresh(sl[2]),
+                is_fresh(sl[3]),
+            ];
             if fresh == [false; 4] {
+                if first {
+                    ti[x..x + 4].fill(NO_TEXEL);
+                }
                 continue;
             }
             let (p0, p1, p2) = (load(px, x), load(py, x), load(pz, x));
@@ -294,7 +297,15 @@ impl Shade<'_> {
             let dist2 = vx * vx + vy * vy + vz * vz;
             let invalid = dist2.is_nan_mask() | dist2.cmple(Vec4::splat(1e-12));
             let l = dist2.sqrt();
-            let t = Vec4::select(invalid, Vec4::splat(-1.0), geometry.texels(vx, vy, vz));
+            let t = geometry.texels(vx, vy, vz);
+            let invalid = invalid.bitmask();
+            for i in 0..4 {
+                if fresh[i] && invalid & (1 << i) == 0 {
+                    ti[x + i] = t[i];
+                } else if fresh[i] || first {
+                    ti[x + i] = NO_TEXEL;
+                }
+            }
             let e = load(ex, x) * vx + load(ey, x) * vy + load(ez, x) * vz;
             let cos = -e / l;
             let c = ((Vec4::ONE + cos) * 0.5).max(Vec4::splat(1e-3));
@@ -313,7 +324,6 @@ impl Shade<'_> {
             put(dy, vy);
             put(dz, vz);
             put(dist, l);
-            put(ti, t);
             put(wa, w);
         }
     }
@@ -323,13 +333,9 @@ impl Shade<'_> {
     fn accumulate(&self, s: &mut Scratch, k: &FastKey<'_>, obj: &[u32]) {
         let n = obj.len();
         let tol = self.tol;
-        let (slots, ti, dist, wa) = (&s.slot[..n], &s.ti[..n], &s.dist[..n], &s.wa[..n]);
-        let [sx, sy, sz] = &mut s.sum;
-        let ws = &mut s.ws[..n];
+        let (ti, dist, wa) = (&s.ti[..n], &s.dist[..n], &s.wa[..n]);
+        let sum = &mut s.sum[..n];
         for x in 0..n {
-            if slots[x] == NO_SLOT || ti[x] < 0.0 {
-                continue;
-            }
             let t = ti[x] as usize;
             let Some(tx) = k.texels.get(t) else { continue };
             if tx.id != obj[x] {
@@ -352,15 +358,13 @@ impl Shade<'_> {
                     continue;
                 }
             }
-            let wt = k.weight * wa[x];
-            let r = tx.radiance;
-            sx[x] += r.x * wt;
-            sy[x] += r.y * wt;
-            sz[x] += r.z * wt;
-            ws[x] += wt;
+            sum[x] += tx.radiance * (k.weight * wa[x]);
         }
     }
 }
+
+/// 2²³ as f32.
+const TWO_23: f32 = (1u32 << 23) as f32;
 
 /// `c^k` for `k ≥ 1` by repeated squaring, lane by lane as `f32::powi` multiplies.
 #[inline(always)]
@@ -379,26 +383,51 @@ fn powi4(mut c: Vec4, mut k: u32) -> Vec4 {
 }
 
 /// Cube texel addressing four directions at a time: [`sample::texel`] with selects instead
-/// of branches, and the index computed in f32 (exact below 2²⁴ texels).
+/// of branches, and the index computed in f32 (exact for cubes of fewer than 2²³ texels, face
+/// size ≤ 1182; larger cubes take [`sample::texel`] lane by lane).
 struct CubeLanes {
+    face_size: u32,
     n: Vec4,
     n_minus_1: Vec4,
     face_texels: Vec4,
+    exact: bool,
 }
 
 impl CubeLanes {
     fn new(face_size: u32) -> Self {
         let n = face_size.max(1) as f32;
         CubeLanes {
+            face_size,
             n: Vec4::splat(n),
             n_minus_1: Vec4::splat(n - 1.0),
             face_texels: Vec4::splat(n * n),
+            exact: 6 * (face_size.max(1) as u64).pow(2) < 1 << 23,
         }
     }
 
-    /// The texel indices (as f32) of directions (x, y, z).
+    /// The texel indices of directions (x, y, z).
     #[inline(always)]
-    fn texels(&self, x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
+    fn texels(&self, x: Vec4, y: Vec4, z: Vec4) -> [u32; 4] {
+        if !self.exact {
+            let (x, y, z) = (x.to_array(), y.to_array(), z.to_array());
+            return std::array::from_fn(|i| {
+                sample::texel(self.face_size, Vec3::new(x[i], y[i], z[i])) as u32
+            });
+        }
+        // The index in the low 23 bits of `index + 2²³` (exact below 2²³).
+        let t = (self.texels_f32(x, y, z) + Vec4::splat(TWO_23)).to_array();
+        let m = (1 << 23) - 1;
+        [
+            t[0].to_bits() & m,
+            t[1].to_bits() & m,
+            t[2].to_bits() & m,
+            t[3].to_bits() & m,
+        ]
+    }
+
+    /// The texel indices as f32.
+    #[inline(always)]
+    fn texels_f32(&self, x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
         let sel = Vec4::select;
         let zero = Vec4::ZERO;
         let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
@@ -432,7 +461,6 @@ impl CubeLanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sample;
 
     #[test]
     fn branch_free_texel_matches_the_reference() {
@@ -455,10 +483,10 @@ mod tests {
             Vec3::new(f32::INFINITY, 1.0, 0.0),
         ]);
         for d in dirs {
-            for n in [1u32, 16, 128] {
+            for n in [1u32, 16, 128, 1182, 1183, 2048] {
                 let lanes =
                     CubeLanes::new(n).texels(Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
-                assert_eq!(lanes.x as usize, sample::texel(n, d), "{d} {n}");
+                assert_eq!(lanes[0] as usize, sample::texel(n, d), "{d} {n}");
             }
         }
         for c in [0.0f32, 1e-3, 0.3, 0.77, 1.0] {

@@ -7,7 +7,7 @@
 //! its centre; the hit point is the eye plus the pixel's ray direction times the ray distance.
 //! The image is split into bands of rows rasterized in parallel.
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Vec3, Vec4};
 use plenoptic_scene::Mesh;
 use rayon::prelude::*;
 
@@ -158,22 +158,50 @@ pub(crate) fn raster_band(
             let x0 = ((lo - 0.5).floor() - 2.0).max(xmin as f64) as usize;
             let x1 = (((hi - 0.5).ceil() + 3.0) as usize).min(xmax);
             let row = (py - y0) * w;
-            for px in x0..x1 {
-                let cx = px as f32 + 0.5;
-                let e = |i: usize, j: usize| {
-                    (t.x[j] - t.x[i]) * (cy - t.y[i]) - (t.y[j] - t.y[i]) * (cx - t.x[i])
-                };
-                let b0 = e(1, 2) * inv;
-                let b1 = e(2, 0) * inv;
-                let b2 = e(0, 1) * inv;
+            // Per row: e(i, j) = (x_j − x_i)(cy − y_i) − (y_j − y_i)(cx − x_i).
+            let a = |i: usize, j: usize| (t.x[j] - t.x[i]) * (cy - t.y[i]);
+            let (a12, a20, a01) = (a(1, 2), a(2, 0), a(0, 1));
+            let (d12, d20, d01) = (t.y[2] - t.y[1], t.y[0] - t.y[2], t.y[1] - t.y[0]);
+            let test = |cx: f32| {
+                let b0 = (a12 - d12 * (cx - t.x[1])) * inv;
+                let b1 = (a20 - d20 * (cx - t.x[2])) * inv;
+                let b2 = (a01 - d01 * (cx - t.x[0])) * inv;
                 if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
-                    continue;
+                    return None;
                 }
                 let iz = b0 * t.iz[0] + b1 * t.iz[1] + b2 * t.iz[2];
-                if iz <= 0.0 {
-                    continue;
+                (iz > 0.0).then(|| 1.0 / iz)
+            };
+            // Four pixels at a time (the same arithmetic lane by lane), then the rest.
+            let mut px = x0;
+            let (v, lanes) = (Vec4::splat, Vec4::new(0.5, 1.5, 2.5, 3.5));
+            while px + 4 <= x1 {
+                let cx = v(px as f32) + lanes;
+                let b0 = (v(a12) - v(d12) * (cx - v(t.x[1]))) * v(inv);
+                let b1 = (v(a20) - v(d20) * (cx - v(t.x[2]))) * v(inv);
+                let b2 = (v(a01) - v(d01) * (cx - v(t.x[0]))) * v(inv);
+                let iz = b0 * v(t.iz[0]) + b1 * v(t.iz[1]) + b2 * v(t.iz[2]);
+                let z = Vec4::ONE / iz;
+                let j = row + px;
+                let old = Vec4::from_slice(&zbuf[j..j + 4]);
+                let zero = Vec4::ZERO;
+                let inside = !(b0.cmplt(zero) | b1.cmplt(zero) | b2.cmplt(zero) | iz.cmple(zero));
+                let write = inside & z.cmplt(old);
+                let bits = write.bitmask();
+                if bits != 0 {
+                    Vec4::select(write, z, old).write_to_slice(&mut zbuf[j..j + 4]);
+                    for i in 0..4 {
+                        if bits & (1 << i) != 0 {
+                            obj[j + i] = t.object;
+                        }
+                    }
                 }
-                let z = 1.0 / iz;
+                px += 4;
+            }
+            for px in px..x1 {
+                let Some(z) = test(px as f32 + 0.5) else {
+                    continue;
+                };
                 let j = row + px;
                 if z < zbuf[j] {
                     zbuf[j] = z;
