@@ -53,6 +53,10 @@
 //! - `--plan`: print the bake plan of the recipe (base views, time keys, estimated cost) and
 //!   stop.
 //! - `--quiet`: no progress bars.
+//! - `--screenshot FILE`, `--screenshot-at S`: in the window, hold the tour at S seconds
+//!   (default 4), save the window to FILE once the frame's data is resident, and quit.
+//! - `--streaming`: print the plugin's streaming working set along the whole tour (bytes
+//!   resident per frame with its default settings) and stop; needs the `bevy` feature.
 //! - `--results DIR`: instead of the tour, the README's results (`results.rs`): path-traced
 //!   reference frames (`--spp N`, default 128) at `--frames` (default 8) frames spread over
 //!   the tour, each mode's reconstruction of them, errors, plot, montage and figures, at
@@ -97,11 +101,14 @@ struct Options {
     plan: bool,
     results: Option<PathBuf>,
     spp: u32,
+    screenshot: Option<PathBuf>,
+    screenshot_at: f32,
+    streaming: bool,
 }
 
 const USAGE: &str = "usage: architectural_tour [--headless] [--cpu] [--frames N] [--width W] \
                      [--height H] [--out DIR] [--pack FILE] [--recipe FILE] [--mode geometry|image|volume] \
-                     [--plan] [--quiet] [--results DIR [--spp N]]";
+                     [--plan] [--streaming] [--quiet] [--results DIR [--spp N]] [--screenshot FILE [--screenshot-at S]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -118,6 +125,9 @@ fn parse_args() -> Result<Options, String> {
         plan: false,
         results: None,
         spp: 128,
+        screenshot: None,
+        screenshot_at: 4.0,
+        streaming: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -133,6 +143,7 @@ fn parse_args() -> Result<Options, String> {
             "--cpu" => o.cpu = true,
             "--quiet" => o.quiet = true,
             "--plan" => o.plan = true,
+            "--streaming" => o.streaming = true,
             "--frames" => o.frames = Some(number("--frames", value("--frames")?)? as usize),
             "--width" => o.width = Some(number("--width", value("--width")?)?),
             "--height" => o.height = Some(number("--height", value("--height")?)?),
@@ -141,6 +152,15 @@ fn parse_args() -> Result<Options, String> {
             "--recipe" => o.recipe = Some(value("--recipe")?.into()),
             "--results" => o.results = Some(value("--results")?.into()),
             "--spp" => o.spp = number("--spp", value("--spp")?)?,
+            "--screenshot" => o.screenshot = Some(value("--screenshot")?.into()),
+            "--screenshot-at" => {
+                let v = value("--screenshot-at")?;
+                o.screenshot_at = v
+                    .parse()
+                    .ok()
+                    .filter(|s: &f32| s.is_finite() && *s >= 0.0)
+                    .ok_or(format!("--screenshot-at: `{v}` is not a time in seconds"))?;
+            }
             "--mode" => {
                 let v = value("--mode")?;
                 o.mode = Mode::parse(&v).ok_or(format!("--mode: unknown mode `{v}`"))?;
@@ -243,6 +263,13 @@ fn run(options: &Options) -> Result<(), BoxError> {
     }
 
     // 3. The tour, or the results.
+    if options.streaming {
+        let path = CameraPath::load(assets.join("tour_path.json"))?;
+        let line = streaming_figures(&pack, &path)?
+            .ok_or("--streaming needs the `bevy` feature (leave out --no-default-features)")?;
+        println!("{line}");
+        return Ok(());
+    }
     if let Some(dir) = &options.results {
         let path = CameraPath::load(assets.join("tour_path.json"))?;
         return results::run(
@@ -277,8 +304,12 @@ fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
     if let Some(h) = options.height {
         path.height = h;
     }
-    // The exposure of the first frame, from a small CPU reconstruction.
-    let start = path.sample(path.time_range().0);
+    // The exposure of the first frame shown, from a small CPU reconstruction.
+    let start = path.sample(if options.screenshot.is_some() {
+        options.screenshot_at
+    } else {
+        path.time_range().0
+    });
     let mut probe = start.camera;
     (probe.width, probe.height) = (160, 90);
     let (frame, _) = Reconstructor::open(pack)?.render(&probe, start.scene_time, options.mode)?;
@@ -292,7 +323,14 @@ fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
         "opening the tour window ({}): Tab free-fly / tour, Space pause, 1-3 mode, Esc quit",
         pack.display()
     );
-    windowed::run(pack, path, exposure, backend)
+    let screenshot = options
+        .screenshot
+        .clone()
+        .map(|file| windowed::ScreenshotPlan {
+            file,
+            at: options.screenshot_at,
+        });
+    windowed::run(pack, path, exposure, backend, screenshot)
 }
 
 /// Without the `window` feature the tour renders headless.

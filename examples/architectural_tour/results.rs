@@ -10,8 +10,9 @@
 //!    volume.
 //! 5. `figures.md`: bake time per phase, pack size and its ratio to the raw range images,
 //!    error per mode, CPU reconstruction time per frame at the path's own 640 × 360, the
-//!    streaming working set along the whole tour (with the `bevy` feature), and the
-//!    walk-through speed-up over path tracing every frame — beside the thesis's figures.
+//!    streaming working set along the whole tour (with the `bevy` feature; `--streaming`
+//!    prints it alone), and the walk-through speed-up over path tracing every frame — beside
+//!    the thesis's figures.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -8,17 +8,24 @@
 //! rate, the scene time, the mode and the plugin's resident streaming memory; the peak
 //! resident memory is printed when the window closes.
 //!
+//! `--screenshot FILE` (with `--screenshot-at SECONDS` along the path) holds the tour at that
+//! moment, waits until the plugin has streamed what the frame needs and the pipelines are
+//! compiled, saves the window to FILE and quits: how the README's window picture was taken.
+//!
 //! Exposure: the reconstruction writes linear radiance into the HDR target; the example sets
 //! the camera's colour-grading exposure from the CPU reconstruction's automatic exposure at
 //! the start of the path and tonemaps with ACES, the same curve as the headless frames.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use bevy::camera::Hdr;
 use bevy::camera_controller::free_camera::{FreeCamera, FreeCameraPlugin, FreeCameraState};
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
+use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::prelude::*;
+use bevy::render::view::screenshot::{Capturing, Screenshot, save_to_disk};
 use bevy::render::view::{ColorGrading, ColorGradingGlobal};
 use bevy::window::WindowResolution;
 use bevy_plenoptic::prelude::*;
@@ -34,10 +41,23 @@ struct Tour {
     /// The path drives the camera (else the free-fly controller does).
     flying_tour: bool,
     paused: bool,
-    /// Largest resident-bytes diagnostic seen.
-    peak_resident: f64,
+    /// Largest resident-bytes diagnostic seen (read after the app has exited).
+    peak_resident: Arc<AtomicU64>,
     title_timer: Timer,
+    screenshot: Option<ScreenshotPlan>,
 }
+
+/// A screenshot to take and then quit.
+pub struct ScreenshotPlan {
+    /// Where the PNG goes.
+    pub file: PathBuf,
+    /// Seconds along the camera path.
+    pub at: f32,
+}
+
+/// Frames rendered with everything resident before the screenshot (lavapipe compiles
+/// pipelines lazily; the first frames can be blank).
+const SETTLE_FRAMES: u32 = 30;
 
 /// Opens the window and runs the tour until it is closed.
 pub fn run(
@@ -45,6 +65,7 @@ pub fn run(
     path: CameraPath,
     exposure: f32,
     backend: Backend,
+    screenshot: Option<ScreenshotPlan>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let dir = pack
         .parent()
@@ -57,6 +78,7 @@ pub fn run(
         .into_owned();
     let (width, height) = (path.width.max(320), path.height.max(180));
 
+    let peak = Arc::new(AtomicU64::new(0));
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
@@ -85,17 +107,18 @@ pub fn run(
     })
     .insert_resource(ClearColor(Color::BLACK))
     .insert_resource(Tour {
+        path_time: screenshot.as_ref().map_or(0.0, |s| s.at),
+        paused: screenshot.is_some(),
         path,
-        path_time: 0.0,
         flying_tour: true,
-        paused: false,
-        peak_resident: 0.0,
+        peak_resident: peak.clone(),
         title_timer: Timer::from_seconds(0.5, TimerMode::Repeating),
+        screenshot,
     })
     .add_systems(
         Startup,
         move |mut commands: Commands, assets: Res<AssetServer>, tour: Res<Tour>| {
-            let start = tour.path.sample(tour.path.time_range().0);
+            let start = tour.path.sample(tour.path_time);
             let mut camera = PlenopticCamera::new(assets.load(file.clone()));
             camera.playback = Playback::Manual;
             camera.time = start.scene_time;
@@ -126,14 +149,18 @@ pub fn run(
     )
     .add_systems(
         Update,
-        (keys, fly_tour.before(PlenopticSystems::Playback), title),
+        (
+            keys,
+            fly_tour.before(PlenopticSystems::Playback),
+            title,
+            take_screenshot,
+        ),
     );
     app.run();
 
-    let peak = app.world().resource::<Tour>().peak_resident;
     println!(
         "peak resident streaming memory: {:.1} MiB",
-        peak / (1024.0 * 1024.0)
+        peak.load(Ordering::Relaxed) as f64 / (1024.0 * 1024.0)
     );
     Ok(())
 }
@@ -226,7 +253,8 @@ fn title(
         .get(&RESIDENT_BYTES)
         .and_then(|d| d.value())
         .unwrap_or(0.0);
-    tour.peak_resident = tour.peak_resident.max(resident);
+    tour.peak_resident
+        .fetch_max(resident as u64, Ordering::Relaxed);
     if !tour.title_timer.tick(time.delta()).just_finished() {
         return;
     }
@@ -254,5 +282,43 @@ fn title(
             resident / (1024.0 * 1024.0),
             if tour.paused { " — paused" } else { "" }
         );
+    }
+}
+
+/// With a [`ScreenshotPlan`]: once nothing the frame needs is missing, waits
+/// [`SETTLE_FRAMES`] frames, captures the window, and quits when the file is written.
+fn take_screenshot(
+    mut commands: Commands,
+    tour: Res<Tour>,
+    diagnostics: Res<DiagnosticsStore>,
+    capturing: Query<(), With<Capturing>>,
+    mut settled: Local<u32>,
+    mut requested: Local<bool>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(plan) = &tour.screenshot else {
+        return;
+    };
+    if *requested {
+        if capturing.is_empty() {
+            println!("window saved to {}", plan.file.display());
+            exit.write(AppExit::Success);
+        }
+        return;
+    }
+    let value =
+        |p: DiagnosticPath| -> f64 { diagnostics.get(&p).and_then(|d| d.value()).unwrap_or(0.0) };
+    let resident = value(RESIDENT_BYTES);
+    let stalls = value(bevy_plenoptic::streaming::STALLS);
+    *settled = if resident > 0.0 && stalls == 0.0 {
+        *settled + 1
+    } else {
+        0
+    };
+    if *settled >= SETTLE_FRAMES {
+        commands
+            .spawn(Screenshot::primary_window())
+            .observe(save_to_disk(plan.file.clone()));
+        *requested = true;
     }
 }
