@@ -450,6 +450,7 @@ fn cmd_reference(
         &scene,
         &frames,
         spp,
+        None,
         out,
         exposure,
         &Progress::new(true),

@@ -27,20 +27,25 @@ pub struct ReferenceSummary {
 
 /// Path-traces `samples` of a camera path through `scene` with `spp` samples per pixel into
 /// `out` (`frame_NNNNN.exr` linear and `.png` tonemapped with `exposure`, or with the first
-/// frame's automatic exposure when `None`).
+/// frame's automatic exposure when `None`). `seed` picks the random sequence (`None`: the
+/// tracer's default); two seeds give independent references, whose difference measures the
+/// reference's own noise.
 pub fn render_reference(
     scene: &Scene,
     samples: &[PathSample],
     spp: u32,
+    seed: Option<u64>,
     out: &Path,
     exposure: Option<f32>,
     progress: &Progress,
 ) -> Result<ReferenceSummary> {
     let accel = SceneAccel::new(scene)?;
     std::fs::create_dir_all(out).map_err(|e| BakeError::io(out, e))?;
+    let defaults = PathTracerSettings::default();
     let tracer = PathTracer::new(PathTracerSettings {
         samples_per_pixel: spp,
-        ..Default::default()
+        seed: seed.unwrap_or(defaults.seed),
+        ..defaults
     });
     let bar = progress.phase("reference", samples.len() as u64);
     let mut exposure = exposure;
