@@ -40,7 +40,7 @@ use plenoptic_recon::temporal::bracketing;
 use plenoptic_recon::viewspace::ViewWeights;
 
 use crate::asset::RadiancePack;
-use crate::camera::PlenopticCamera;
+use crate::camera::{PlenopticCamera, ReconMode};
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::streaming::StreamCache;
 use crate::streaming::schedule::{time_epsilon, volume_buckets};
@@ -248,6 +248,13 @@ fn update_materials(
         let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.pack.id() == id) else {
             continue;
         };
+        if cam.mode != ReconMode::GeometryAssisted {
+            warn_once!(
+                "plenoptic: the GPU backend reconstructs in geometry-assisted mode only; \
+                 {:?} mode needs Backend::Cpu",
+                cam.mode
+            );
+        }
         let m = pack.reader.manifest();
         let usable = vec![true; m.base_views.len()];
         let mut views = ViewWeights::new(&m.view_space, &m.base_views, &usable)

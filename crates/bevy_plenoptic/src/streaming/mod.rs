@@ -38,11 +38,11 @@ use schedule::{BlockRef, KeyRef, Lookahead, working_set};
 
 /// Bytes of decoded cube data resident (and reserved for reads in flight).
 pub const RESIDENT_BYTES: DiagnosticPath = DiagnosticPath::const_new("plenoptic/resident_bytes");
-/// Needed keys found resident this frame.
+/// Needed keys and volume blocks found resident this frame.
 pub const HITS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/hits");
-/// Needed keys not resident this frame.
+/// Needed keys and volume blocks not resident this frame.
 pub const MISSES: DiagnosticPath = DiagnosticPath::const_new("plenoptic/misses");
-/// 1 for a frame in which some needed key was not resident, else 0.
+/// 1 for a frame in which some needed key or volume block was not resident, else 0.
 pub const STALLS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/stalls");
 /// Milliseconds spent reading and decoding the keys that finished this frame.
 pub const DECODE_MS: DiagnosticPath = DiagnosticPath::const_new("plenoptic/decode_ms");
@@ -74,7 +74,7 @@ pub struct StreamState {
     pub last_position: Option<Vec3>,
     /// This frame's working set.
     pub working_set: schedule::WorkingSet,
-    /// Whether every needed key was resident this frame.
+    /// Whether every needed key and volume block was resident this frame.
     pub complete: bool,
 }
 
@@ -85,9 +85,9 @@ pub struct StreamingStats {
     pub resident_bytes: u64,
     /// Highest `resident_bytes` seen.
     pub peak_resident_bytes: u64,
-    /// Needed keys found resident.
+    /// Needed keys and volume blocks found resident.
     pub hits: u64,
-    /// Needed keys not resident.
+    /// Needed keys and volume blocks not resident.
     pub misses: u64,
     /// Frames with a needed key missing.
     pub stalls: u64,
