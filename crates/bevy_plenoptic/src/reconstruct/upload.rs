@@ -38,7 +38,7 @@ pub struct KeyUpload {
     pub first_layer: u32,
     /// Face size.
     pub face: u32,
-    /// Six faces of `face`² texels of [`TEXEL_BYTES`] bytes.
+    /// Six faces of `face`² texels of 16 bytes (`Rgba32Uint`).
     pub data: Vec<u8>,
 }
 
