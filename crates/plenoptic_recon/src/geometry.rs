@@ -33,7 +33,7 @@ use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Report};
 use crate::lookup::{FastKey, NO_SLOT, PackedTexels, Scratch, Shade};
 use crate::proxy::GeometryMask;
-use crate::reconstructor::{KeyCubes, MaskMethod, Reconstructor};
+use crate::reconstructor::{CubeFilter, KeyCubes, MaskMethod, Reconstructor};
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
 use crate::{Error, Result, sample};
@@ -183,11 +183,13 @@ pub(crate) fn render(
         .iter()
         .max_by(|a, b| a.weight.total_cmp(&b.weight))
         .map(|k| (k.base, k.cubes.radiance.clone()));
+    let bilinear = rec.settings.cube_filter == CubeFilter::Bilinear;
     let shade = Shade {
         fast: &fast,
         tol,
         power,
         power_int,
+        bilinear,
     };
     let band = ROWS * w.max(1);
     frame
@@ -240,7 +242,11 @@ pub(crate) fn render(
                     if o == 0 {
                         cls[x] = NONE;
                         if let Some((_, env)) = &env {
-                            rad[x] = env.texels[sample::texel(env.face_size, s.dir_at(x))];
+                            rad[x] = if bilinear {
+                                sample::bilinear(env, s.dir_at(x))
+                            } else {
+                                env.texels[sample::texel(env.face_size, s.dir_at(x))]
+                            };
                         }
                         continue;
                     }

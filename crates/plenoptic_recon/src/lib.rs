@@ -88,7 +88,7 @@ pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry};
-pub use reconstructor::{MaskMethod, ReconSettings, Reconstructor};
+pub use reconstructor::{CubeFilter, MaskMethod, ReconSettings, Reconstructor};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -104,6 +104,11 @@ pub(crate) struct Scratch {
     dist: Vec<f32>,
     ti: Vec<u32>,
     wa: Vec<f32>,
+    /// With bilinear filtering: the first texel of the lookup's footprint ([`NO_TEXEL`]:
+    /// across a seam) and the fractions along u and v.
+    tap: Vec<u32>,
+    fx: Vec<f32>,
+    fy: Vec<f32>,
     /// Weighted radiance sum and, in `w`, the weight sum.
     pub sum: Vec<Vec4>,
 }
@@ -122,6 +127,9 @@ impl Scratch {
         self.dist.resize(n, 0.0);
         self.ti.resize(n, NO_TEXEL);
         self.wa.resize(n, 0.0);
+        self.tap.resize(n, NO_TEXEL);
+        self.fx.resize(n, 0.0);
+        self.fy.resize(n, 0.0);
         self.sum.resize(n, Vec4::ZERO);
     }
 
@@ -207,6 +215,8 @@ pub(crate) struct Shade<'a> {
     /// Angular power, and the same as an integer when it is one (else 0).
     pub power: f32,
     pub power_int: u32,
+    /// Seamless bilinear filtering of the radiance of accepted lookups.
+    pub bilinear: bool,
 }
 
 impl Shade<'_> {
@@ -238,6 +248,7 @@ impl Shade<'_> {
         let [dx, dy, dz] = &mut s.d;
         let (dx, dy, dz) = (&mut dx[..n4], &mut dy[..n4], &mut dz[..n4]);
         let (dist, ti, wa) = (&mut s.dist[..n4], &mut s.ti[..n4], &mut s.wa[..n4]);
+        let (tap, fxs, fys) = (&mut s.tap[..n4], &mut s.fx[..n4], &mut s.fy[..n4]);
         let geometry = CubeLanes::new(k.face);
         let b = k.base;
         let (bx, by, bz) = (Vec4::splat(b.x), Vec4::splat(b.y), Vec4::splat(b.z));
@@ -297,7 +308,7 @@ impl Shade<'_> {
             let dist2 = vx * vx + vy * vy + vz * vz;
             let invalid = dist2.is_nan_mask() | dist2.cmple(Vec4::splat(1e-12));
             let l = dist2.sqrt();
-            let t = geometry.texels(vx, vy, vz);
+            let (t, taps, fx, fy) = geometry.texels(vx, vy, vz, self.bilinear);
             let invalid = invalid.bitmask();
             for i in 0..4 {
                 if fresh[i] && invalid & (1 << i) == 0 {
@@ -305,6 +316,19 @@ impl Shade<'_> {
                 } else if fresh[i] || first {
                     ti[x + i] = NO_TEXEL;
                 }
+            }
+            if self.bilinear {
+                for i in 0..4 {
+                    if fresh[i] {
+                        tap[x + i] = taps[i];
+                    }
+                }
+                let f = BVec4A::new(fresh[0], fresh[1], fresh[2], fresh[3]);
+                let put = |a: &mut [f32], v: Vec4| {
+                    Vec4::select(f, v, load(a, x)).write_to_slice(&mut a[x..x + 4]);
+                };
+                put(fxs, fx);
+                put(fys, fy);
             }
             let e = load(ex, x) * vx + load(ey, x) * vy + load(ez, x) * vz;
             let cos = -e / l;
@@ -334,6 +358,7 @@ impl Shade<'_> {
         let n = obj.len();
         let tol = self.tol;
         let (ti, dist, wa) = (&s.ti[..n], &s.dist[..n], &s.wa[..n]);
+        let (tap, fxs, fys) = (&s.tap[..n], &s.fx[..n], &s.fy[..n]);
         let sum = &mut s.sum[..n];
         for x in 0..n {
             let t = ti[x] as usize;
@@ -358,8 +383,55 @@ impl Shade<'_> {
                     continue;
                 }
             }
-            sum[x] += tx.radiance * (k.weight * wa[x]);
+            let radiance = if !self.bilinear {
+                tx.radiance
+            } else if tap[x] != NO_TEXEL {
+                // The footprint inside one face: its texels of the same object at the same
+                // distance, and the nearest texel.
+                let (i, fx, fy) = (tap[x] as usize, fxs[x], fys[x]);
+                let n = k.face as usize;
+                let (Some(a), Some(b)) = (k.texels.get(i..i + 2), k.texels.get(i + n..i + n + 2))
+                else {
+                    continue;
+                };
+                let o = obj[x];
+                let keep = |tj: &Texel, j: usize| {
+                    j == t || (tj.id == o && (tj.distance - l).abs() <= tol * l)
+                };
+                let w = |tj: &Texel, j: usize, w: f32| if keep(tj, j) { w } else { 0.0 };
+                let acc = a[0].radiance * w(&a[0], i, (1.0 - fx) * (1.0 - fy))
+                    + a[1].radiance * w(&a[1], i + 1, fx * (1.0 - fy))
+                    + b[0].radiance * w(&b[0], i + n, (1.0 - fx) * fy)
+                    + b[1].radiance * w(&b[1], i + n + 1, fx * fy);
+                if acc.w > 0.0 {
+                    acc * (1.0 / acc.w)
+                } else {
+                    tx.radiance
+                }
+            } else {
+                let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
+                filtered(k, d, t, obj[x], l, tol)
+            };
+            sum[x] += radiance * (k.weight * wa[x]);
         }
+    }
+}
+
+/// The radiance of key `k` in direction `d` (length `l`) filtered over the bilinear taps that
+/// show object `o` at distance `l` (relative tolerance `tol`) or are the nearest texel `t`,
+/// as radiance and 1.
+fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> Vec4 {
+    let mut acc = Vec4::ZERO;
+    for (i, w) in sample::bilinear_taps(k.face, d) {
+        let Some(tx) = k.texels.get(i) else { continue };
+        if w > 0.0 && (i == t || (tx.id == o && (tx.distance - l).abs() <= tol * l)) {
+            acc += tx.radiance * w;
+        }
+    }
+    if acc.w > 0.0 {
+        (acc.truncate() / acc.w).extend(1.0)
+    } else {
+        k.texels[t].radiance
     }
 }
 
@@ -405,29 +477,57 @@ impl CubeLanes {
         }
     }
 
-    /// The texel indices of directions (x, y, z).
+    /// The texel indices of directions (x, y, z) and, with `bilinear`, their bilinear
+    /// footprints where they lie inside one face: the index of the first texel (the others are
+    /// +1, +n, +n+1; [`NO_TEXEL`] where the footprint crosses a seam) and the fractions along
+    /// u and v.
     #[inline(always)]
-    fn texels(&self, x: Vec4, y: Vec4, z: Vec4) -> [u32; 4] {
+    fn texels(
+        &self,
+        x: Vec4,
+        y: Vec4,
+        z: Vec4,
+        bilinear: bool,
+    ) -> ([u32; 4], [u32; 4], Vec4, Vec4) {
+        let none = ([NO_TEXEL; 4], Vec4::ZERO, Vec4::ZERO);
         if !self.exact {
             let (x, y, z) = (x.to_array(), y.to_array(), z.to_array());
-            return std::array::from_fn(|i| {
+            let t = std::array::from_fn(|i| {
                 sample::texel(self.face_size, Vec3::new(x[i], y[i], z[i])) as u32
             });
+            return (t, none.0, none.1, none.2);
         }
-        // The index in the low 23 bits of `index + 2²³` (exact below 2²³).
-        let t = (self.texels_f32(x, y, z) + Vec4::splat(TWO_23)).to_array();
-        let m = (1 << 23) - 1;
-        [
-            t[0].to_bits() & m,
-            t[1].to_bits() & m,
-            t[2].to_bits() & m,
-            t[3].to_bits() & m,
-        ]
+        let (face, u, v) = self.face_uv(x, y, z);
+        let zero = Vec4::ZERO;
+        let (un, vn) = (u * self.n, v * self.n);
+        // `(u n) as usize` then `min(n − 1)`; NaN → 0 (maxps returns its second operand).
+        let i = un.trunc().max(zero).min(self.n_minus_1);
+        let j = vn.trunc().max(zero).min(self.n_minus_1);
+        let base = face * self.face_texels;
+        let t = to_indices(base + j * self.n + i);
+        if !bilinear {
+            return (t, none.0, none.1, none.2);
+        }
+        // The footprint's first texel: floor(u n − ½) is i or i − 1.
+        let half = Vec4::splat(0.5);
+        let (s, r) = (un - half, vn - half);
+        let i0 = Vec4::select(s.cmpge(i), i, i - Vec4::ONE);
+        let j0 = Vec4::select(r.cmpge(j), j, j - Vec4::ONE);
+        let last = self.n_minus_1 - Vec4::ONE;
+        let inside = i0.cmpge(zero) & i0.cmple(last) & j0.cmpge(zero) & j0.cmple(last);
+        let mut first = to_indices(Vec4::select(inside, base + j0 * self.n + i0, zero));
+        let inside = inside.bitmask();
+        for (k, f) in first.iter_mut().enumerate() {
+            if inside & (1 << k) == 0 {
+                *f = NO_TEXEL;
+            }
+        }
+        (t, first, s - i0, r - j0)
     }
 
-    /// The texel indices as f32.
+    /// `(face, u, v)` of directions (x, y, z), as [`sample::face_uv`] computes them.
     #[inline(always)]
-    fn texels_f32(&self, x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
+    fn face_uv(&self, x: Vec4, y: Vec4, z: Vec4) -> (Vec4, Vec4, Vec4) {
         let sel = Vec4::select;
         let zero = Vec4::ZERO;
         let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
@@ -450,12 +550,21 @@ impl CubeLanes {
         let half = Vec4::splat(0.5);
         let u = sel(ok, half * (sc / ma + Vec4::ONE), half);
         let v = sel(ok, half * (tc / ma + Vec4::ONE), half);
-        let face = sel(ok, face, zero);
-        // `(u n) as usize` then `min(n − 1)`; NaN → 0 (maxps returns its second operand).
-        let i = (u * self.n).trunc().max(zero).min(self.n_minus_1);
-        let j = (v * self.n).trunc().max(zero).min(self.n_minus_1);
-        face * self.face_texels + j * self.n + i
+        (sel(ok, face, zero), u, v)
     }
+}
+
+/// Non-negative integral f32 values below 2²³ as u32: the low 23 bits of `value + 2²³`.
+#[inline(always)]
+fn to_indices(v: Vec4) -> [u32; 4] {
+    let t = (v + Vec4::splat(TWO_23)).to_array();
+    let m = (1 << 23) - 1;
+    [
+        t[0].to_bits() & m,
+        t[1].to_bits() & m,
+        t[2].to_bits() & m,
+        t[3].to_bits() & m,
+    ]
 }
 
 #[cfg(test)]
@@ -484,9 +593,30 @@ mod tests {
         ]);
         for d in dirs {
             for n in [1u32, 16, 128, 1182, 1183, 2048] {
-                let lanes =
-                    CubeLanes::new(n).texels(Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
+                let (lanes, taps, fx, fy) = CubeLanes::new(n).texels(
+                    Vec4::splat(d.x),
+                    Vec4::splat(d.y),
+                    Vec4::splat(d.z),
+                    true,
+                );
                 assert_eq!(lanes[0] as usize, sample::texel(n, d), "{d} {n}");
+                // Inside a face, the footprint is the scalar filter's.
+                if taps[0] != NO_TEXEL {
+                    let reference = sample::bilinear_taps(n, d);
+                    let (fx, fy) = (fx.x, fy.x);
+                    let i = taps[0] as usize;
+                    let n = n as usize;
+                    let weights = [
+                        (i, (1.0 - fx) * (1.0 - fy)),
+                        (i + 1, fx * (1.0 - fy)),
+                        (i + n, (1.0 - fx) * fy),
+                        (i + n + 1, fx * fy),
+                    ];
+                    for ((a, wa), (b, wb)) in weights.into_iter().zip(reference) {
+                        assert!(a == b || wa.abs() < 1e-6, "{d} {n}: {a} {b}");
+                        assert!((wa - wb).abs() < 1e-5, "{d} {n}: {wa} {wb}");
+                    }
+                }
             }
         }
         for c in [0.0f32, 1e-3, 0.3, 0.77, 1.0] {
