@@ -1,7 +1,10 @@
 //! Reconstruction speed: milliseconds per frame for each mode at 640×360 and 1280×720 from
 //! four base views (face size 128, five time keys, temporal volumes), on a synthetic pack
-//! built in the setup; and the reference path tracer's time for the same frame, as a ratio
-//! measured in the same run.
+//! built in the setup; the geometry-assisted mode also with seamless bilinear cube filtering
+//! (`geometry_bilinear`, `ReconSettings::cube_filter`; the other cases use the default,
+//! nearest texel); and the reference path tracer's time for the same frame, as a ratio
+//! measured in the same run. The chunk cache is warm (decoded cubes, interleaved texels and
+//! binned volume blocks are built on the first frame), as in a walk-through.
 //!
 //! Run: `cargo bench --no-default-features --bench recon -- --warm-up-time 1 --measurement-time 3`
 
@@ -13,7 +16,7 @@ use std::time::Instant;
 
 use common::*;
 use criterion::{Criterion, criterion_group, criterion_main};
-use plenoptic_recon::{Camera, Mode, Reconstructor};
+use plenoptic_recon::{Camera, CubeFilter, Mode, Reconstructor};
 use plenoptic_trace::glam::Vec3;
 use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
 
@@ -40,6 +43,8 @@ fn bench(c: &mut Criterion) {
     spec.volume_samples = 12_000;
     write_pack(&scene, &spec, &path);
     let rec = Reconstructor::open(&path).unwrap();
+    let mut bilinear = Reconstructor::open(&path).unwrap();
+    bilinear.settings.cube_filter = CubeFilter::Bilinear;
     let mut group = c.benchmark_group("recon");
     group.sample_size(10);
     for (w, h) in [(640, 360), (1280, 720)] {
@@ -50,6 +55,11 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| black_box(rec.render(black_box(&cam), T, mode).unwrap()))
             });
         }
+        let mode = Mode::GeometryAssisted;
+        let _ = bilinear.render(&cam, T, mode).unwrap();
+        group.bench_function(format!("geometry_bilinear/{w}x{h}"), |b| {
+            b.iter(|| black_box(bilinear.render(black_box(&cam), T, mode).unwrap()))
+        });
     }
     let accel = SceneAccel::new(&scene).unwrap();
     let tracer = PathTracer::new(PathTracerSettings {
