@@ -143,7 +143,22 @@ pub(crate) fn render(
     report.stage_ms.push(("mask_setup".into(), ms(start)));
     let start = Instant::now();
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let mut frame = Frame::new(camera.width, camera.height);
+    // The frame, filled in parallel (the first touch of its pages is a good part of the cost).
+    let n = w * h;
+    let mut frame = Frame {
+        width: camera.width,
+        height: camera.height,
+        radiance: Vec::with_capacity(n),
+        depth: Vec::with_capacity(n),
+        object: Vec::with_capacity(n),
+    };
+    frame
+        .radiance
+        .par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
+    frame
+        .depth
+        .par_extend(rayon::iter::repeat_n(f32::INFINITY, n));
+    frame.object.par_extend(rayon::iter::repeat_n(0, n));
     // Flat views of the cubes for the pixel loop; keys of negligible weight are skipped.
     let mut fast: Vec<FastKey<'_>> = keys
         .iter()

@@ -94,6 +94,8 @@ pub(crate) struct Scratch {
     pub slot: Vec<u32>,
     /// Unit ray direction per pixel.
     pub dir: [Vec<f32>; 3],
+    /// `right · sx` per column of the frame (empty until the first row).
+    columns: [Vec<f32>; 3],
     /// Hit point.
     pub p: [Vec<f32>; 3],
     /// Unit direction from the hit point to the eye.
@@ -135,16 +137,29 @@ impl Scratch {
 
     /// The unit ray directions of row `y` (what [`CameraBasis::direction`] gives at the pixel
     /// centres).
-    #[inline(never)]
     pub fn directions(&mut self, b: &CameraBasis, y: usize, n: usize) {
+        let [cx, cy, cz] = &mut self.columns;
+        if cx.len() != n {
+            // right · sx per column, the same for every row (a frame's scratch is its own).
+            cx.clear();
+            cy.clear();
+            cz.clear();
+            for x in 0..n {
+                let sx = (2.0 * (x as f32 + 0.5) / b.width - 1.0) * b.tan_x;
+                cx.push(b.right.x * sx);
+                cy.push(b.right.y * sx);
+                cz.push(b.right.z * sx);
+            }
+        }
         let sy = (1.0 - 2.0 * (y as f32 + 0.5) / b.height) * b.tan_y;
+        let (ux, uy, uz) = (b.up.x * sy, b.up.y * sy, b.up.z * sy);
+        let (cx, cy, cz) = (&cx[..n], &cy[..n], &cz[..n]);
         let [dx, dy, dz] = &mut self.dir;
         let (dx, dy, dz) = (&mut dx[..n], &mut dy[..n], &mut dz[..n]);
         for x in 0..n {
-            let sx = (2.0 * (x as f32 + 0.5) / b.width - 1.0) * b.tan_x;
-            let rx = b.right.x * sx + b.up.x * sy + b.forward.x;
-            let ry = b.right.y * sx + b.up.y * sy + b.forward.y;
-            let rz = b.right.z * sx + b.up.z * sy + b.forward.z;
+            let rx = cx[x] + ux + b.forward.x;
+            let ry = cy[x] + uy + b.forward.y;
+            let rz = cz[x] + uz + b.forward.z;
             let r = 1.0 / (rx * rx + ry * ry + rz * rz).sqrt();
             dx[x] = rx * r;
             dy[x] = ry * r;

@@ -50,7 +50,6 @@ pub struct VolumeIndex {
     blocks: Vec<Arc<BlockBins>>,
     t: f32,
     eps: f32,
-    len: usize,
 }
 
 /// One volume block's samples binned by direction (cube of face size `BIN_FACE`), stable in
@@ -126,8 +125,8 @@ pub(crate) fn filtered_samples(
 }
 
 impl VolumeIndex {
-    /// The binned samples of `view` around `t`; `None` if no readable block overlapping the
-    /// window has a sample in it.
+    /// The binned samples of `view` around `t`; `None` if no readable block overlaps the
+    /// window.
     pub(crate) fn build(
         rec: &Reconstructor,
         view: usize,
@@ -138,38 +137,28 @@ impl VolumeIndex {
         let eps = rec.time_epsilon();
         let (b0, b1) = (m.bucket_of(t - eps), m.bucket_of(t + eps));
         let mut blocks = Vec::new();
-        let mut len = 0;
         for b in b0..=b1.min(b0.saturating_add(64)) {
-            let Some(bins) = rec.block_bins(view, b, missing) else {
-                continue;
-            };
-            let n = bins
-                .block
-                .samples
-                .iter()
-                .filter(|s| (s.t - t).abs() <= eps)
-                .count();
-            if n > 0 {
-                len += n;
+            if let Some(bins) = rec.block_bins(view, b, missing)
+                && !bins.block.samples.is_empty()
+            {
                 blocks.push(bins);
             }
         }
-        (len > 0).then_some(VolumeIndex {
-            blocks,
-            t,
-            eps,
-            len,
-        })
+        (!blocks.is_empty()).then_some(VolumeIndex { blocks, t, eps })
     }
 
     /// Number of samples in the window.
     pub fn len(&self) -> usize {
-        self.len
+        self.blocks
+            .iter()
+            .flat_map(|b| &b.block.samples)
+            .filter(|s| (s.t - self.t).abs() <= self.eps)
+            .count()
     }
 
     /// True if the window has no samples.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.len() == 0
     }
 
     /// The filtered radiance of object `object`'s samples whose cone contains direction `d`
