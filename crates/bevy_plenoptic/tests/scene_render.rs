@@ -204,6 +204,17 @@ fn plugin_and_cpu_frames(
     volume_samples: usize,
     budget_keys: Option<u64>,
 ) -> Frames {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    plugin_and_cpu_frames_from(backend, volume_samples, budget_keys, view)
+}
+
+/// [`plugin_and_cpu_frames`] from the eye `view.0` looking at `view.1`.
+fn plugin_and_cpu_frames_from(
+    backend: Backend,
+    volume_samples: usize,
+    budget_keys: Option<u64>,
+    view: (Vec3, Vec3),
+) -> Frames {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::{Mode, Reconstructor};
@@ -219,8 +230,8 @@ fn plugin_and_cpu_frames(
         },
         &path,
     );
-    let (eye, t) = (Vec3::new(0.3, 1.3, 1.0), 0.7);
-    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y);
+    let (eye, t) = (view.0, 0.7);
+    let transform = Transform::from_translation(eye).looking_at(view.1, Vec3::Y);
 
     // CPU reference.
     let rec = Reconstructor::open(&path).unwrap();
@@ -401,6 +412,21 @@ fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
         "{:?}",
         f.uploads
     );
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    assert!(
+        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
+/// Outside the room looking away from it no proxy covers a pixel: the frame is the
+/// environment, the heaviest key's cube in each pixel's direction, on the GPU (a full-screen
+/// background behind all geometry) as on the CPU.
+#[test]
+fn gpu_background_matches_cpu_where_there_is_no_geometry() {
+    let view = (Vec3::new(0.3, 1.3, 3.5), Vec3::new(0.5, 1.6, 6.0));
+    let f = plugin_and_cpu_frames_from(Backend::Gpu, 0, None, view);
+    assert!(f.fallback.no_geometry > 0.99, "{:?}", f.fallback);
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(
         mean < 0.005 && f5 > 0.99 && f20 > 0.995,

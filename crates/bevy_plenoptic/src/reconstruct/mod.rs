@@ -20,11 +20,16 @@
 //!    object in front of the plane;
 //! 3. the heaviest key's texel in the point's direction ("background").
 //!
+//! Pixels no proxy covers show the heaviest key's cube in the viewing direction
+//! ([`background`], a full-screen triangle behind all geometry), as on the CPU. The
+//! background is drawn by every camera of the app: give other cameras other `RenderLayers`.
+//!
 //! Resident keys live in one `Rgba32Uint` 2D-array texture per pack: texel = (radiance as
 //! RGB9E5, distance as f32 bits, object id, oct-encoded RG16Snorm normal), six layers per
 //! streaming slot: the pack's own texel bytes interleaved, one binding and `textureLoad` only
 //! (distances and ids are not filterable anyway).
 
+pub mod background;
 pub mod cpu;
 pub mod upload;
 pub mod volume;
@@ -61,6 +66,7 @@ impl Plugin for PlenopticReconstructPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
+        background::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
@@ -72,6 +78,7 @@ impl Plugin for PlenopticReconstructPlugin {
                     upload::upload_keys,
                     volume::upload_volumes,
                     attach_materials,
+                    background::spawn_backgrounds,
                     update_materials,
                 )
                     .chain()
@@ -224,7 +231,95 @@ fn attach_materials(
     }
 }
 
-/// Fills every proxy material's lookups for its pack's (first) camera.
+/// One lookup of a frame: a resident, uploaded (base view, time key).
+#[derive(Debug, Clone, Copy)]
+struct Lookup {
+    base: Vec3,
+    slot: u32,
+    weight: f32,
+    tau: f32,
+    normals: bool,
+}
+
+/// What every proxy of a pack looks up this frame.
+#[derive(Debug, Clone, Default)]
+struct FrameLookups {
+    /// (base view, normalised view weight), heaviest first.
+    views: Vec<(usize, f32)>,
+    /// At most [`MAX_LOOKUPS`].
+    lookups: Vec<Lookup>,
+    /// Index of the heaviest lookup (`plenoptic_recon`'s "background" and environment key).
+    heaviest: Option<usize>,
+}
+
+/// The lookups of a camera at `position` and time `t` on pack `id`, as `plenoptic_recon`'s
+/// geometry mode chooses them: the view-space weights of the nearest
+/// [`PlenopticSettings::max_views`] views, each at its bracketing keys with linear time
+/// weights, over the keys that are resident and uploaded.
+fn frame_lookups(
+    id: AssetId<RadiancePack>,
+    pack: &RadiancePack,
+    tex: &KeyTexture,
+    cache: &StreamCache,
+    max_views: usize,
+    position: Vec3,
+    t: f32,
+) -> FrameLookups {
+    let m = pack.reader.manifest();
+    let usable = vec![true; m.base_views.len()];
+    let mut views = ViewWeights::new(&m.view_space, &m.base_views, &usable).weights(position);
+    views.truncate(max_views.max(1));
+    let s: f32 = views.iter().map(|v| v.1).sum();
+    let views: Vec<(usize, f32)> = views
+        .into_iter()
+        .map(|(v, w)| (v, if s > 0.0 { w / s } else { w }))
+        .collect();
+    let mut out = FrameLookups::default();
+    // Weight of the heaviest lookup.
+    let mut heaviest = f32::NEG_INFINITY;
+    for &(v, w) in &views {
+        let bv = &m.base_views[v];
+        let Some((k0, k1, f)) = bracketing(&bv.time_keys, t) else {
+            continue;
+        };
+        let mut pairs = vec![(k0, 1.0 - f)];
+        if k1 != k0 {
+            pairs.push((k1, f));
+        }
+        let got: Vec<_> = pairs
+            .into_iter()
+            .filter_map(|(k, wt)| {
+                let r = cache.get(id, (v as u32, k as u32))?;
+                (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
+                    .then_some((k, wt, r.slot))
+            })
+            .collect();
+        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
+        for (k, wt, slot) in got {
+            let weight = w * wt / total;
+            if out.lookups.len() == MAX_LOOKUPS || weight <= 1e-4 {
+                continue;
+            }
+            // Ties go to the later lookup, as Iterator::max_by does on the CPU.
+            if weight >= heaviest {
+                heaviest = weight;
+                out.heaviest = Some(out.lookups.len());
+            }
+            out.lookups.push(Lookup {
+                base: bv.position,
+                slot,
+                weight,
+                tau: bv.time_keys[k],
+                normals: tex.normals.contains(&slot),
+            });
+        }
+    }
+    out.views = views;
+    out
+}
+
+/// Fills every proxy material's lookups for its pack's (first) camera, and every
+/// background's environment key.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn update_materials(
     keys: Res<KeyTextures>,
@@ -236,16 +331,36 @@ fn update_materials(
     roots: Query<&PlenopticScene>,
     proxies: Query<(&ChildOf, &ProxyOf, &MeshMaterial3d<PlenopticMaterial>)>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
+    backgrounds: Query<(
+        &background::PlenopticBackground,
+        &MeshMaterial3d<background::PlenopticBackgroundMaterial>,
+    )>,
+    mut background_materials: ResMut<Assets<background::PlenopticBackgroundMaterial>>,
 ) {
+    let mut frames: HashMap<AssetId<RadiancePack>, FrameLookups> = HashMap::new();
+    let mut frame = |id: AssetId<RadiancePack>, cam: &PlenopticCamera, at: Vec3| {
+        let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
+        Some(
+            frames
+                .entry(id)
+                .or_insert_with(|| {
+                    frame_lookups(id, pack, tex, &cache, settings.max_views, at, cam.time)
+                })
+                .clone(),
+        )
+    };
     for (parent, of, handle) in &proxies {
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
         let id = scene.pack.id();
+        let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.pack.id() == id) else {
+            continue;
+        };
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
         };
-        let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.pack.id() == id) else {
+        let Some(f) = frame(id, cam, transform.translation()) else {
             continue;
         };
         if cam.mode != ReconMode::GeometryAssisted {
@@ -256,81 +371,49 @@ fn update_materials(
             );
         }
         let m = pack.reader.manifest();
-        let usable = vec![true; m.base_views.len()];
-        let mut views = ViewWeights::new(&m.view_space, &m.base_views, &usable)
-            .weights(transform.translation());
-        views.truncate(settings.max_views.max(1));
-        let s: f32 = views.iter().map(|v| v.1).sum();
-        let inv_now = pack.proxy(of.id).map_or(Mat4::IDENTITY, |p| {
+        let proxy = pack.proxy(of.id);
+        let inv_now = proxy.map_or(Mat4::IDENTITY, |p| {
             p.transform_at(cam.time).to_matrix().inverse()
         });
         let mut params = ReconParams {
-            header: Vec4::new(0.0, of.id as f32, tex.face as f32, 0.0),
+            header: Vec4::new(f.lookups.len() as f32, of.id as f32, tex.face as f32, 0.0),
             tuning: Vec4::new(0.03, 8.0, 0.0, 0.0),
+            fill: Vec4::new(
+                HOLE_FILL_RADIUS as f32,
+                f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
+                0.0,
+                0.0,
+            ),
             ..default()
         };
-        let views: Vec<(usize, f32)> = views
-            .into_iter()
-            .map(|(v, w)| (v, if s > 0.0 { w / s } else { w }))
-            .collect();
         let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
         volume::fill_params(
             &mut params,
             volumes.0.get(&id),
-            &views,
+            &f.views,
             &positions,
             volume_buckets(m, cam.time),
             cam.time,
             time_epsilon(m),
         );
-        let mut n = 0;
-        // (weight, index) of the heaviest lookup.
-        let mut heaviest = (f32::NEG_INFINITY, MAX_LOOKUPS);
-        for (v, w) in views {
-            let bv = &m.base_views[v];
-            let Some((k0, k1, f)) = bracketing(&bv.time_keys, cam.time) else {
-                continue;
-            };
-            let mut pairs = vec![(k0, 1.0 - f)];
-            if k1 != k0 {
-                pairs.push((k1, f));
-            }
-            let got: Vec<_> = pairs
-                .into_iter()
-                .filter_map(|(k, wt)| {
-                    let r = cache.get(id, (v as u32, k as u32))?;
-                    (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
-                        .then_some((k, wt, r.slot))
-                })
-                .collect();
-            let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
-            for (k, wt, slot) in got {
-                if n == MAX_LOOKUPS || w * wt / total <= 1e-4 {
-                    continue;
-                }
-                let tau = bv.time_keys[k];
-                let motion = pack
-                    .proxy(of.id)
-                    .map_or(Mat4::IDENTITY, |p| p.transform_at(tau).to_matrix())
-                    * inv_now;
-                if w * wt / total >= heaviest.0 {
-                    heaviest = (w * wt / total, n);
-                }
-                params.base[n] = bv.position.extend((slot * 6) as f32);
-                let normals = if tex.normals.contains(&slot) {
-                    1.0
-                } else {
-                    0.0
-                };
-                params.weight[n] = Vec4::new(w * wt / total, normals, 0.0, 0.0);
-                params.motion[n] = motion;
-                n += 1;
-            }
+        for (n, l) in f.lookups.iter().enumerate() {
+            params.base[n] = l.base.extend((l.slot * 6) as f32);
+            params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
+            params.motion[n] =
+                proxy.map_or(Mat4::IDENTITY, |p| p.transform_at(l.tau).to_matrix()) * inv_now;
         }
-        params.header.x = n as f32;
-        params.fill = Vec4::new(HOLE_FILL_RADIUS as f32, heaviest.1 as f32, 0.0, 0.0);
         if let Some(mut mat) = materials.get_mut(&handle.0) {
             mat.params = params;
         }
+    }
+    for (bg, handle) in &backgrounds {
+        let Ok((cam, transform)) = cameras.get(bg.camera) else {
+            continue;
+        };
+        let id = cam.pack.id();
+        let face = keys.0.get(&id).map_or(1, |t| t.face);
+        let layer = frame(id, cam, transform.translation())
+            .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
+        background::set_background(&mut background_materials, handle, layer, face);
     }
 }
