@@ -64,8 +64,8 @@ pub enum CubeFilter {
     /// seams from the neighbouring face ([`plenoptic_pack::cube`] convention), restricted to
     /// the texels that show the same object at the same distance (so that edges stay sharp).
     /// The lookup is still accepted or rejected by its nearest texel. Lowers the error against
-    /// the path tracer (by about an eighth on the test room) and costs about 60 % more time
-    /// per frame than `Nearest` (benches/recon.rs).
+    /// the path tracer (by about an eighth on the test room) and takes about twice the time
+    /// per frame of `Nearest` (benches/recon.rs).
     Bilinear,
 }
 

@@ -43,7 +43,7 @@ pub type Cubes = (CubeImage<Vec3>, CubeImage<f32>, CubeImage<u32>);
 const BIN_FACE: u32 = 16;
 
 /// The samples of one base view around time t, binned by direction: the blocks overlapping
-/// t ± tε, each binned once and cached by the [`Reconstructor`] ([`BlockBins`]); the tent
+/// t ± tε, each binned once and cached by the [`Reconstructor`]; the tent
 /// filter is applied at lookup.
 #[derive(Clone, Debug)]
 pub struct VolumeIndex {
