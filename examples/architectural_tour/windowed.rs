@@ -57,7 +57,7 @@ pub struct ScreenshotPlan {
 
 /// Frames rendered with everything resident before the screenshot (lavapipe compiles
 /// pipelines lazily; the first frames can be blank).
-const SETTLE_FRAMES: u32 = 30;
+const SETTLE_FRAMES: u32 = 10;
 
 /// Opens the window and runs the tour until it is closed.
 pub fn run(
@@ -276,12 +276,17 @@ fn title(
         "free-fly WASD/QE, right mouse (Tab: tour)"
     };
     for mut window in &mut windows {
+        let previous = window.title.clone();
         window.title = format!(
             "plenoptic tour — {fps:.0} fps, t = {:.1} s, {mode}, resident {:.0} MiB — {driver}{}",
             camera.time,
             resident / (1024.0 * 1024.0),
             if tour.paused { " — paused" } else { "" }
         );
+        if tour.screenshot.is_some() && window.title != previous {
+            // Unattended: the title is the only progress there is.
+            println!("{}", window.title);
+        }
     }
 }
 
