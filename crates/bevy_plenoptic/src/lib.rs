@@ -11,7 +11,7 @@
 //!   ordinary Bevy mesh entities and placed from the animation tracks at the camera's time.
 //!   Rasterising them gives each pixel its object and surface point and writes real depth,
 //!   so ordinary Bevy meshes occlude, and are occluded by, the baked scene.
-//! - [`streaming`]: the working set (nearest base views × time keys bracketing t, prefetch
+//! - [`streaming`]: the working set (weighted base views × time keys bracketing t, prefetch
 //!   along the camera's motion and the playback direction) kept inside
 //!   [`PlenopticSettings::memory_budget_bytes`] with LRU eviction; reads and decodes run on
 //!   the I/O task pool; Bevy diagnostics report resident bytes, hits, misses, stalls

@@ -1,7 +1,8 @@
 //! Streaming: keeps each camera's working set of cubes resident inside the memory budget.
 //!
 //! Every frame, per [`PlenopticCamera`]: the working set ([`schedule::working_set`]) is the
-//! nearest base views × the time keys bracketing t ("needed"), plus the same around where
+//! base views the reconstruction blends (the view-space weights,
+//! [`schedule::weighted_views`]) × the time keys bracketing t ("needed"), plus the same around where
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
 //! bytes) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:

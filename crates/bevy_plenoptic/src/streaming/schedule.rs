@@ -3,6 +3,7 @@
 
 use bevy::math::Vec3;
 use plenoptic_pack::Manifest;
+use plenoptic_recon::viewspace::ViewWeights;
 
 /// One streamable unit: the cubes (radiance, distance, object id, normal) of base view
 /// `view` (index into the manifest's base views) at time key `key`.
@@ -24,6 +25,19 @@ pub fn volume_buckets(manifest: &Manifest, t: f32) -> std::ops::RangeInclusive<u
 /// `plenoptic_recon`'s default settings.
 pub fn time_epsilon(manifest: &Manifest) -> f32 {
     (manifest.bucket_span * 0.5).max(1e-6)
+}
+
+/// The base views the reconstruction blends for a camera at `position`: those of the pack's
+/// view-space weights (`plenoptic_recon::viewspace::ViewWeights`, every view usable), heaviest
+/// first, at most `count`. These, not merely the nearest views, must be resident: a plane
+/// view space weights the corners of the triangle around the camera, which need not be the
+/// nearest views.
+pub fn weighted_views(manifest: &Manifest, position: Vec3, count: usize) -> Vec<u32> {
+    let usable = vec![true; manifest.base_views.len()];
+    let mut w =
+        ViewWeights::new(&manifest.view_space, &manifest.base_views, &usable).weights(position);
+    w.truncate(count.max(1));
+    w.into_iter().map(|(v, _)| v as u32).collect()
 }
 
 /// Indices of the `count` base views nearest `position`, nearest first.
@@ -95,7 +109,7 @@ pub fn working_set(
             list.push(k);
         }
     };
-    for v in nearest_views(manifest, position, look.views) {
+    for v in weighted_views(manifest, position, look.views) {
         for k in bracketing_keys(&manifest.base_views[v as usize].time_keys, t) {
             push(&mut set.needed, &[], (v, k));
         }
@@ -105,7 +119,7 @@ pub fn working_set(
     }
     let future_pos = position + velocity * look.seconds;
     let future_t = t + direction * look.seconds;
-    for v in nearest_views(manifest, future_pos, look.views) {
+    for v in weighted_views(manifest, future_pos, look.views) {
         let keys = &manifest.base_views[v as usize].time_keys;
         let mut ks = bracketing_keys(keys, t);
         ks.extend(bracketing_keys(keys, future_t));
