@@ -365,18 +365,18 @@ fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
 /// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
 /// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
 /// camera and time. A sixth of this frame has no accepted lookup and is filled from
-/// neighbouring pixels of the same object (the CPU's ring search; the GPU's in-shader search
-/// over the fragment's surface plane).
+/// neighbouring pixels of the same object (the CPU's ring search; on the GPU an in-shader
+/// search over the points the depth prepass gives the neighbouring pixels).
 #[test]
 fn gpu_frame_matches_cpu_reconstruction() {
     let f = plugin_and_cpu_frames(Backend::Gpu, 0, None);
     assert!(f.fallback.hole_fill > 0.1, "{:?}", f.fallback);
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
-    // Measured on lavapipe: mean 0.0005, 99.97 % within 5 %, 100 % within 20 % (the rest is
-    // the f16 target's rounding). With Bevy's default 4× MSAA instead, silhouette pixels
-    // blend two objects: mean 0.020, 96.5 % within 5 %.
+    // Measured on lavapipe: mean 0.00042, 100 % of pixels within 5 % (what remains is the f16
+    // target's rounding). With Bevy's default 4× MSAA instead, silhouette pixels blend two
+    // objects: mean 0.023, 95.6 % within 5 %, 97.2 % within 20 %.
     assert!(
-        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
 }
@@ -389,22 +389,22 @@ fn gpu_frame_matches_cpu_with_volume_fallback() {
     assert!(f.fallback.volume > 0.02, "{:?}", f.fallback);
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(
-        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
 }
 
-/// Keys stream in, are evicted and their slots of the key texture reused (the budget holds 7
-/// keys; t = 1.7, then 0.3, then 0.7 each need 6): each key is written into its own slot's
-/// layers only, once, and the frame is still the CPU frame.
+/// Keys stream in, are evicted and their slots of the key texture reused (the budget holds 4
+/// keys; t = 1.7, then 0.3, then 0.7 each need 4: two weighted views × two keys): each key is
+/// written into its own slot's layers only, once, and the frame is still the CPU frame.
 #[test]
 fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
-    let f = plugin_and_cpu_frames(Backend::Gpu, 0, Some(7));
+    let f = plugin_and_cpu_frames(Backend::Gpu, 0, Some(4));
     eprintln!("{:?}; {:?}", f.stats, f.uploads);
     assert!(f.stats.evictions >= 2, "{:?}", f.stats);
-    assert!(f.stats.decoded_keys >= 9, "{:?}", f.stats);
+    assert!(f.stats.decoded_keys >= 6, "{:?}", f.stats);
     // Only the keys' own layers travel: 6 faces of 8² texels of 16 bytes per key, one
-    // upload per decoded key (not the whole 7-slot texture per arrival).
+    // upload per decoded key (not the whole 4-slot texture per arrival).
     assert_eq!(f.uploads.keys, f.stats.decoded_keys, "{:?}", f.uploads);
     assert_eq!(
         f.uploads.bytes,
@@ -414,7 +414,7 @@ fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
     );
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(
-        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
 }
@@ -429,7 +429,7 @@ fn gpu_background_matches_cpu_where_there_is_no_geometry() {
     assert!(f.fallback.no_geometry > 0.99, "{:?}", f.fallback);
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(
-        mean < 0.005 && f5 > 0.99 && f20 > 0.995,
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
 }

@@ -1,5 +1,6 @@
 //! The [`PlenopticCamera`] component and playback.
 
+use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::prelude::*;
 
 use crate::PlenopticSystems;
@@ -18,10 +19,11 @@ impl Plugin for PlenopticCameraPlugin {
 
 /// A camera that shows a radiance pack: which pack, at which time, reconstructed how.
 ///
-/// Requires a [`Camera3d`] (the proxy geometry is rasterised by it) and carries the
-/// per-camera streaming state.
+/// Requires a [`Camera3d`] (the proxy geometry is rasterised by it) with a
+/// [`DepthPrepass`] (the GPU reconstruction's hole fill reads the depth of neighbouring
+/// pixels), and carries the per-camera streaming state.
 #[derive(Component, Debug, Clone)]
-#[require(Camera3d, StreamState)]
+#[require(Camera3d, DepthPrepass, StreamState)]
 pub struct PlenopticCamera {
     /// The pack shown.
     pub pack: Handle<RadiancePack>,

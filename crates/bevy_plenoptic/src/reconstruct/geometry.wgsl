@@ -4,6 +4,7 @@
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
+#import bevy_pbr::prepass_utils
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
@@ -228,6 +229,24 @@ fn pixel_on_plane(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(a + dir * s, 1.0);
 }
 
+// The world point neighbouring pixel `c` (framebuffer coordinates, its centre) shows: from
+// the depth prepass where the camera has one (w = 0 where nothing is there), else where its
+// ray meets this fragment's surface plane (through `p`, normal `nrm`).
+fn neighbour_point(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
+#ifdef DEPTH_PREPASS
+    let depth = prepass_utils::prepass_depth(vec4<f32>(c, 0.0, 0.0), 0u);
+    if depth <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let uv = (c - view.viewport.xy) / view.viewport.zw;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let w4 = view.world_from_clip * vec4<f32>(ndc, depth, 1.0);
+    return vec4<f32>(w4.xyz / w4.w, 1.0);
+#else
+    return pixel_on_plane(c, p, nrm);
+#endif
+}
+
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     let object = u32(params.header.y);
@@ -245,8 +264,8 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
         return vec4<f32>(own.rgb, 1.0);
     }
     // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
-    // this one whose points, on this fragment's surface plane, have a direct or volume
-    // lookup of this object; their mean.
+    // this one whose points (neighbour_point) have a direct or volume lookup of this object;
+    // their mean.
     let radius = i32(params.fill.x);
     let centre = in.position.xy;
     for (var r = 1; r <= radius; r++) {
@@ -260,7 +279,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
                 if any(c < view.viewport.xy) || any(c >= view.viewport.xy + view.viewport.zw) {
                     continue;
                 }
-                let q = pixel_on_plane(c, p, nrm);
+                let q = neighbour_point(c, p, nrm);
                 if q.w == 0.0 {
                     continue;
                 }

@@ -13,11 +13,12 @@
 //!    from each base view, within `t ± tε`;
 //! 2. the same-object hole fill: the nearest ring of pixels (radius up to
 //!    [`HOLE_FILL_RADIUS`]) whose points have a direct or volume lookup of this object, their
-//!    mean. A fragment cannot read its neighbours' results, so it recomputes them: each ring
-//!    pixel's ray is intersected with the fragment's surface plane (from screen-space
-//!    derivatives) and that point is reconstructed. On planar faces this is the CPU's search
-//!    exactly; it differs where a neighbour pixel shows another face of the object, or another
-//!    object in front of the plane;
+//!    mean. A fragment cannot read its neighbours' results, so it recomputes them at the
+//!    points the neighbouring pixels show, read from the depth prepass
+//!    ([`PlenopticCamera`] requires one); a lookup accepted there means the neighbour shows
+//!    this object, as the CPU's mask test does. Without a prepass (a camera that removed it)
+//!    each ring pixel's ray is intersected with the fragment's surface plane instead, exact on
+//!    planar faces only;
 //! 3. the heaviest key's texel in the point's direction ("background").
 //!
 //! Pixels no proxy covers show the heaviest key's cube in the viewing direction
