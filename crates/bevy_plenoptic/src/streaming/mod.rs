@@ -504,8 +504,9 @@ fn schedule_reads(
             look,
         );
         // Volume blocks are optional: only those the pack has.
-        set.volumes
-            .retain(|b| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some());
+        let has = |b: &BlockRef| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some();
+        set.volumes.retain(has);
+        set.volume_prefetch.retain(has);
         let mut complete = true;
         for &k in &set.needed {
             match cache.resident.get_mut(&(id, k.0, k.1)) {
@@ -538,6 +539,12 @@ fn schedule_reads(
                 r.last_used = frame;
             }
             wanted.push((id, pack.reader.clone(), Unit::Key(k), false));
+        }
+        for &b in &set.volume_prefetch {
+            if let Some(r) = cache.volumes.get_mut(&(id, b.0, b.1)) {
+                r.last_used = frame;
+            }
+            wanted.push((id, pack.reader.clone(), Unit::Volume(b), false));
         }
         stalled |= !complete;
         state.complete = complete;

@@ -82,6 +82,8 @@ pub struct WorkingSet {
     /// Temporal-volume blocks of the needed base views around t (the GPU reconstruction's
     /// fallback where no time key sees a point); only those the pack has are read.
     pub volumes: Vec<BlockRef>,
+    /// Volume blocks wanted soon, like [`WorkingSet::prefetch`].
+    pub volume_prefetch: Vec<BlockRef>,
 }
 
 /// Parameters of [`working_set`].
@@ -126,6 +128,10 @@ pub fn working_set(
         for k in ks {
             let needed = set.needed.clone();
             push(&mut set.prefetch, &needed, (v, k));
+        }
+        for b in volume_buckets(manifest, t).chain(volume_buckets(manifest, future_t)) {
+            let volumes = set.volumes.clone();
+            push(&mut set.volume_prefetch, &volumes, (v, b));
         }
     }
     set
@@ -177,6 +183,9 @@ mod tests {
         assert!(s.prefetch.iter().all(|k| !s.needed.contains(k)));
         // Buckets of 0.5 s, tε = 0.25 s: t = 0.5 needs buckets 0 and 1 of both views.
         assert_eq!(s.volumes, vec![(0, 0), (0, 1), (1, 0), (1, 1)]);
+        // At x = 3.1 and t = 1.5 (buckets 2 and 3) for views 3 and 4, and their buckets at t.
+        assert!(s.volume_prefetch.contains(&(3, 3)) && s.volume_prefetch.contains(&(4, 0)));
+        assert!(s.volume_prefetch.iter().all(|b| !s.volumes.contains(b)));
         assert_eq!(volume_buckets(&m, 0.2), 0..=0);
         assert_eq!(volume_buckets(&m, 0.8), 1..=2);
     }
