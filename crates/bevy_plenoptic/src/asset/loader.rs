@@ -8,7 +8,7 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoader, LoadContext, RenderAssetUsages};
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
-use plenoptic_pack::{PackError, PackReader};
+use plenoptic_pack::{ChunkKind, PackError, PackReader};
 
 use super::{ProxyObject, RadiancePack};
 
@@ -91,11 +91,24 @@ impl AssetLoader for RadiancePackLoader {
                 track: proxy.track,
             });
         }
+        let usable_views = pack
+            .manifest()
+            .base_views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                (0..v.time_keys.len()).any(|k| {
+                    pack.find(ChunkKind::RadianceCube, i as u32, k as u32)
+                        .is_some()
+                })
+            })
+            .collect();
         Ok(RadiancePack {
             reader: Arc::new(pack),
             proxies,
             failed,
             file,
+            usable_views,
         })
     }
 

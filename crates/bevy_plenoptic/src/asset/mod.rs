@@ -35,6 +35,9 @@ pub struct RadiancePack {
     /// The pack's file, when it was opened from the file system (the CPU backend opens its own
     /// reader on it).
     pub file: Option<std::path::PathBuf>,
+    /// Per base view: whether the directory has a radiance cube of it at some time key. Views
+    /// without one get no view-space weight, as in `plenoptic_recon`.
+    pub usable_views: Vec<bool>,
 }
 
 impl std::fmt::Debug for RadiancePack {

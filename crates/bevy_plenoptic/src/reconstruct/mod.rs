@@ -43,13 +43,12 @@ use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
 use plenoptic_recon::temporal::bracketing;
-use plenoptic_recon::viewspace::ViewWeights;
 
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::streaming::StreamCache;
-use crate::streaming::schedule::{time_epsilon, volume_buckets};
+use crate::streaming::schedule::{time_epsilon, view_weights, volume_buckets};
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
@@ -267,14 +266,7 @@ fn frame_lookups(
     t: f32,
 ) -> FrameLookups {
     let m = pack.reader.manifest();
-    let usable = vec![true; m.base_views.len()];
-    let mut views = ViewWeights::new(&m.view_space, &m.base_views, &usable).weights(position);
-    views.truncate(max_views.max(1));
-    let s: f32 = views.iter().map(|v| v.1).sum();
-    let views: Vec<(usize, f32)> = views
-        .into_iter()
-        .map(|(v, w)| (v, if s > 0.0 { w / s } else { w }))
-        .collect();
+    let views = view_weights(m, &pack.usable_views, position, max_views);
     let mut out = FrameLookups::default();
     // Weight of the heaviest lookup.
     let mut heaviest = f32::NEG_INFINITY;

@@ -2,7 +2,7 @@
 //!
 //! Every frame, per [`PlenopticCamera`]: the working set ([`schedule::working_set`]) is the
 //! base views the reconstruction blends (the view-space weights,
-//! [`schedule::weighted_views`]) × the time keys bracketing t ("needed"), plus the same around where
+//! [`schedule::view_weights`]) × the time keys bracketing t ("needed"), plus the same around where
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
 //! bytes) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
@@ -497,6 +497,7 @@ fn schedule_reads(
         };
         let mut set = working_set(
             pack.reader.manifest(),
+            &pack.usable_views,
             position,
             velocity,
             cam.time,

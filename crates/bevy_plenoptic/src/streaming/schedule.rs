@@ -27,17 +27,28 @@ pub fn time_epsilon(manifest: &Manifest) -> f32 {
     (manifest.bucket_span * 0.5).max(1e-6)
 }
 
-/// The base views the reconstruction blends for a camera at `position`: those of the pack's
-/// view-space weights (`plenoptic_recon::viewspace::ViewWeights`, every view usable), heaviest
-/// first, at most `count`. These, not merely the nearest views, must be resident: a plane
-/// view space weights the corners of the triangle around the camera, which need not be the
-/// nearest views.
-pub fn weighted_views(manifest: &Manifest, position: Vec3, count: usize) -> Vec<u32> {
-    let usable = vec![true; manifest.base_views.len()];
+/// The base views the reconstruction blends for a camera at `position`, with their weights
+/// normalised to sum 1: the pack's view-space weights over the `usable` views
+/// (`plenoptic_recon::viewspace::ViewWeights`), heaviest first, at most `count`, as
+/// `plenoptic_recon` chooses them. These, not merely the nearest views, must be resident: a
+/// plane view space weights the corners of the triangle around the camera, which need not be
+/// the nearest views.
+pub fn view_weights(
+    manifest: &Manifest,
+    usable: &[bool],
+    position: Vec3,
+    count: usize,
+) -> Vec<(usize, f32)> {
     let mut w =
-        ViewWeights::new(&manifest.view_space, &manifest.base_views, &usable).weights(position);
+        ViewWeights::new(&manifest.view_space, &manifest.base_views, usable).weights(position);
     w.truncate(count.max(1));
-    w.into_iter().map(|(v, _)| v as u32).collect()
+    let s: f32 = w.iter().map(|x| x.1).sum();
+    if s > 0.0 {
+        for x in &mut w {
+            x.1 /= s;
+        }
+    }
+    w
 }
 
 /// Indices of the `count` base views nearest `position`, nearest first.
@@ -95,10 +106,11 @@ pub struct Lookahead {
     pub seconds: f32,
 }
 
-/// The working set of a camera at `position` moving with `velocity` (m/s), at time `t`
+/// The working set of a camera at `position` (base views limited to the `usable` ones) moving with `velocity` (m/s), at time `t`
 /// playing in direction `direction` (seconds of animation per second).
 pub fn working_set(
     manifest: &Manifest,
+    usable: &[bool],
     position: Vec3,
     velocity: Vec3,
     t: f32,
@@ -111,7 +123,8 @@ pub fn working_set(
             list.push(k);
         }
     };
-    for v in weighted_views(manifest, position, look.views) {
+    for (v, _) in view_weights(manifest, usable, position, look.views) {
+        let v = v as u32;
         for k in bracketing_keys(&manifest.base_views[v as usize].time_keys, t) {
             push(&mut set.needed, &[], (v, k));
         }
@@ -121,7 +134,8 @@ pub fn working_set(
     }
     let future_pos = position + velocity * look.seconds;
     let future_t = t + direction * look.seconds;
-    for v in weighted_views(manifest, future_pos, look.views) {
+    for (v, _) in view_weights(manifest, usable, future_pos, look.views) {
+        let v = v as u32;
         let keys = &manifest.base_views[v as usize].time_keys;
         let mut ks = bracketing_keys(keys, t);
         ks.extend(bracketing_keys(keys, future_t));
@@ -176,7 +190,16 @@ mod tests {
             views: 2,
             seconds: 1.0,
         };
-        let s = working_set(&m, Vec3::new(0.1, 0.0, 0.0), Vec3::X * 3.0, 0.5, 1.0, look);
+        let usable = [true; 5];
+        let s = working_set(
+            &m,
+            &usable,
+            Vec3::new(0.1, 0.0, 0.0),
+            Vec3::X * 3.0,
+            0.5,
+            1.0,
+            look,
+        );
         assert_eq!(s.needed, vec![(0, 0), (0, 1), (1, 0), (1, 1)]);
         // Moving +x at 3 m/s: views 3 and 4 (near x = 3.1) are prefetched, at t = 0.5 and 1.5.
         assert!(s.prefetch.contains(&(3, 1)) && s.prefetch.contains(&(3, 2)));
