@@ -509,13 +509,14 @@ fn spread_samples(path: &CameraPath, n: usize) -> Vec<PathSample> {
 }
 
 /// The plugin's streaming working set along every frame of the tour, with its default
-/// settings: the bytes it must hold for each frame (the nearest base views at the bracketing
-/// time keys) and with prefetch along the camera's motion.
+/// settings: the bytes it must hold for each frame (the weighted base views at the
+/// bracketing time keys, and the temporal-volume blocks around t) and with prefetch along
+/// the camera's motion.
 #[cfg(feature = "bevy")]
 fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, BoxError> {
     use bevy_plenoptic::PlenopticSettings;
-    use bevy_plenoptic::streaming::key_bytes;
     use bevy_plenoptic::streaming::schedule::{Lookahead, working_set};
+    use bevy_plenoptic::streaming::{key_bytes, volume_bytes};
 
     const MIB: f64 = 1024.0 * 1024.0;
     let reader = plenoptic_pack::PackReader::open(pack)?;
@@ -524,6 +525,7 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
         views: settings.max_views,
         seconds: settings.prefetch_seconds,
     };
+    let usable = bevy_plenoptic::asset::usable_views(&reader);
     let frames: Vec<PathSample> = path.frames().collect();
     let (mut needed_max, mut needed_sum, mut all_max) = (0u64, 0u64, 0u64);
     for (i, s) in frames.iter().enumerate() {
@@ -533,25 +535,51 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
         let direction = (next.scene_time - s.scene_time) / dt;
         let set = working_set(
             reader.manifest(),
+            &usable,
             s.camera.position,
             velocity,
             s.scene_time,
             direction,
             look,
         );
-        let needed: u64 = set.needed.iter().map(|&k| key_bytes(&reader, k)).sum();
-        let prefetch: u64 = set.prefetch.iter().map(|&k| key_bytes(&reader, k)).sum();
+        let needed: u64 = set
+            .needed
+            .iter()
+            .map(|&k| key_bytes(&reader, k))
+            .sum::<u64>()
+            + set
+                .volumes
+                .iter()
+                .filter_map(|&b| volume_bytes(&reader, b))
+                .sum::<u64>();
+        let prefetch: u64 = set
+            .prefetch
+            .iter()
+            .map(|&k| key_bytes(&reader, k))
+            .sum::<u64>()
+            + set
+                .volume_prefetch
+                .iter()
+                .filter_map(|&b| volume_bytes(&reader, b))
+                .sum::<u64>();
         needed_max = needed_max.max(needed);
         needed_sum += needed;
         all_max = all_max.max(needed + prefetch);
     }
-    let decoded: u64 = (0..reader.manifest().base_views.len() as u32)
+    let keys_decoded: u64 = (0..reader.manifest().base_views.len() as u32)
         .flat_map(|v| {
             let keys = reader.manifest().base_views[v as usize].time_keys.len() as u32;
             (0..keys).map(move |k| (v, k))
         })
         .map(|k| key_bytes(&reader, k))
         .sum();
+    let volumes_decoded: u64 = reader
+        .entries()
+        .iter()
+        .filter(|e| e.kind == plenoptic_pack::ChunkKind::VolumeBlock)
+        .filter_map(|e| volume_bytes(&reader, (e.base_view, e.key)))
+        .sum();
+    let decoded = keys_decoded + volumes_decoded;
     Ok(Some(format!(
         "Streaming (bevy_plenoptic's working set with its default settings, {} views, {} s \
          prefetch, along all {} frames of the tour): needed per frame {:.1} MiB mean, {:.1} MiB \

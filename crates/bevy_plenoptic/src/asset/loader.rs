@@ -8,7 +8,7 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoader, LoadContext, RenderAssetUsages};
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
-use plenoptic_pack::{ChunkKind, PackError, PackReader};
+use plenoptic_pack::{PackError, PackReader};
 
 use super::{ProxyObject, RadiancePack};
 
@@ -91,18 +91,7 @@ impl AssetLoader for RadiancePackLoader {
                 track: proxy.track,
             });
         }
-        let usable_views = pack
-            .manifest()
-            .base_views
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                (0..v.time_keys.len()).any(|k| {
-                    pack.find(ChunkKind::RadianceCube, i as u32, k as u32)
-                        .is_some()
-                })
-            })
-            .collect();
+        let usable_views = super::usable_views(&pack);
         Ok(RadiancePack {
             reader: Arc::new(pack),
             proxies,

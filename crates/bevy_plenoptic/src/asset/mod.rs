@@ -40,6 +40,22 @@ pub struct RadiancePack {
     pub usable_views: Vec<bool>,
 }
 
+/// Per base view of `pack`: whether the directory has a radiance cube of it at some time key
+/// ([`RadiancePack::usable_views`]).
+pub fn usable_views(pack: &plenoptic_pack::PackReader) -> Vec<bool> {
+    pack.manifest()
+        .base_views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            (0..v.time_keys.len()).any(|k| {
+                pack.find(plenoptic_pack::ChunkKind::RadianceCube, i as u32, k as u32)
+                    .is_some()
+            })
+        })
+        .collect()
+}
+
 impl std::fmt::Debug for RadiancePack {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("RadiancePack")
