@@ -82,20 +82,21 @@ const HEIGHT: u32 = 240;
 fn first_frame_once(assets: &std::path::Path) -> Duration {
     let start = Instant::now();
     let mut app = App::new();
-    app.add_plugins((
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(AssetPlugin {
-                file_path: assets.to_string_lossy().into_owned(),
-                ..default()
-            })
-            .disable::<bevy::log::LogPlugin>(),
-        PlenopticPlugin,
-    ));
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            ..default()
+        })
+        .set(AssetPlugin {
+            file_path: assets.to_string_lossy().into_owned(),
+            ..default()
+        })
+        .disable::<bevy::log::LogPlugin>();
+    // The tour's window backend is not wanted here (no display; its event loop).
+    #[cfg(feature = "window")]
+    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
+    app.add_plugins((plugins, PlenopticPlugin));
     app.finish();
     app.cleanup();
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");

@@ -29,16 +29,23 @@ pub const HEIGHT: u32 = 48;
 /// (Mesa's lavapipe on CI).
 pub fn headless_app() -> App {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .build(),
-    );
+    app.add_plugins(headless_plugins());
     app
+}
+
+/// `DefaultPlugins` without a window (and without winit's event loop, which must run on the
+/// main thread and needs a display, when the `winit` feature is on).
+pub fn headless_plugins() -> bevy::app::PluginGroupBuilder {
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            ..default()
+        })
+        .build();
+    #[cfg(feature = "winit")]
+    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
+    plugins
 }
 
 /// Like [`headless_app`], with assets read from `dir` and the plenoptic plugin added
@@ -46,17 +53,10 @@ pub fn headless_app() -> App {
 pub fn headless_app_in(dir: &std::path::Path) -> App {
     let mut app = App::new();
     app.add_plugins((
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(AssetPlugin {
-                file_path: dir.to_string_lossy().into_owned(),
-                ..default()
-            })
-            .build(),
+        headless_plugins().set(AssetPlugin {
+            file_path: dir.to_string_lossy().into_owned(),
+            ..default()
+        }),
         bevy_plenoptic::PlenopticPlugin,
     ));
     app.finish();
