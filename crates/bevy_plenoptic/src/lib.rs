@@ -121,8 +121,10 @@ pub struct PlenopticSettings {
 pub enum Backend {
     /// The WGSL material on the proxy meshes (per-fragment lookups; cost scales with the
     /// covered pixels × base views × 2 keys, more where the volume fallback or the hole fill
-    /// runs). Geometry-assisted mode only: cameras in image or volume mode are shown
-    /// geometry-assisted, with a warning.
+    /// runs). Image mode runs as compute passes ([`reconstruct::image`]: splats of the
+    /// weighted views' cube texels, view blend, background fill) shown through the proxies
+    /// and the background (the first image-mode camera only). Cameras in volume mode are
+    /// shown geometry-assisted, with a warning.
     Gpu,
     /// `plenoptic_recon`'s CPU reconstructor on a worker thread, its frame shown through the
     /// proxy meshes (screen-space texture; depth still from the rasterised proxies). Far

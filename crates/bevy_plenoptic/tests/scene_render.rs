@@ -185,6 +185,8 @@ struct Frames {
     gpu: Vec<Vec3>,
     /// plenoptic_recon's CPU frame.
     cpu: Vec<Vec3>,
+    /// plenoptic_recon's CPU frame in geometry-assisted mode (whatever the compared mode).
+    cpu_geometry: Vec<Vec3>,
     /// The CPU frame's fallbacks.
     fallback: plenoptic_recon::FallbackReport,
     /// Streaming counters at the end.
@@ -205,19 +207,26 @@ fn plugin_and_cpu_frames(
     budget_keys: Option<u64>,
 ) -> Frames {
     let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
-    plugin_and_cpu_frames_from(backend, volume_samples, budget_keys, view)
+    plugin_and_cpu_frames_from(
+        backend,
+        volume_samples,
+        budget_keys,
+        view,
+        ReconMode::GeometryAssisted,
+    )
 }
 
-/// [`plugin_and_cpu_frames`] from the eye `view.0` looking at `view.1`.
+/// [`plugin_and_cpu_frames`] from the eye `view.0` looking at `view.1`, in `mode`.
 fn plugin_and_cpu_frames_from(
     backend: Backend,
     volume_samples: usize,
     budget_keys: Option<u64>,
     view: (Vec3, Vec3),
+    mode: ReconMode,
 ) -> Frames {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
-    use plenoptic_recon::{Mode, Reconstructor};
+    use plenoptic_recon::Reconstructor;
     use std::cell::RefCell;
 
     let dir = tempfile::tempdir().unwrap();
@@ -243,7 +252,10 @@ fn plugin_and_cpu_frames_from(
         HEIGHT,
     )
     .unwrap();
-    let (cpu, report) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let (cpu, report) = rec.render(&cam, t, mode.into()).unwrap();
+    let (cpu_geometry, _) = rec
+        .render(&cam, t, plenoptic_recon::Mode::GeometryAssisted)
+        .unwrap();
     eprintln!("CPU frame: {:?}", report.fallback);
 
     // GPU.
@@ -275,6 +287,7 @@ fn plugin_and_cpu_frames_from(
         PlenopticCamera {
             playback: Playback::Manual,
             time: detour[0],
+            mode,
             ..PlenopticCamera::new(handle)
         },
     ));
@@ -327,6 +340,7 @@ fn plugin_and_cpu_frames_from(
     Frames {
         gpu: decode(&data),
         cpu: cpu.radiance,
+        cpu_geometry: cpu_geometry.radiance,
         fallback: report.fallback,
         stats: app.world().resource::<StreamingStats>().clone(),
         uploads: *app.world().resource::<KeyUploadStats>(),
@@ -419,13 +433,36 @@ fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
     );
 }
 
+/// Image mode on the GPU (splats of the weighted views' cube texels through per-view
+/// z-buffers, view blend, background fill; compute passes) against plenoptic_recon's image
+/// mode for the same pack, camera and time.
+#[test]
+fn gpu_image_mode_matches_cpu_image_mode() {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let f = plugin_and_cpu_frames_from(Backend::Gpu, 0, None, view, ReconMode::Image);
+    // Half the frame is holes between the splats, filled from the farthest neighbour.
+    assert!(f.fallback.hole_fill > 0.3, "{:?}", f.fallback);
+    // The two modes' frames differ on this view, so agreement below is image mode's own.
+    let (mean_modes, f5_modes, _) = compare(&f.cpu_geometry, &f.cpu);
+    assert!(
+        mean_modes > 0.02 && f5_modes < 0.9,
+        "CPU image vs geometry mode: mean {mean_modes}, within 5 %: {f5_modes}"
+    );
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    // Measured on lavapipe: mean 0.00018, 100 % of pixels within 5 %.
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
 /// Outside the room looking away from it no proxy covers a pixel: the frame is the
 /// environment, the heaviest key's cube in each pixel's direction, on the GPU (a full-screen
 /// background behind all geometry) as on the CPU.
 #[test]
 fn gpu_background_matches_cpu_where_there_is_no_geometry() {
     let view = (Vec3::new(0.3, 1.3, 3.5), Vec3::new(0.5, 1.6, 6.0));
-    let f = plugin_and_cpu_frames_from(Backend::Gpu, 0, None, view);
+    let f = plugin_and_cpu_frames_from(Backend::Gpu, 0, None, view, ReconMode::GeometryAssisted);
     assert!(f.fallback.no_geometry > 0.99, "{:?}", f.fallback);
     let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
     assert!(

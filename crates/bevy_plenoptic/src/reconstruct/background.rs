@@ -39,13 +39,17 @@ pub struct PlenopticBackgroundMaterial {
     /// Which key to show.
     #[uniform(1)]
     pub params: BackgroundParams,
+    /// The image-mode frame ([`super::image::ImageFrame`]), shown while the camera is in
+    /// image mode.
+    #[texture(2, sample_type = "float", filterable = false)]
+    pub image_frame: Handle<Image>,
 }
 
 /// The uniform of a [`PlenopticBackgroundMaterial`].
 #[derive(ShaderType, Debug, Clone, Default)]
 pub struct BackgroundParams {
     /// x: first array layer of the key shown, y: face size, z: 1 if a key is shown (else
-    /// black).
+    /// black), w: 1 to show the image-mode frame instead.
     pub key: Vec4,
 }
 
@@ -86,10 +90,12 @@ pub struct PlenopticBackground {
 
 /// Spawns a background child for each camera on the GPU backend whose pack's key texture
 /// exists.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 pub(super) fn spawn_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
+    image_frame: Res<super::image::ImageFrame>,
     cameras: Query<(Entity, &PlenopticCamera)>,
     existing: Query<&PlenopticBackground>,
     mut meshes: ResMut<Assets<Mesh>>,
@@ -120,6 +126,7 @@ pub(super) fn spawn_backgrounds(
         let material = materials.add(PlenopticBackgroundMaterial {
             cubes: tex.image.clone(),
             params: BackgroundParams::default(),
+            image_frame: image_frame.0.clone(),
         });
         let child = commands
             .spawn((
@@ -135,17 +142,22 @@ pub(super) fn spawn_backgrounds(
     }
 }
 
-/// Shows the heaviest key (`layer`: its first array layer) of the camera's pack, or black.
+/// Shows the heaviest key (`layer`: its first array layer) of the camera's pack, or black;
+/// or, with `image_mode`, the image-mode frame.
 pub(super) fn set_background(
     materials: &mut Assets<PlenopticBackgroundMaterial>,
     handle: &MeshMaterial3d<PlenopticBackgroundMaterial>,
     layer: Option<u32>,
     face: u32,
+    image_mode: bool,
 ) {
-    let key = match layer {
+    let mut key = match layer {
         Some(l) => Vec4::new(l as f32, face as f32, 1.0, 0.0),
         None => Vec4::ZERO,
     };
+    if image_mode {
+        key.w = 1.0;
+    }
     if materials
         .get(&handle.0)
         .is_some_and(|m| m.params.key != key)

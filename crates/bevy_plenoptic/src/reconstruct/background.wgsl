@@ -5,8 +5,10 @@
 #import bevy_pbr::mesh_view_bindings::view
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
-// x: first layer, y: face size, z: 1 if a key is shown.
+// x: first layer, y: face size, z: 1 if a key is shown, w: 1 to show the image-mode frame.
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> key: vec4<f32>;
+// The image-mode frame (image.wgsl).
+@group(#{MATERIAL_BIND_GROUP}) @binding(2) var image_frame: texture_2d<f32>;
 
 struct Out {
     @builtin(position) position: vec4<f32>,
@@ -53,6 +55,12 @@ fn cube_texel(dir: vec3<f32>, n: u32) -> vec3<u32> {
 
 @fragment
 fn fragment(in: Out) -> @location(0) vec4<f32> {
+    if key.w == 1.0 {
+        let size = textureDimensions(image_frame);
+        let uv = (in.position.xy - view.viewport.xy) / view.viewport.zw;
+        let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+        return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
+    }
     if key.z == 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }

@@ -35,6 +35,8 @@ struct ReconParams {
 // Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object, -, -).
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
+// The image-mode frame (image.wgsl), shown when params.fill.z is 1.
+@group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
 
 fn rgb9e5_decode(v: u32) -> vec3<f32> {
     let e = f32(v >> 27u) - 15.0 - 9.0;
@@ -247,6 +249,14 @@ fn neighbour_point(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
 #endif
 }
 
+// The image-mode frame's texel of the fragment's pixel.
+fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
+    let size = textureDimensions(image_frame);
+    let uv = (position - view.viewport.xy) / view.viewport.zw;
+    let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+    return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
+}
+
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     let object = u32(params.header.y);
@@ -259,6 +269,9 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
         nrm = in.world_normal;
     }
     nrm = normalize(nrm);
+    if params.fill.z == 1.0 {
+        return image_frame_texel(in.position.xy);
+    }
     let own = reconstruct(p, eye, object);
     if own.w > 0.0 {
         return vec4<f32>(own.rgb, 1.0);

@@ -1,4 +1,5 @@
-//! GPU geometry-assisted reconstruction (thesis §8.2.3).
+//! GPU geometry-assisted reconstruction (thesis §8.2.3); image mode is in [`image`] (compute
+//! passes whose frame the proxy materials and the background show).
 //!
 //! Every proxy mesh is drawn with a [`PlenopticMaterial`] whose fragment shader
 //! (`geometry.wgsl`, beside this file) does the lookups of `plenoptic_recon`'s geometry mode:
@@ -32,6 +33,7 @@
 
 pub mod background;
 pub mod cpu;
+pub mod image;
 pub mod upload;
 pub mod volume;
 
@@ -67,6 +69,7 @@ impl Plugin for PlenopticReconstructPlugin {
         embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
         background::build(app);
+        image::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
@@ -79,6 +82,7 @@ impl Plugin for PlenopticReconstructPlugin {
                     volume::upload_volumes,
                     attach_materials,
                     background::spawn_backgrounds,
+                    image::prepare_job,
                     update_materials,
                 )
                     .chain()
@@ -146,6 +150,10 @@ pub struct PlenopticMaterial {
     /// Their bin offsets ([`volume::PackVolumes::bins`]).
     #[storage(3, read_only)]
     pub volume_bins: Handle<ShaderBuffer>,
+    /// The image-mode frame ([`image::ImageFrame`]), shown instead of the lookups while the
+    /// camera is in [`ReconMode::Image`].
+    #[texture(4, sample_type = "float", filterable = false)]
+    pub image_frame: Handle<Image>,
 }
 
 impl Material for PlenopticMaterial {
@@ -162,7 +170,8 @@ pub struct ReconParams {
     /// x: relative depth tolerance, y: angular power, z: time t, w: temporal window tε.
     pub tuning: Vec4,
     /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
-    /// "background" fallback; ≥ the lookup count when there is none).
+    /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
+    /// image-mode frame instead.
     pub fill: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
@@ -196,11 +205,13 @@ pub struct KeyTexture {
     pub normals: HashSet<u32>,
 }
 
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn attach_materials(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
+    image_frame: Res<image::ImageFrame>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
@@ -223,6 +234,7 @@ fn attach_materials(
             params: ReconParams::default(),
             volume_samples: vol.samples.clone(),
             volume_bins: vol.bins.clone(),
+            image_frame: image_frame.0.clone(),
         });
         commands
             .entity(entity)
@@ -320,6 +332,7 @@ fn update_materials(
     cache: Res<StreamCache>,
     settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
+    job: Res<image::ImageJob>,
     cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(&ChildOf, &ProxyOf, &MeshMaterial3d<PlenopticMaterial>)>,
@@ -356,13 +369,13 @@ fn update_materials(
         let Some(f) = frame(id, cam, transform.translation()) else {
             continue;
         };
-        if cam.mode != ReconMode::GeometryAssisted {
+        if cam.mode == ReconMode::Volume {
             warn_once!(
-                "plenoptic: the GPU backend reconstructs in geometry-assisted mode only; \
-                 {:?} mode needs Backend::Cpu",
-                cam.mode
+                "plenoptic: the GPU backend reconstructs in geometry-assisted and image modes \
+                 only; volume mode needs Backend::Cpu"
             );
         }
+        let image_mode = cam.mode == ReconMode::Image && job.0.is_some();
         let m = pack.reader.manifest();
         let proxy = pack.proxy(of.id);
         let inv_now = proxy.map_or(Mat4::IDENTITY, |p| {
@@ -374,7 +387,7 @@ fn update_materials(
             fill: Vec4::new(
                 HOLE_FILL_RADIUS as f32,
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
-                0.0,
+                if image_mode { 1.0 } else { 0.0 },
                 0.0,
             ),
             ..default()
@@ -407,6 +420,7 @@ fn update_materials(
         let face = keys.0.get(&id).map_or(1, |t| t.face);
         let layer = frame(id, cam, transform.translation())
             .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
-        background::set_background(&mut background_materials, handle, layer, face);
+        let image_mode = cam.mode == ReconMode::Image && job.0.is_some();
+        background::set_background(&mut background_materials, handle, layer, face, image_mode);
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! Every frame, per [`PlenopticCamera`]: the working set ([`schedule::working_set`]) is the
 //! base views the reconstruction blends (the view-space weights,
-//! [`schedule::view_weights`]) × the time keys bracketing t ("needed"), plus the same around where
+//! [`schedule::view_weights`]) × the time keys bracketing t (in image mode the up to four keys
+//! of its Bézier segment) ("needed"), plus the same around where
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
 //! bytes) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
@@ -504,6 +505,23 @@ fn schedule_reads(
             speed,
             look,
         );
+        if cam.mode == crate::camera::ReconMode::Image {
+            // Image mode blends each view's keys with Bézier weights over up to four keys
+            // (`plenoptic_recon::temporal::bezier_weights`), not just the bracketing two.
+            let m = pack.reader.manifest();
+            let mut views: Vec<u32> = set.needed.iter().map(|k| k.0).collect();
+            views.dedup();
+            for v in views {
+                let times = &m.base_views[v as usize].time_keys;
+                for (k, _) in plenoptic_recon::temporal::bezier_weights(times, cam.time) {
+                    let key = (v, k as u32);
+                    if !set.needed.contains(&key) {
+                        set.needed.push(key);
+                    }
+                    set.prefetch.retain(|p| *p != key);
+                }
+            }
+        }
         // Volume blocks are optional: only those the pack has.
         let has = |b: &BlockRef| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some();
         set.volumes.retain(has);

@@ -1,0 +1,427 @@
+//! GPU image mode ([`ReconMode::Image`]): `plenoptic_recon`'s image-based warping in compute
+//! passes (`image.wgsl`, beside this file), dispatched before the cameras render.
+//!
+//! Per weighted base view (the view-space weights of the nearest
+//! [`PlenopticSettings::max_views`] views, at most [`MAX_IMAGE_VIEWS`]), every texel of the
+//! view's nearest resident key with a finite distance is splatted into the camera as
+//! `plenoptic_recon::warp` does (square splats of the texel's footprint, at most 8 pixels),
+//! through a per-view z-buffer: the nearest surface (splats within 3 % of the nearest depth)
+//! wins, and among its splats the one whose centre is nearest the pixel. The CPU resolves
+//! splats in texel order ("clearly in front, or same surface and nearer centre"); the GPU's
+//! three atomic passes (nearest depth, nearest centre within the surface, winning texel) are
+//! order-independent, so the two can differ where surfaces meet. A texel's radiance is the
+//! view's keys blended with `plenoptic_recon`'s Bézier weights when all those keys are
+//! resident, otherwise with inverse time-distance weights over the resident ones (the CPU's
+//! fallback for unreadable keys). The views are then blended per pixel over those within
+//! the depth tolerance of the nearest, and holes are filled from the farthest covered
+//! neighbour, [`FILL_PASSES`] times.
+//!
+//! The frame is written to [`ImageFrame`]'s `Rgba32Float` storage texture, which the proxy
+//! materials and the background show in screen space while the camera is in image mode.
+//! Only the first image-mode camera of the app is reconstructed.
+
+use std::borrow::Cow;
+
+use bevy::asset::{RenderAssetUsages, embedded_asset, load_embedded_asset};
+use bevy::core_pipeline::schedule::camera_driver;
+use bevy::prelude::*;
+use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::binding_types::{
+    storage_buffer_sized, texture_2d_array, texture_storage_2d, uniform_buffer,
+};
+use bevy::render::render_resource::{
+    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, Buffer,
+    BufferDescriptor, BufferUsages, CachedComputePipelineId, ComputePassDescriptor,
+    ComputePipelineDescriptor, Extent3d, PipelineCache, ShaderStages, ShaderType,
+    StorageTextureAccess, TextureDimension, TextureFormat, TextureSampleType, TextureUsages,
+    UniformBuffer,
+};
+use bevy::render::renderer::{RenderContext, RenderDevice, RenderGraph, RenderQueue};
+use bevy::render::texture::GpuImage;
+use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use plenoptic_recon::temporal::bezier_weights;
+
+use super::background::PlenopticBackgroundMaterial;
+use super::{KeyTextures, ResolvedBackend};
+use crate::asset::RadiancePack;
+use crate::camera::{PlenopticCamera, ReconMode};
+use crate::streaming::StreamCache;
+use crate::streaming::schedule::view_weights;
+use crate::{Backend, PlenopticSettings};
+
+/// Most base views warped per frame.
+pub const MAX_IMAGE_VIEWS: usize = 8;
+/// Most keys blended per view (the Bézier segment's four).
+pub const KEYS_PER_VIEW: usize = 4;
+/// Background-fill passes (`plenoptic_recon`'s default).
+pub const FILL_PASSES: u32 = 24;
+/// Relative depth window of the blend (`plenoptic_recon`'s default).
+const DEPTH_TOLERANCE: f32 = 0.03;
+
+/// The uniform of the image-mode passes.
+#[derive(ShaderType, Debug, Clone, Default)]
+pub struct ImageParams {
+    /// Eye (xyz), focal length in pixels (w).
+    pub eye: Vec4,
+    /// Camera right (xyz), tan of half the horizontal field of view (w).
+    pub right: Vec4,
+    /// Camera up (xyz), tan of half the vertical field of view (w).
+    pub up: Vec4,
+    /// Viewing direction (xyz), relative depth tolerance of the blend (w).
+    pub forward: Vec4,
+    /// Width, height, face size, view count.
+    pub size: UVec4,
+    /// x: background-fill passes.
+    pub misc: UVec4,
+    /// Per view: position (xyz), view weight (w).
+    pub views: [Vec4; MAX_IMAGE_VIEWS],
+    /// Per view: first array layer of each key blended.
+    pub layers: [UVec4; MAX_IMAGE_VIEWS],
+    /// Per view: each key's weight (0 for unused).
+    pub key_weights: [Vec4; MAX_IMAGE_VIEWS],
+    /// Per view: x: first layer of the nearest key (distances), y: key count.
+    pub nearest: [UVec4; MAX_IMAGE_VIEWS],
+}
+
+/// The frame the image mode writes (an `Rgba32Float` storage texture, resized to the camera).
+#[derive(Resource, Debug, Clone)]
+pub struct ImageFrame(pub Handle<Image>);
+
+/// This frame's image-mode work, if a camera is in image mode on the GPU backend.
+#[derive(Resource, Debug, Clone, Default, ExtractResource)]
+pub struct ImageJob(pub Option<ImageWork>);
+
+/// What the image-mode passes read and write.
+#[derive(Debug, Clone)]
+pub struct ImageWork {
+    /// The pack's key texture.
+    pub cubes: Handle<Image>,
+    /// The output frame.
+    pub output: Handle<Image>,
+    /// The passes' uniform.
+    pub params: ImageParams,
+}
+
+fn frame_image(width: u32, height: u32) -> Image {
+    let mut image = Image::new_fill(
+        Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[0; 16],
+        TextureFormat::Rgba32Float,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    image.texture_descriptor.usage =
+        TextureUsages::COPY_DST | TextureUsages::STORAGE_BINDING | TextureUsages::TEXTURE_BINDING;
+    image
+}
+
+pub(super) fn build(app: &mut App) {
+    embedded_asset!(app, "image.wgsl");
+    app.init_resource::<ImageJob>()
+        .add_plugins(ExtractResourcePlugin::<ImageJob>::default());
+    let frame = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(frame_image(1, 1));
+    app.insert_resource(ImageFrame(frame));
+    if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+        render_app
+            .init_resource::<ImageBuffers>()
+            .add_systems(RenderStartup, init_pipelines)
+            .add_systems(
+                Render,
+                prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
+            )
+            .add_systems(RenderGraph, run_passes.before(camera_driver));
+    }
+}
+
+/// Fills [`ImageJob`] for the first camera in image mode and resizes [`ImageFrame`] to it.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+pub(super) fn prepare_job(
+    backend: Res<ResolvedBackend>,
+    keys: Res<KeyTextures>,
+    cache: Res<StreamCache>,
+    settings: Res<PlenopticSettings>,
+    packs: Res<Assets<RadiancePack>>,
+    frame: Res<ImageFrame>,
+    cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
+    mut images: ResMut<Assets<Image>>,
+    mut job: ResMut<ImageJob>,
+    mut backgrounds: ResMut<Assets<PlenopticBackgroundMaterial>>,
+) {
+    let work = (|| {
+        if backend.0 != Backend::Gpu {
+            return None;
+        }
+        let (cam, camera, projection, transform) =
+            cameras.iter().find(|(c, ..)| c.mode == ReconMode::Image)?;
+        let id = cam.pack.id();
+        let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
+        let size = camera.physical_viewport_size()?;
+        let vfov = match projection {
+            Projection::Perspective(p) => p.fov,
+            _ => std::f32::consts::FRAC_PI_4,
+        };
+        let (_, rotation, position) = transform.to_scale_rotation_translation();
+        let basis = plenoptic_recon::Camera::new(position, rotation, vfov, size.x, size.y)
+            .ok()?
+            .basis();
+        let mut params = ImageParams {
+            eye: basis.position.extend(basis.focal_px),
+            right: basis.right.extend(basis.tan_x),
+            up: basis.up.extend(basis.tan_y),
+            forward: basis.forward.extend(DEPTH_TOLERANCE),
+            size: UVec4::new(size.x, size.y, tex.face, 0),
+            misc: UVec4::new(FILL_PASSES, 0, 0, 0),
+            ..default()
+        };
+        let m = pack.reader.manifest();
+        let t = cam.time;
+        let views = view_weights(m, &pack.usable_views, position, settings.max_views);
+        let mut n = 0;
+        for (v, w) in views {
+            if n == MAX_IMAGE_VIEWS {
+                break;
+            }
+            let times = &m.base_views[v].time_keys;
+            let wanted = bezier_weights(times, t);
+            let resident: Vec<(usize, f32, u32)> = wanted
+                .iter()
+                .filter_map(|&(k, wk)| {
+                    let r = cache.get(id, (v as u32, k as u32))?;
+                    (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
+                        .then_some((k, wk, r.slot))
+                })
+                .take(KEYS_PER_VIEW)
+                .collect();
+            if resident.is_empty() {
+                continue;
+            }
+            let weights: Vec<f32> = if resident.len() == wanted.len() {
+                resident.iter().map(|r| r.1).collect()
+            } else {
+                resident
+                    .iter()
+                    .map(|r| 1.0 / ((times[r.0] - t).abs() + 1e-4))
+                    .collect()
+            };
+            let total: f32 = weights.iter().sum();
+            let nearest = resident
+                .iter()
+                .min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?;
+            params.views[n] = m.base_views[v].position.extend(w);
+            params.nearest[n] = UVec4::new(nearest.2 * 6, resident.len() as u32, 0, 0);
+            for (k, (r, wk)) in resident.iter().zip(&weights).enumerate() {
+                params.layers[n][k] = r.2 * 6;
+                params.key_weights[n][k] = wk / total;
+            }
+            n += 1;
+        }
+        if n == 0 {
+            return None;
+        }
+        params.size.w = n as u32;
+        Some(ImageWork {
+            cubes: tex.image.clone(),
+            output: frame.0.clone(),
+            params,
+        })
+    })();
+    if let Some(w) = &work {
+        let size = UVec2::new(w.params.size.x, w.params.size.y);
+        if images.get(&frame.0).is_some_and(|i| i.size() != size) {
+            images.insert(&frame.0, frame_image(size.x, size.y)).ok();
+            // Touch the backgrounds so that their bind groups take the new texture (the proxy
+            // materials are updated every frame anyway).
+            let ids: Vec<_> = backgrounds.ids().collect();
+            for id in ids {
+                backgrounds.get_mut(id);
+            }
+        }
+    }
+    job.0 = work;
+}
+
+#[derive(Resource)]
+struct ImagePipelines {
+    layout: BindGroupLayoutDescriptor,
+    /// clear, splat_depth, splat_centre, splat_texel, blend, fill, write_output.
+    passes: [CachedComputePipelineId; 7],
+}
+
+const ENTRY_POINTS: [&str; 7] = [
+    "clear",
+    "splat_depth",
+    "splat_centre",
+    "splat_texel",
+    "blend",
+    "fill",
+    "write_output",
+];
+
+fn init_pipelines(
+    mut commands: Commands,
+    asset_server: Res<AssetServer>,
+    pipeline_cache: Res<PipelineCache>,
+) {
+    let layout = BindGroupLayoutDescriptor::new(
+        "plenoptic image mode",
+        &BindGroupLayoutEntries::sequential(
+            ShaderStages::COMPUTE,
+            (
+                texture_2d_array(TextureSampleType::Uint),
+                uniform_buffer::<ImageParams>(false),
+                storage_buffer_sized(false, None),
+                storage_buffer_sized(false, None),
+                storage_buffer_sized(false, None),
+                storage_buffer_sized(false, None),
+                texture_storage_2d(TextureFormat::Rgba32Float, StorageTextureAccess::WriteOnly),
+            ),
+        ),
+    );
+    let shader = load_embedded_asset!(asset_server.as_ref(), "image.wgsl");
+    let passes = ENTRY_POINTS.map(|e| {
+        pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
+            label: Some(format!("plenoptic image mode: {e}").into()),
+            layout: vec![layout.clone()],
+            shader: shader.clone(),
+            entry_point: Some(Cow::from(e)),
+            ..default()
+        })
+    });
+    commands.insert_resource(ImagePipelines { layout, passes });
+}
+
+/// Scratch buffers, grown as needed: splat keys, splat texels, two frame buffers.
+#[derive(Resource, Default)]
+struct ImageBuffers {
+    buffers: Option<[Buffer; 4]>,
+    /// (views × pixels) they hold.
+    capacity: u64,
+}
+
+#[derive(Resource)]
+struct ImageBindGroups {
+    /// Frame buffers (a, b) and (b, a) as (in, out).
+    groups: [BindGroup; 2],
+    params: ImageParams,
+}
+
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+fn prepare_bind_groups(
+    mut commands: Commands,
+    job: Res<ImageJob>,
+    pipelines: Option<Res<ImagePipelines>>,
+    images: Res<RenderAssets<GpuImage>>,
+    mut buffers: ResMut<ImageBuffers>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    pipeline_cache: Res<PipelineCache>,
+) {
+    commands.remove_resource::<ImageBindGroups>();
+    let (Some(work), Some(pipelines)) = (job.0.as_ref(), pipelines) else {
+        return;
+    };
+    let (Some(cubes), Some(output)) = (images.get(&work.cubes), images.get(&work.output)) else {
+        return;
+    };
+    let p = work.params.size;
+    if output.texture_descriptor.size.width != p.x || output.texture_descriptor.size.height != p.y {
+        return;
+    }
+    let pixels = u64::from(p.x) * u64::from(p.y);
+    let need = pixels * MAX_IMAGE_VIEWS as u64;
+    if buffers.capacity < need || buffers.buffers.is_none() {
+        let make = |label: &'static str, bytes: u64| {
+            device.create_buffer(&BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        buffers.buffers = Some([
+            make("plenoptic image splat keys", need * 8),
+            make("plenoptic image splat texels", need * 4),
+            make("plenoptic image frame a", pixels * 16),
+            make("plenoptic image frame b", pixels * 16),
+        ]);
+        buffers.capacity = need;
+    }
+    let Some([keys, texels, a, b]) = buffers.buffers.as_ref() else {
+        return;
+    };
+    let mut uniform = UniformBuffer::from(work.params.clone());
+    uniform.write_buffer(&device, &queue);
+    let layout = pipeline_cache.get_bind_group_layout(&pipelines.layout);
+    let group = |fin: &Buffer, fout: &Buffer| {
+        device.create_bind_group(
+            "plenoptic image mode",
+            &layout,
+            &BindGroupEntries::sequential((
+                &cubes.texture_view,
+                &uniform,
+                keys.as_entire_binding(),
+                texels.as_entire_binding(),
+                fin.as_entire_binding(),
+                fout.as_entire_binding(),
+                &output.texture_view,
+            )),
+        )
+    };
+    commands.insert_resource(ImageBindGroups {
+        groups: [group(a, b), group(b, a)],
+        params: work.params.clone(),
+    });
+}
+
+fn run_passes(
+    mut render_context: RenderContext,
+    groups: Option<Res<ImageBindGroups>>,
+    pipelines: Option<Res<ImagePipelines>>,
+    pipeline_cache: Res<PipelineCache>,
+) {
+    let (Some(groups), Some(pipelines)) = (groups, pipelines) else {
+        return;
+    };
+    let Some(passes) = pipelines
+        .passes
+        .iter()
+        .map(|&id| pipeline_cache.get_compute_pipeline(id))
+        .collect::<Option<Vec<_>>>()
+    else {
+        return;
+    };
+    let p = &groups.params;
+    let (w, h, face, views) = (p.size.x, p.size.y, p.size.z, p.size.w);
+    let texels = 6 * face * face;
+    let mut pass = render_context
+        .command_encoder()
+        .begin_compute_pass(&ComputePassDescriptor {
+            label: Some("plenoptic image mode"),
+            ..default()
+        });
+    pass.set_bind_group(0, &groups.groups[0], &[]);
+    pass.set_pipeline(passes[0]);
+    pass.dispatch_workgroups((w * h).div_ceil(64), views, 1);
+    for splat in &passes[1..4] {
+        pass.set_pipeline(splat);
+        pass.dispatch_workgroups(texels.div_ceil(64), views, 1);
+    }
+    pass.set_pipeline(passes[4]);
+    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    pass.set_pipeline(passes[5]);
+    for k in 0..p.misc.x {
+        pass.set_bind_group(0, &groups.groups[k as usize % 2], &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
+    pass.set_bind_group(0, &groups.groups[p.misc.x as usize % 2], &[]);
+    pass.set_pipeline(passes[6]);
+    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+}
