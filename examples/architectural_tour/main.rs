@@ -330,7 +330,12 @@ fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
             file,
             at: options.screenshot_at,
         });
-    windowed::run(pack, path, exposure, backend, screenshot)
+    let mode = match options.mode {
+        Mode::GeometryAssisted => bevy_plenoptic::ReconMode::GeometryAssisted,
+        Mode::Image => bevy_plenoptic::ReconMode::Image,
+        Mode::Volume => bevy_plenoptic::ReconMode::Volume,
+    };
+    windowed::run(pack, path, exposure, backend, mode, screenshot)
 }
 
 /// Without the `window` feature the tour renders headless.

@@ -65,6 +65,7 @@ pub fn run(
     path: CameraPath,
     exposure: f32,
     backend: Backend,
+    mode: ReconMode,
     screenshot: Option<ScreenshotPlan>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let dir = pack
@@ -121,6 +122,7 @@ pub fn run(
             let start = tour.path.sample(tour.path_time);
             let mut camera = PlenopticCamera::new(assets.load(file.clone()));
             camera.playback = Playback::Manual;
+            camera.mode = mode;
             camera.time = start.scene_time;
             commands.spawn((
                 camera,
