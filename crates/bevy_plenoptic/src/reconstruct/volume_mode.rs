@@ -14,17 +14,21 @@
 //! the views and fill the background.
 //!
 //! The cubes are rebuilt when the camera's time, its views or their weights change, once all
-//! the views' volume blocks of the window are resident in the stream cache (the blocks are
-//! read again from the pack: the resident [`crate::streaming::BinnedVolume`]s are sorted by
-//! direction, and the baked connectivity names the samples in stored order). This runs on
-//! the main thread (parallel over texels), so a playing volume-mode camera pays it every
-//! frame. A view without volume samples near t is left out (the CPU warps its range images
-//! instead).
+//! the views' volume blocks of the window are resident in the stream cache. The rebuild is a
+//! task on the I/O task pool (the blocks are read again from the pack: the resident
+//! [`crate::streaming::BinnedVolume`]s are sorted by direction, and the baked connectivity
+//! names the samples in stored order), never on the main thread; until it finishes the frame
+//! shows the previous cubes, and one rebuild runs at a time, so a playing camera's cubes lag
+//! its time by the rebuild's duration. A view without volume samples near t is left out (the
+//! CPU warps its range images instead).
+
+use std::sync::Arc;
 
 use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
-use plenoptic_pack::{ChunkKind, cube::rgb9e5_pack};
+use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
+use plenoptic_pack::{ChunkKind, PackReader, cube::rgb9e5_pack};
 use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
 
 use super::ResolvedBackend;
@@ -40,7 +44,7 @@ use crate::{Backend, PlenopticSettings};
 pub const VOLUME_FACE_SIZE: u32 = 48;
 
 /// The volume-mode cubes of the first volume-mode camera, six layers per view.
-#[derive(Resource, Debug, Clone, Default)]
+#[derive(Resource, Default)]
 pub struct VolumeCubes {
     /// The texture (`Rgba32Uint`, [`VOLUME_FACE_SIZE`]² per layer), once built.
     pub image: Option<Handle<Image>>,
@@ -48,6 +52,19 @@ pub struct VolumeCubes {
     pub views: Vec<(usize, f32)>,
     /// What they were built for: pack, time bits, (view, weight bits) of the weighted views.
     built_for: Option<BuiltFor>,
+    /// The rebuild in flight: what for, and its texels and views.
+    task: Option<(BuiltFor, Task<(Vec<u8>, Vec<(usize, f32)>)>)>,
+}
+
+impl std::fmt::Debug for VolumeCubes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VolumeCubes")
+            .field("image", &self.image)
+            .field("views", &self.views)
+            .field("built_for", &self.built_for)
+            .field("rebuilding", &self.task.is_some())
+            .finish()
+    }
 }
 
 /// Pack, time bits, and (view, weight bits) of the weighted views.
@@ -55,8 +72,7 @@ type BuiltFor = (AssetId<RadiancePack>, u32, Vec<(usize, u32)>);
 
 /// The cube of base view `view` at time `t`, as `plenoptic_recon`'s volume mode builds it;
 /// `None` when the view has no usable volume near t.
-pub fn view_cube(pack: &RadiancePack, view: usize, t: f32) -> Option<Cubes> {
-    let r = &pack.reader;
+pub fn view_cube(r: &PackReader, view: usize, t: f32) -> Option<Cubes> {
     let m = r.manifest();
     let v = view as u32;
     // The baked complex of the block of bucket_of(t), if any.
@@ -120,6 +136,15 @@ pub(super) fn prepare_cubes(
     if backend.0 != Backend::Gpu {
         return;
     }
+    // A rebuild in flight: apply it when done; start no other meanwhile.
+    if let Some((_, task)) = cubes.task.as_mut() {
+        let Some(result) = check_ready(task) else {
+            return;
+        };
+        if let Some((key, _)) = cubes.task.take() {
+            apply(&mut cubes, &mut images, key, result);
+        }
+    }
     let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.mode == ReconMode::Volume) else {
         return;
     };
@@ -150,14 +175,30 @@ pub(super) fn prepare_cubes(
     if !resident {
         return;
     }
-    let mut data = Vec::new();
-    let mut built = Vec::new();
-    for &(v, w) in &views {
-        if let Some(c) = view_cube(pack, v, t) {
-            data.extend_from_slice(&texels(&c));
-            built.push((v, w));
-        }
-    }
+    let reader: Arc<PackReader> = pack.reader.clone();
+    cubes.task = Some((
+        key,
+        IoTaskPool::get().spawn(async move {
+            let mut data = Vec::new();
+            let mut built = Vec::new();
+            for (v, w) in views {
+                if let Some(c) = view_cube(&reader, v, t) {
+                    data.extend_from_slice(&texels(&c));
+                    built.push((v, w));
+                }
+            }
+            (data, built)
+        }),
+    ));
+}
+
+/// Applies a finished rebuild: the views, and the texture (re)created.
+fn apply(
+    cubes: &mut VolumeCubes,
+    images: &mut Assets<Image>,
+    key: BuiltFor,
+    (data, built): (Vec<u8>, Vec<(usize, f32)>),
+) {
     cubes.built_for = Some(key);
     cubes.views = built;
     if cubes.views.is_empty() {
