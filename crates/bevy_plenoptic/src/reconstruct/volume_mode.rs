@@ -53,7 +53,7 @@ pub struct VolumeCubes {
     /// What they were built for: pack, time bits, (view, weight bits) of the weighted views.
     built_for: Option<BuiltFor>,
     /// The rebuild in flight: what for, and its texels and views.
-    task: Option<(BuiltFor, Task<(Vec<u8>, Vec<(usize, f32)>)>)>,
+    task: Option<(BuiltFor, Task<Rebuilt>)>,
 }
 
 impl std::fmt::Debug for VolumeCubes {
@@ -66,6 +66,9 @@ impl std::fmt::Debug for VolumeCubes {
             .finish()
     }
 }
+
+/// A finished rebuild: the texels of the cubes, and (view, weight) of each.
+type Rebuilt = (Vec<u8>, Vec<(usize, f32)>);
 
 /// Pack, time bits, and (view, weight bits) of the weighted views.
 type BuiltFor = (AssetId<RadiancePack>, u32, Vec<(usize, u32)>);
@@ -197,7 +200,7 @@ fn apply(
     cubes: &mut VolumeCubes,
     images: &mut Assets<Image>,
     key: BuiltFor,
-    (data, built): (Vec<u8>, Vec<(usize, f32)>),
+    (data, built): Rebuilt,
 ) {
     cubes.built_for = Some(key);
     cubes.views = built;
