@@ -123,8 +123,11 @@ pub enum Backend {
     /// covered pixels × base views × 2 keys, more where the volume fallback or the hole fill
     /// runs). Image mode runs as compute passes ([`reconstruct::image`]: splats of the
     /// weighted views' cube texels, view blend, background fill) shown through the proxies
-    /// and the background (the first image-mode camera only). Cameras in volume mode are
-    /// shown geometry-assisted, with a warning.
+    /// and the background. Volume mode ([`reconstruct::volume_mode`]) interpolates each
+    /// weighted view's cube at t from its resident temporal-volume blocks on the CPU (main
+    /// thread, when the time or views change) and warps those cubes with the same passes.
+    /// Only the first camera in image or volume mode is reconstructed that way; until its
+    /// volume cubes exist a volume-mode camera is shown geometry-assisted.
     Gpu,
     /// `plenoptic_recon`'s CPU reconstructor on a worker thread, its frame shown through the
     /// proxy meshes (screen-space texture; depth still from the rasterised proxies). Far

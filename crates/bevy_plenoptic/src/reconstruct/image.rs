@@ -18,7 +18,8 @@
 //!
 //! The frame is written to [`ImageFrame`]'s `Rgba32Float` storage texture, which the proxy
 //! materials and the background show in screen space while the camera is in image mode.
-//! Only the first image-mode camera of the app is reconstructed.
+//! Only the first camera of the app in image or volume mode is reconstructed (volume mode:
+//! [`super::volume_mode`] supplies each view's cube at t as its single key).
 
 use std::borrow::Cow;
 
@@ -43,6 +44,7 @@ use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use plenoptic_recon::temporal::bezier_weights;
 
 use super::background::PlenopticBackgroundMaterial;
+use super::volume_mode::{VOLUME_FACE_SIZE, VolumeCubes};
 use super::{KeyTextures, ResolvedBackend};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode};
@@ -141,7 +143,8 @@ pub(super) fn build(app: &mut App) {
     }
 }
 
-/// Fills [`ImageJob`] for the first camera in image mode and resizes [`ImageFrame`] to it.
+/// Fills [`ImageJob`] for the first camera in image or volume mode (warping the
+/// [`VolumeCubes`] in volume mode) and resizes [`ImageFrame`] to it.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 pub(super) fn prepare_job(
     backend: Res<ResolvedBackend>,
@@ -149,6 +152,7 @@ pub(super) fn prepare_job(
     cache: Res<StreamCache>,
     settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
+    volume: Res<VolumeCubes>,
     frame: Res<ImageFrame>,
     cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
     mut images: ResMut<Assets<Image>>,
@@ -159,10 +163,12 @@ pub(super) fn prepare_job(
         if backend.0 != Backend::Gpu {
             return None;
         }
-        let (cam, camera, projection, transform) =
-            cameras.iter().find(|(c, ..)| c.mode == ReconMode::Image)?;
+        let (cam, camera, projection, transform) = cameras
+            .iter()
+            .find(|(c, ..)| matches!(c.mode, ReconMode::Image | ReconMode::Volume))?;
         let id = cam.pack.id();
         let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
+        let volume_mode = cam.mode == ReconMode::Volume;
         let size = camera.physical_viewport_size()?;
         let vfov = match projection {
             Projection::Perspective(p) => p.fov,
@@ -181,6 +187,24 @@ pub(super) fn prepare_job(
             misc: UVec4::new(FILL_PASSES, 0, 0, 0),
             ..default()
         };
+        if volume_mode {
+            // Each view's cube at t is its single key.
+            let image = volume.image.clone()?;
+            params.size.z = VOLUME_FACE_SIZE;
+            for (n, &(v, w)) in volume.views.iter().enumerate() {
+                let layer = 6 * n as u32;
+                params.views[n] = pack.reader.manifest().base_views[v].position.extend(w);
+                params.nearest[n] = UVec4::new(layer, 1, 0, 0);
+                params.layers[n][0] = layer;
+                params.key_weights[n][0] = 1.0;
+            }
+            params.size.w = volume.views.len() as u32;
+            return Some(ImageWork {
+                cubes: image,
+                output: frame.0.clone(),
+                params,
+            });
+        }
         let m = pack.reader.manifest();
         let t = cam.time;
         let views = view_weights(m, &pack.usable_views, position, settings.max_views);

@@ -1,5 +1,7 @@
 //! GPU geometry-assisted reconstruction (thesis §8.2.3); image mode is in [`image`] (compute
-//! passes whose frame the proxy materials and the background show).
+//! passes whose frame the proxy materials and the background show), and volume mode in
+//! [`volume_mode`] (cubes at t interpolated on the CPU from the temporal volumes, warped by
+//! the image-mode passes).
 //!
 //! Every proxy mesh is drawn with a [`PlenopticMaterial`] whose fragment shader
 //! (`geometry.wgsl`, beside this file) does the lookups of `plenoptic_recon`'s geometry mode:
@@ -36,6 +38,7 @@ pub mod cpu;
 pub mod image;
 pub mod upload;
 pub mod volume;
+pub mod volume_mode;
 
 use std::collections::{HashMap, HashSet};
 
@@ -74,6 +77,7 @@ impl Plugin for PlenopticReconstructPlugin {
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
             .init_resource::<volume::VolumeBuffers>()
+            .init_resource::<volume_mode::VolumeCubes>()
             .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
@@ -82,6 +86,7 @@ impl Plugin for PlenopticReconstructPlugin {
                     volume::upload_volumes,
                     attach_materials,
                     background::spawn_backgrounds,
+                    volume_mode::prepare_cubes,
                     image::prepare_job,
                     update_materials,
                 )
@@ -151,7 +156,7 @@ pub struct PlenopticMaterial {
     #[storage(3, read_only)]
     pub volume_bins: Handle<ShaderBuffer>,
     /// The image-mode frame ([`image::ImageFrame`]), shown instead of the lookups while the
-    /// camera is in [`ReconMode::Image`].
+    /// camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
 }
@@ -171,7 +176,7 @@ pub struct ReconParams {
     pub tuning: Vec4,
     /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
     /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
-    /// image-mode frame instead.
+    /// image-mode passes' frame instead (image and volume modes).
     pub fill: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
@@ -323,6 +328,11 @@ fn frame_lookups(
     out
 }
 
+/// Whether `mode` shows the frame of the image-mode passes (image and volume modes).
+fn warped(mode: ReconMode) -> bool {
+    matches!(mode, ReconMode::Image | ReconMode::Volume)
+}
+
 /// Fills every proxy material's lookups for its pack's (first) camera, and every
 /// background's environment key.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
@@ -369,13 +379,7 @@ fn update_materials(
         let Some(f) = frame(id, cam, transform.translation()) else {
             continue;
         };
-        if cam.mode == ReconMode::Volume {
-            warn_once!(
-                "plenoptic: the GPU backend reconstructs in geometry-assisted and image modes \
-                 only; volume mode needs Backend::Cpu"
-            );
-        }
-        let image_mode = cam.mode == ReconMode::Image && job.0.is_some();
+        let image_mode = warped(cam.mode) && job.0.is_some();
         let m = pack.reader.manifest();
         let proxy = pack.proxy(of.id);
         let inv_now = proxy.map_or(Mat4::IDENTITY, |p| {
@@ -420,7 +424,7 @@ fn update_materials(
         let face = keys.0.get(&id).map_or(1, |t| t.face);
         let layer = frame(id, cam, transform.translation())
             .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
-        let image_mode = cam.mode == ReconMode::Image && job.0.is_some();
+        let image_mode = warped(cam.mode) && job.0.is_some();
         background::set_background(&mut background_materials, handle, layer, face, image_mode);
     }
 }

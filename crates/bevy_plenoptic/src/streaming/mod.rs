@@ -16,7 +16,7 @@
 //! reconstructed from what is resident (a *stall* is counted).
 //!
 //! The temporal-volume blocks of the needed base views around t (the GPU reconstruction's
-//! fallback) are streamed the same way, inside the same budget and LRU, when the pack has them:
+//! fallback, and the source of the GPU volume mode's cubes) are streamed the same way, inside the same budget and LRU, when the pack has them:
 //! decoded and binned by direction ([`BinnedVolume`]) off the main thread.
 //!
 //! Each resident key sits in a fixed-size slot (`slot` < budget / key bytes): the index of its

@@ -1,0 +1,229 @@
+//! GPU volume mode ([`ReconMode::Volume`]): `plenoptic_recon`'s volume mode with the warping
+//! on the GPU.
+//!
+//! Per weighted base view (the view-space weights of the nearest
+//! [`PlenopticSettings::max_views`] views, at most [`MAX_IMAGE_VIEWS`]), a cube of face size
+//! [`VOLUME_FACE_SIZE`] at the camera's time t is interpolated on the CPU from the view's
+//! temporal-volume samples, exactly as `plenoptic_recon` does: sliced from the baked
+//! (x, y, t) complex of the block of `bucket_of(t)` when the pack has its connectivity
+//! ([`plenoptic_recon::volume::slice_to_cube`]), otherwise triangulated per face from the
+//! samples within `t ± tε` with tent weights ([`plenoptic_recon::volume::samples_to_cube`],
+//! at least three samples). The cubes (radiance as RGB9E5, distance, object id) are written
+//! into one `Rgba32Uint` 2D-array texture, six layers per view ([`VolumeCubes`]), and the
+//! image-mode passes ([`super::image`]) warp them as each view's single key (weight 1), blend
+//! the views and fill the background.
+//!
+//! The cubes are rebuilt when the camera's time, its views or their weights change, once all
+//! the views' volume blocks of the window are resident in the stream cache. The rebuild is a
+//! task on the I/O task pool (the blocks are read again from the pack: the resident
+//! [`crate::streaming::BinnedVolume`]s are sorted by direction, and the baked connectivity
+//! names the samples in stored order), never on the main thread; until it finishes the frame
+//! shows the previous cubes, and one rebuild runs at a time, so a playing camera's cubes lag
+//! its time by the rebuild's duration. A view without volume samples near t is left out (the
+//! CPU warps its range images instead).
+
+use std::sync::Arc;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
+use plenoptic_pack::{ChunkKind, PackReader, cube::rgb9e5_pack};
+use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
+
+use super::ResolvedBackend;
+use super::image::MAX_IMAGE_VIEWS;
+use crate::asset::RadiancePack;
+use crate::camera::{PlenopticCamera, ReconMode};
+use crate::streaming::StreamCache;
+use crate::streaming::schedule::{time_epsilon, view_weights, volume_buckets};
+use crate::{Backend, PlenopticSettings};
+
+/// Face size of the cubes interpolated from the temporal volumes (`plenoptic_recon`'s
+/// default `volume_face_size`).
+pub const VOLUME_FACE_SIZE: u32 = 48;
+
+/// The volume-mode cubes of the first volume-mode camera, six layers per view.
+#[derive(Resource, Default)]
+pub struct VolumeCubes {
+    /// The texture (`Rgba32Uint`, [`VOLUME_FACE_SIZE`]² per layer), once built.
+    pub image: Option<Handle<Image>>,
+    /// (base view, normalised view weight) of each view in the texture, in layer order.
+    pub views: Vec<(usize, f32)>,
+    /// What they were built for: pack, time bits, (view, weight bits) of the weighted views.
+    built_for: Option<BuiltFor>,
+    /// The rebuild in flight: what for, and its texels and views.
+    task: Option<(BuiltFor, Task<Rebuilt>)>,
+}
+
+impl std::fmt::Debug for VolumeCubes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VolumeCubes")
+            .field("image", &self.image)
+            .field("views", &self.views)
+            .field("built_for", &self.built_for)
+            .field("rebuilding", &self.task.is_some())
+            .finish()
+    }
+}
+
+/// A finished rebuild: the texels of the cubes, and (view, weight) of each.
+type Rebuilt = (Vec<u8>, Vec<(usize, f32)>);
+
+/// Pack, time bits, and (view, weight bits) of the weighted views.
+type BuiltFor = (AssetId<RadiancePack>, u32, Vec<(usize, u32)>);
+
+/// The cube of base view `view` at time `t`, as `plenoptic_recon`'s volume mode builds it;
+/// `None` when the view has no usable volume near t.
+pub fn view_cube(r: &PackReader, view: usize, t: f32) -> Option<Cubes> {
+    let m = r.manifest();
+    let v = view as u32;
+    // The baked complex of the block of bucket_of(t), if any.
+    let bucket = m.bucket_of(t);
+    if r.find(ChunkKind::VolumeConnectivity, v, bucket).is_some()
+        && r.find(ChunkKind::VolumeBlock, v, bucket).is_some()
+        && let (Ok(block), Ok(tets)) = (r.volume_block(v, bucket), r.connectivity(v, bucket))
+        && let Ok(Some(c)) = slice_to_cube(&block, &tets, t, VOLUME_FACE_SIZE)
+    {
+        return Some(c);
+    }
+    // The samples within t ± tε, tent-weighted.
+    let eps = time_epsilon(m);
+    let mut samples = Vec::new();
+    for b in volume_buckets(m, t) {
+        if r.find(ChunkKind::VolumeBlock, v, b).is_none() {
+            continue;
+        }
+        let Ok(block) = r.volume_block(v, b) else {
+            continue;
+        };
+        for s in &block.samples {
+            let dt = (s.t - t).abs();
+            if dt <= eps {
+                samples.push((*s, 1.0 - dt / eps));
+            }
+        }
+    }
+    (samples.len() >= 3).then(|| samples_to_cube(&samples, VOLUME_FACE_SIZE))
+}
+
+/// A cube's texels in the image-mode passes' key layout: (radiance RGB9E5, distance f32 bits,
+/// object id, 0).
+fn texels((radiance, distance, ids): &Cubes) -> Vec<u8> {
+    let mut out = Vec::with_capacity(radiance.texels.len() * 16);
+    for ((r, d), o) in radiance
+        .texels
+        .iter()
+        .zip(&distance.texels)
+        .zip(&ids.texels)
+    {
+        out.extend_from_slice(&rgb9e5_pack(*r).to_le_bytes());
+        out.extend_from_slice(&d.to_bits().to_le_bytes());
+        out.extend_from_slice(&o.to_le_bytes());
+        out.extend_from_slice(&0u32.to_le_bytes());
+    }
+    out
+}
+
+/// Rebuilds [`VolumeCubes`] for the first volume-mode camera on the GPU backend when its time
+/// or views change and their volume blocks are resident.
+pub(super) fn prepare_cubes(
+    backend: Res<ResolvedBackend>,
+    cache: Res<StreamCache>,
+    settings: Res<PlenopticSettings>,
+    packs: Res<Assets<RadiancePack>>,
+    cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
+    mut images: ResMut<Assets<Image>>,
+    mut cubes: ResMut<VolumeCubes>,
+) {
+    if backend.0 != Backend::Gpu {
+        return;
+    }
+    // A rebuild in flight: apply it when done; start no other meanwhile.
+    if let Some((_, task)) = cubes.task.as_mut() {
+        let Some(result) = check_ready(task) else {
+            return;
+        };
+        if let Some((key, _)) = cubes.task.take() {
+            apply(&mut cubes, &mut images, key, result);
+        }
+    }
+    let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.mode == ReconMode::Volume) else {
+        return;
+    };
+    let id = cam.pack.id();
+    let Some(pack) = packs.get(id) else {
+        return;
+    };
+    let m = pack.reader.manifest();
+    let (t, position) = (cam.time, transform.translation());
+    let mut views = view_weights(m, &pack.usable_views, position, settings.max_views);
+    views.truncate(MAX_IMAGE_VIEWS);
+    let key = (
+        id,
+        t.to_bits(),
+        views.iter().map(|&(v, w)| (v, w.to_bits())).collect(),
+    );
+    if cubes.built_for.as_ref() == Some(&key) {
+        return;
+    }
+    let resident = views.iter().all(|&(v, _)| {
+        volume_buckets(m, t).all(|b| {
+            pack.reader
+                .find(ChunkKind::VolumeBlock, v as u32, b)
+                .is_none()
+                || cache.volume(id, (v as u32, b)).is_some()
+        })
+    });
+    if !resident {
+        return;
+    }
+    let reader: Arc<PackReader> = pack.reader.clone();
+    cubes.task = Some((
+        key,
+        IoTaskPool::get().spawn(async move {
+            let mut data = Vec::new();
+            let mut built = Vec::new();
+            for (v, w) in views {
+                if let Some(c) = view_cube(&reader, v, t) {
+                    data.extend_from_slice(&texels(&c));
+                    built.push((v, w));
+                }
+            }
+            (data, built)
+        }),
+    ));
+}
+
+/// Applies a finished rebuild: the views, and the texture (re)created.
+fn apply(
+    cubes: &mut VolumeCubes,
+    images: &mut Assets<Image>,
+    key: BuiltFor,
+    (data, built): Rebuilt,
+) {
+    cubes.built_for = Some(key);
+    cubes.views = built;
+    if cubes.views.is_empty() {
+        cubes.image = None;
+        return;
+    }
+    let image = Image::new(
+        Extent3d {
+            width: VOLUME_FACE_SIZE,
+            height: VOLUME_FACE_SIZE,
+            depth_or_array_layers: 6 * cubes.views.len() as u32,
+        },
+        TextureDimension::D2,
+        data,
+        TextureFormat::Rgba32Uint,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    if let Some(h) = &cubes.image
+        && images.get(h).is_some()
+    {
+        images.insert(h, image).ok();
+    } else {
+        cubes.image = Some(images.add(image));
+    }
+}
