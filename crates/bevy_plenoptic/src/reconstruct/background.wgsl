@@ -4,6 +4,8 @@
 
 #import bevy_pbr::mesh_view_bindings::view
 
+#import plenoptic::cube::{rgb9e5_decode, cube_texel}
+
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 // x: first layer, y: face size, z: 1 if a key is shown, w: 1 to show the image-mode frame.
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> key: vec4<f32>;
@@ -21,36 +23,6 @@ fn vertex(@location(0) corner: vec3<f32>) -> Out {
     var out: Out;
     out.position = vec4<f32>(corner.xy, 0.0, 1.0);
     return out;
-}
-
-fn rgb9e5_decode(v: u32) -> vec3<f32> {
-    let e = f32(v >> 27u) - 15.0 - 9.0;
-    let s = exp2(e);
-    return vec3<f32>(f32(v & 0x1ffu), f32((v >> 9u) & 0x1ffu), f32((v >> 18u) & 0x1ffu)) * s;
-}
-
-// plenoptic_pack::cube::direction_to_face_uv followed by direction_to_texel.
-fn cube_texel(dir: vec3<f32>, n: u32) -> vec3<u32> {
-    let a = abs(dir);
-    var face = 0u;
-    var sc = 0.0;
-    var tc = 0.0;
-    var ma = 0.0;
-    if a.x >= a.y && a.x >= a.z {
-        if dir.x >= 0.0 { face = 0u; sc = -dir.z; tc = -dir.y; } else { face = 1u; sc = dir.z; tc = -dir.y; }
-        ma = a.x;
-    } else if a.y >= a.z {
-        if dir.y >= 0.0 { face = 2u; sc = dir.x; tc = dir.z; } else { face = 3u; sc = dir.x; tc = -dir.z; }
-        ma = a.y;
-    } else {
-        if dir.z >= 0.0 { face = 4u; sc = dir.x; tc = -dir.y; } else { face = 5u; sc = -dir.x; tc = -dir.y; }
-        ma = a.z;
-    }
-    let u = 0.5 * (sc / ma + 1.0);
-    let v = 0.5 * (tc / ma + 1.0);
-    let i = min(u32(max(u, 0.0) * f32(n)), n - 1u);
-    let j = min(u32(max(v, 0.0) * f32(n)), n - 1u);
-    return vec3<u32>(i, j, face);
 }
 
 @fragment

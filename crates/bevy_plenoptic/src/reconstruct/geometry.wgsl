@@ -6,6 +6,8 @@
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
 
+#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction}
+
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
 // Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
@@ -38,36 +40,6 @@ struct ReconParams {
 // The image-mode frame (image.wgsl), shown when params.fill.z is 1.
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
 
-fn rgb9e5_decode(v: u32) -> vec3<f32> {
-    let e = f32(v >> 27u) - 15.0 - 9.0;
-    let s = exp2(e);
-    return vec3<f32>(f32(v & 0x1ffu), f32((v >> 9u) & 0x1ffu), f32((v >> 18u) & 0x1ffu)) * s;
-}
-
-// plenoptic_pack::cube::direction_to_face_uv followed by direction_to_texel.
-fn cube_texel(dir: vec3<f32>, n: u32) -> vec3<u32> {
-    let a = abs(dir);
-    var face = 0u;
-    var sc = 0.0;
-    var tc = 0.0;
-    var ma = 0.0;
-    if a.x >= a.y && a.x >= a.z {
-        if dir.x >= 0.0 { face = 0u; sc = -dir.z; tc = -dir.y; } else { face = 1u; sc = dir.z; tc = -dir.y; }
-        ma = a.x;
-    } else if a.y >= a.z {
-        if dir.y >= 0.0 { face = 2u; sc = dir.x; tc = dir.z; } else { face = 3u; sc = dir.x; tc = -dir.z; }
-        ma = a.y;
-    } else {
-        if dir.z >= 0.0 { face = 4u; sc = dir.x; tc = -dir.y; } else { face = 5u; sc = -dir.x; tc = -dir.y; }
-        ma = a.z;
-    }
-    let u = 0.5 * (sc / ma + 1.0);
-    let v = 0.5 * (tc / ma + 1.0);
-    let i = min(u32(max(u, 0.0) * f32(n)), n - 1u);
-    let j = min(u32(max(v, 0.0) * f32(n)), n - 1u);
-    return vec3<u32>(i, j, face);
-}
-
 // plenoptic_pack::cube::oct_decode.
 fn oct_decode(e: vec2<f32>) -> vec3<f32> {
     var v = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
@@ -78,22 +50,6 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
         v.y = y;
     }
     return normalize(v);
-}
-
-// plenoptic_pack::cube::face_uv_to_direction at the texel's centre.
-fn texel_direction(t: vec3<u32>, n: u32) -> vec3<f32> {
-    let sc = 2.0 * ((f32(t.x) + 0.5) / f32(n)) - 1.0;
-    let tc = 2.0 * ((f32(t.y) + 0.5) / f32(n)) - 1.0;
-    var d = vec3<f32>(0.0);
-    switch t.z {
-        case 0u: { d = vec3<f32>(1.0, -tc, -sc); }
-        case 1u: { d = vec3<f32>(-1.0, -tc, sc); }
-        case 2u: { d = vec3<f32>(sc, 1.0, tc); }
-        case 3u: { d = vec3<f32>(sc, -1.0, -tc); }
-        case 4u: { d = vec3<f32>(sc, -tc, 1.0); }
-        default: { d = vec3<f32>(-sc, -tc, -1.0); }
-    }
-    return normalize(d);
 }
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).

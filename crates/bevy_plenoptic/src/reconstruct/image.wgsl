@@ -3,6 +3,8 @@
 // pixel within a relative depth tolerance of the nearest, and holes are filled from the
 // farthest covered neighbour, pass after pass.
 
+#import plenoptic::cube::{rgb9e5_decode, texel_direction}
+
 const MAX_VIEWS: u32 = 8u;
 const EMPTY: u32 = 0xffffffffu;
 // plenoptic_recon::warp::MAX_SPLAT_PX and SAME_SURFACE.
@@ -43,28 +45,6 @@ struct ImageParams {
 @group(0) @binding(4) var<storage, read_write> frame_in: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> frame_out: array<vec4<f32>>;
 @group(0) @binding(6) var output: texture_storage_2d<rgba32float, write>;
-
-fn rgb9e5_decode(v: u32) -> vec3<f32> {
-    let e = f32(v >> 27u) - 15.0 - 9.0;
-    let s = exp2(e);
-    return vec3<f32>(f32(v & 0x1ffu), f32((v >> 9u) & 0x1ffu), f32((v >> 18u) & 0x1ffu)) * s;
-}
-
-// plenoptic_pack::cube::face_uv_to_direction at the texel's centre.
-fn texel_direction(t: vec3<u32>, n: u32) -> vec3<f32> {
-    let sc = 2.0 * ((f32(t.x) + 0.5) / f32(n)) - 1.0;
-    let tc = 2.0 * ((f32(t.y) + 0.5) / f32(n)) - 1.0;
-    var d = vec3<f32>(0.0);
-    switch t.z {
-        case 0u: { d = vec3<f32>(1.0, -tc, -sc); }
-        case 1u: { d = vec3<f32>(-1.0, -tc, sc); }
-        case 2u: { d = vec3<f32>(sc, 1.0, tc); }
-        case 3u: { d = vec3<f32>(sc, -1.0, -tc); }
-        case 4u: { d = vec3<f32>(sc, -tc, 1.0); }
-        default: { d = vec3<f32>(-sc, -tc, -1.0); }
-    }
-    return normalize(d);
-}
 
 fn pixel_count() -> u32 {
     return params.size.x * params.size.y;

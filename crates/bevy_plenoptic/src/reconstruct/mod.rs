@@ -69,6 +69,8 @@ pub struct PlenopticReconstructPlugin;
 
 impl Plugin for PlenopticReconstructPlugin {
     fn build(&self, app: &mut App) {
+        // Cube helpers the reconstruction shaders import (`plenoptic::cube`).
+        bevy::shader::load_shader_library!(app, "cube.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
         background::build(app);
