@@ -16,17 +16,20 @@
 //!   [`PlenopticSettings::memory_budget_bytes`] with LRU eviction; reads and decodes run on
 //!   the I/O task pool; Bevy diagnostics report resident bytes, hits, misses, stalls
 //!   and decode time.
-//! - [`reconstruct`]: the geometry-assisted reconstruction in WGSL — a material on the proxy
-//!   meshes that does `plenoptic_recon`'s geometry-mode lookups per fragment and writes
-//!   linear radiance, unlit, into the camera's HDR target; [`cpu`] is the fallback backend
-//!   ([`Backend`]) that runs `plenoptic_recon` itself on a worker thread, and the reference
-//!   the GPU path is tested against.
+//! - [`reconstruct`]: the reconstruction in WGSL. Geometry-assisted: a material on the proxy
+//!   meshes that does `plenoptic_recon`'s geometry-mode lookups per fragment (with its
+//!   volume, hole-fill and background fallbacks) and writes linear radiance, unlit, into the
+//!   camera's HDR target. Image mode: compute passes (splats, key and view blends, background
+//!   fill) whose frame the proxies show; volume mode: the same passes over cubes interpolated
+//!   from the temporal volumes. [`cpu`] is the fallback backend ([`Backend`]) that runs
+//!   `plenoptic_recon` itself on a worker thread, and the reference the GPU path is tested
+//!   against.
 //!
 //! Layout: like bevy_solari, one folder per feature with its plugin and documented settings in
-//! `mod.rs` and shaders beside the code. There are no `extract.rs`/`prepare.rs`/`node.rs`: the
-//! reconstruction rides on Bevy's `Material` pipeline (the material's bind group is the
-//! "prepare", the main opaque pass the "node"), which is also what gives correct depth
-//! compositing with ordinary meshes for free.
+//! `mod.rs` and shaders beside the code. The geometry-assisted mode rides on Bevy's `Material`
+//! pipeline (the material's bind group is the "prepare", the main opaque pass the "node"),
+//! which is also what gives correct depth compositing with ordinary meshes for free; image
+//! and volume modes add compute passes to the render graph (`reconstruct/image.rs`).
 //!
 //! Errors never panic the app: a pack that cannot be opened is an asset load failure whose
 //! message names the section or chunk; a chunk that fails its checksum while streaming is a
