@@ -294,14 +294,7 @@ fn plugin_and_cpu_frames_from(
             ..PlenopticCamera::new(handle)
         },
     ));
-    let decode = |d: &[u8]| -> Vec<Vec3> {
-        d.chunks_exact(8)
-            .map(|p| {
-                let h = |i: usize| half::f16::from_le_bytes([p[i], p[i + 1]]).to_f32();
-                Vec3::new(h(0), h(2), h(4))
-            })
-            .collect()
-    };
+    let decode = common::rgba16f_pixels;
     let cam_entity = {
         let mut q = app
             .world_mut()

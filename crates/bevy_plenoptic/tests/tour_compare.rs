@@ -89,14 +89,7 @@ fn tour_gpu_against_cpu() {
             }
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        let decode = |d: &[u8]| -> Vec<Vec3> {
-            d.chunks_exact(8)
-                .map(|p| {
-                    let h = |i: usize| half::f16::from_le_bytes([p[i], p[i + 1]]).to_f32();
-                    Vec3::new(h(0), h(2), h(4))
-                })
-                .collect()
-        };
+        let decode = common::rgba16f_pixels;
         let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
         let data = common::render_until(&mut app, image, 600, |d| {
             let stable = prev.borrow().as_deref() == Some(d);

@@ -122,3 +122,13 @@ pub fn pixel(data: &[u8], x: u32, y: u32) -> [u8; 4] {
     let i = ((y * WIDTH + x) * 4) as usize;
     [data[i], data[i + 1], data[i + 2], data[i + 3]]
 }
+
+/// Linear RGB of each pixel of an `Rgba16Float` read-back.
+pub fn rgba16f_pixels(d: &[u8]) -> Vec<bevy::math::Vec3> {
+    d.chunks_exact(8)
+        .map(|p| {
+            let h = |i: usize| half::f16::from_le_bytes([p[i], p[i + 1]]).to_f32();
+            bevy::math::Vec3::new(h(0), h(2), h(4))
+        })
+        .collect()
+}
