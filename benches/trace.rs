@@ -175,9 +175,8 @@ fn renderers(c: &mut Criterion) {
         &AmbientSettings {
             quality: 0.3,
             rays_per_point: 64,
-            passes: 3,
             seed: 2,
-            extrapolate: true,
+            ..AmbientSettings::low()
         },
     )
     .unwrap();
@@ -215,9 +214,8 @@ fn renderers(c: &mut Criterion) {
                 &AmbientSettings {
                     quality: 0.3,
                     rays_per_point: 64,
-                    passes: 3,
                     seed: 2,
-                    extrapolate: true,
+                    ..AmbientSettings::low()
                 },
             )
             .unwrap()

@@ -33,9 +33,8 @@ fn renders_are_bit_identical_across_runs_and_thread_counts() {
             &AmbientSettings {
                 quality: 0.1,
                 rays_per_point: 8,
-                passes: 2,
                 seed: 4,
-                extrapolate: true,
+                ..AmbientSettings::low()
             },
         )
         .unwrap();
@@ -86,9 +85,9 @@ fn ambient_fields_interpolate_in_time() {
     let settings = AmbientSettings {
         quality: 0.1,
         rays_per_point: 16,
-        passes: 2,
         seed: 4,
-        extrapolate: false,
+        max_bounces: 2,
+        ..AmbientSettings::low()
     };
     let layout = std::sync::Arc::new(
         plenoptic_trace::multistage::FieldLayout::new(&scene, settings.quality).unwrap(),

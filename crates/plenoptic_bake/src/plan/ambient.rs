@@ -18,15 +18,15 @@ use plenoptic_trace::{AmbientField, AmbientSettings, SceneAccel};
 use super::time::{key_time, subdivide};
 use crate::error::Result;
 
-/// Ambient settings for a recipe's quality: gather rays = `ambient_samples`, two bounces,
-/// simplification by q (at least 0.05).
+/// Ambient settings for a recipe's quality: gather rays = `ambient_samples`, simplification
+/// by q (at least 0.05), bounces iterated until the rest of the series is under 0.5 % (at
+/// most 64), gather rays following up to 8 delta bounces through glass and mirrors.
 pub fn settings(quality: &Quality, seed: u64) -> AmbientSettings {
     AmbientSettings {
         quality: quality.q.clamp(0.05, 1.0),
         rays_per_point: quality.ambient_samples.max(1),
-        passes: 2,
         seed,
-        extrapolate: true,
+        ..AmbientSettings::low()
     }
 }
 

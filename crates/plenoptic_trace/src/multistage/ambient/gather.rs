@@ -1,0 +1,281 @@
+//! Gathering the ambient field: every gather ray is traced once, and the bounces of indirect
+//! light are iterated over the stored rays until they converge (thesis §5.3.3, the ambient
+//! computation, built as a fixed-point iteration E = D + K·E on the simplified scene).
+//!
+//! Per gather point i, `rays` cosine-distributed rays leave the surface. Each ray follows
+//! delta bounces (mirrors, clear glass, with their throughput) up to `max_delta_depth`, so
+//! light reaches a room through glazing as in the path tracer, and stops at the first surface
+//! with a non-delta lobe. There it contributes:
+//!
+//! - to D_i, the light that surface reflects of direct light (next-event estimation, one
+//!   shadow sample; emission is added only behind a delta bounce: emission seen directly is
+//!   direct light, which the renderer computes per sample);
+//! - to row i of the sparse matrix K, the surface's one-sample non-delta albedo times the
+//!   field's interpolation weights at the hit: its share of the hit's own indirect light.
+//!
+//! E_1 = D carries one bounce; E_(p+1) = D + K·E_p carries p + 1. The product reuses the same
+//! rays, so increments are noise-free and the iteration converges like the true bounce series
+//! (a furnace of albedo a: E_p = E·(1 + a + … + a^(p−1))). It stops when the remaining tail,
+//! estimated geometrically from the last two increments (r/(1−r)·|ΔE|), falls below
+//! `tolerance` of |E|, or after `max_bounces`.
+//!
+//! Points that lie inside a solid — more than half of their gather rays first meet a back
+//! face, as on a box face running under a wall — are **invalid**: their own gather is
+//! dropped, and at every iteration they take the mean of their valid (or already filled)
+//! neighbours on the same surface, so interpolation next to a wall does not pull in the
+//! darkness inside it.
+
+use glam::Vec3;
+use plenoptic_scene::ObjectId;
+use rayon::prelude::*;
+
+use super::AmbientSettings;
+use super::layout::FieldLayout;
+use crate::accel::{PlacedScene, Ray};
+use crate::image::luminance;
+use crate::light::estimate_direct;
+use crate::material::{Bsdf, Lobes, SurfaceProps};
+use crate::sampling::{Frame, Sampler, cosine_hemisphere};
+
+/// What one gather point's rays found.
+struct PointGather {
+    /// Light reflected of direct light towards the point: E_1.
+    direct: Vec3,
+    /// Row of K: (flat point index, RGB coefficient), sorted by index, merged.
+    row: Vec<(u32, Vec3)>,
+    /// Whether the point lies inside a solid.
+    invalid: bool,
+}
+
+/// The converged field in the layout's flat point order, and how it was reached.
+pub(super) struct Gathered {
+    pub(super) irradiance: Vec<Vec3>,
+    pub(super) bounces: u32,
+    pub(super) invalid: usize,
+}
+
+fn gather_point(
+    placed: &PlacedScene<'_>,
+    layout: &FieldLayout,
+    object: ObjectId,
+    point: usize,
+    settings: &AmbientSettings,
+    s: &mut Sampler,
+) -> PointGather {
+    let mut out = PointGather {
+        direct: Vec3::ZERO,
+        row: Vec::new(),
+        invalid: false,
+    };
+    let Some(inst) = placed.instance(object) else {
+        return out;
+    };
+    let gp = layout.objects[object as usize].points[point];
+    let p = inst.to_world.transform_point3(gp.position);
+    let n = (inst.normal_matrix * gp.normal).normalize_or(Vec3::Y);
+    let frame = Frame::from_normal(n);
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    let scene = placed.scene();
+    let rays = settings.rays_per_point.max(1);
+    let mut back_faces = 0u32;
+    for _ in 0..rays {
+        let d = frame.to_world(cosine_hemisphere(s.next_2d()));
+        let mut ray = Ray::new(p + n * eps, d);
+        let mut throughput = Vec3::ONE;
+        for depth in 0..=settings.max_delta_depth {
+            // A miss finds no light: the scene has no environment yet.
+            let Some(hit) = placed.intersect(&ray) else {
+                break;
+            };
+            if depth == 0 && !hit.front_face {
+                back_faces += 1;
+            }
+            let props = SurfaceProps::at(scene, &hit);
+            if depth > 0 {
+                out.direct += throughput * props.emission(&hit);
+            }
+            let bsdf = Bsdf::new(&props, &hit, -ray.direction);
+            if !bsdf.has(Lobes::All) {
+                break;
+            }
+            if !bsdf.is_delta(Lobes::All) {
+                out.direct +=
+                    throughput * estimate_direct(placed, &hit, &bsdf, Lobes::All, None, 1, s);
+            }
+            // One sample of the whole BSDF: a delta lobe carries the ray on; a non-delta lobe
+            // ends it, its weight being a one-sample estimate of the non-delta albedo that
+            // turns the hit's irradiance into radiance (as if it were diffuse).
+            let u_lobe = s.next_f32();
+            let Some(bs) = bsdf.sample(u_lobe, s.next_2d(), Lobes::All) else {
+                break;
+            };
+            if bs.delta {
+                throughput *= bs.weight;
+                if throughput.max_element() <= 0.0 {
+                    break;
+                }
+                ray = Ray::new(hit.offset_origin(bs.wi), bs.wi);
+                continue;
+            }
+            // E_i = π · mean(L) under cosine sampling, L = albedo · E_hit / π.
+            let c = throughput * bs.weight / rays as f32;
+            if let Some(w) = layout.weights(hit.object, hit.triangle, hit.barycentrics) {
+                let base = layout.offsets[hit.object as usize] as u32;
+                for (j, wt) in w {
+                    if wt > 0.0 {
+                        out.row.push((base + j, c * wt));
+                    }
+                }
+            }
+            break;
+        }
+    }
+    // E = ∫ L cos dω ≈ π · mean(L) under cosine-weighted sampling.
+    out.direct *= std::f32::consts::PI / rays as f32;
+    out.invalid = 2 * back_faces > rays;
+    if out.invalid {
+        out.direct = Vec3::ZERO;
+        out.row.clear();
+    }
+    out.row.sort_unstable_by_key(|e| e.0);
+    out.row.dedup_by(|later, kept| {
+        if later.0 == kept.0 {
+            kept.1 += later.1;
+            true
+        } else {
+            false
+        }
+    });
+    out.row.shrink_to_fit();
+    out
+}
+
+/// Fill rounds for invalid points: each round lists (point, the neighbours it averages), all
+/// of which are valid or filled in an earlier round (Jacobi order: deterministic).
+fn fill_rounds(layout: &FieldLayout, invalid: &[bool]) -> Vec<Vec<(u32, Vec<u32>)>> {
+    let mut known: Vec<bool> = invalid.iter().map(|&x| !x).collect();
+    let mut pending: Vec<u32> = (0..invalid.len() as u32)
+        .filter(|&i| invalid[i as usize])
+        .collect();
+    let locate = |flat: u32| {
+        let o = layout.offsets.partition_point(|&off| off <= flat as usize) - 1;
+        (o, flat as usize - layout.offsets[o])
+    };
+    let mut rounds = Vec::new();
+    while !pending.is_empty() {
+        let mut round = Vec::new();
+        let mut rest = Vec::new();
+        for &i in &pending {
+            let (o, local) = locate(i);
+            let base = layout.offsets[o] as u32;
+            let sources: Vec<u32> = layout.objects[o]
+                .neighbours(local)
+                .iter()
+                .map(|&n| base + n)
+                .filter(|&n| known[n as usize])
+                .collect();
+            if sources.is_empty() {
+                rest.push(i);
+            } else {
+                round.push((i, sources));
+            }
+        }
+        if round.is_empty() {
+            // The rest have no valid point on their surface: they stay dark.
+            break;
+        }
+        for (i, _) in &round {
+            known[*i as usize] = true;
+        }
+        rounds.push(round);
+        pending = rest;
+    }
+    rounds
+}
+
+fn apply_fill(values: &mut [Vec3], rounds: &[Vec<(u32, Vec<u32>)>]) {
+    for round in rounds {
+        let filled: Vec<Vec3> = round
+            .iter()
+            .map(|(_, src)| {
+                src.iter().map(|&j| values[j as usize]).sum::<Vec3>() / src.len() as f32
+            })
+            .collect();
+        for ((i, _), v) in round.iter().zip(filled) {
+            values[*i as usize] = v;
+        }
+    }
+}
+
+fn luminance_sum(values: &[Vec3]) -> f64 {
+    values.iter().map(|&v| f64::from(luminance(v))).sum()
+}
+
+/// Traces the gather rays of every point of `layout` and iterates the bounces.
+pub(super) fn gather(
+    placed: &PlacedScene<'_>,
+    layout: &FieldLayout,
+    settings: &AmbientSettings,
+) -> Gathered {
+    let jobs: Vec<(usize, usize)> = layout
+        .objects
+        .iter()
+        .enumerate()
+        .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
+        .collect();
+    let points: Vec<PointGather> = jobs
+        .par_iter()
+        .enumerate()
+        .map(|(index, &(o, p))| {
+            let mut s = Sampler::new(settings.seed ^ 0xa3b1_e7c0, index as u64, 0);
+            gather_point(placed, layout, o as ObjectId, p, settings, &mut s)
+        })
+        .collect();
+    let invalid_flags: Vec<bool> = points.iter().map(|g| g.invalid).collect();
+    let invalid = invalid_flags.iter().filter(|&&x| x).count();
+    let rounds = fill_rounds(layout, &invalid_flags);
+
+    let mut values: Vec<Vec3> = points.iter().map(|g| g.direct).collect();
+    apply_fill(&mut values, &rounds);
+    let mut bounces = 1;
+    let mut previous_increment = f64::INFINITY;
+    while bounces < settings.max_bounces.max(1) {
+        let next: Vec<Vec3> = points
+            .par_iter()
+            .map(|g| {
+                g.direct
+                    + g.row
+                        .iter()
+                        .map(|&(j, c)| c * values[j as usize])
+                        .sum::<Vec3>()
+            })
+            .collect();
+        let mut next = next;
+        apply_fill(&mut next, &rounds);
+        let increment: f64 = next
+            .iter()
+            .zip(&values)
+            .map(|(a, b)| f64::from(luminance(*a - *b)).abs())
+            .sum();
+        let total = luminance_sum(&next);
+        values = next;
+        bounces += 1;
+        if total <= 0.0 || increment <= 0.0 {
+            break;
+        }
+        // The rest of the series, assuming it falls off geometrically from here.
+        // Needs two increments for the ratio.
+        let r = (increment / previous_increment).clamp(0.0, 0.99);
+        let tail = increment * r / (1.0 - r);
+        let first = !previous_increment.is_finite();
+        previous_increment = increment;
+        if !first && tail <= f64::from(settings.tolerance) * total {
+            break;
+        }
+    }
+    Gathered {
+        irradiance: values,
+        bounces,
+        invalid,
+    }
+}
