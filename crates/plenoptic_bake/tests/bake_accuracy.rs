@@ -76,30 +76,42 @@ fn measure(test: &Image<Vec3>, a: &Image<Vec3>, b: &Image<Vec3>) -> Figures {
     }
 }
 
-/// Renders the bake's view of `camera` at `t` (the multi-stage renderer over the ambient
-/// field the bake would gather for `quality`) and a two-half path-traced reference.
+/// The bake's ambient field for `quality` at `t`.
+fn bake_field(accel: &SceneAccel<'_>, quality: &Quality, t: f32) -> AmbientField {
+    let mut settings = ambient::settings(quality, 7);
+    if let Ok(r) = std::env::var("EXP_RAYS") {
+        settings.rays_per_point = r.parse().unwrap();
+    }
+    if let Ok(q) = std::env::var("EXP_Q") {
+        settings.quality = q.parse().unwrap();
+    }
+    AmbientField::build(&accel.at_time(t), &settings).unwrap()
+}
+
+/// Renders the bake's view of `camera` at the field's time (the multi-stage renderer over
+/// the bake's ambient field, as for a range image) and a two-half path-traced reference.
 fn base_view_frame(
-    scene: &Scene,
-    quality: &Quality,
+    name: &str,
+    accel: &SceneAccel<'_>,
+    field: &AmbientField,
     camera: &PinholeCamera,
-    t: f32,
     reference_spp: u32,
-) -> (Figures, AmbientField) {
-    let accel = SceneAccel::new(scene).unwrap();
-    let placed = accel.at_time(t);
-    let field = AmbientField::build(&placed, &ambient::settings(quality, 7)).unwrap();
+) -> Figures {
+    let placed = accel.at_time(field.time());
+    let start = std::time::Instant::now();
     let ms = MultiStageRenderer::new(
         MultiStageSettings {
-            samples_per_pixel: 64,
+            samples_per_pixel: 256,
             shadow_samples: 2,
             glossy_samples: 2,
-            max_specular_depth: quality.max_specular_depth.max(4),
+            max_specular_depth: 4,
             seed: 3,
         },
-        &field,
+        field,
     )
     .render(&placed, camera)
     .radiance();
+    let ms_time = start.elapsed().as_secs_f64();
     let half = |seed| {
         PathTracer::new(PathTracerSettings {
             samples_per_pixel: reference_spp / 2,
@@ -111,7 +123,43 @@ fn base_view_frame(
         .radiance()
     };
     let (a, b) = (half(11), half(12));
-    (measure(&ms, &a, &b), field)
+    if std::env::var("EXP_WORST").is_ok() {
+        let (t, al, bl) = (lum(&ms), lum(&a), lum(&b));
+        let mut e: Vec<(f64, usize)> = (0..t.len())
+            .map(|i| {
+                (
+                    (t[i] - 0.5 * (al[i] + bl[i])).powi(2) - (al[i] - bl[i]).powi(2) / 4.0,
+                    i,
+                )
+            })
+            .collect();
+        e.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let total: f64 = e.iter().map(|x| x.0).sum();
+        for &(v, i) in e.iter().take(8) {
+            println!(
+                "   worst ({}, {}): bake {:.3} ref {:.3}/{:.3}, share {:.2}",
+                i % camera.width as usize,
+                i / camera.width as usize,
+                t[i],
+                al[i],
+                bl[i],
+                v / total
+            );
+        }
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bake_accuracy");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = name.replace([' ', ','], "_").replace("__", "_");
+    let exposure = 0.5 / a.mean_luminance() as f32;
+    ms.save_png(dir.join(format!("{file}_bake.png")), exposure)
+        .unwrap();
+    a.save_png(dir.join(format!("{file}_reference.png")), exposure)
+        .unwrap();
+    println!(
+        "  multi-stage {ms_time:.2} s, reference {:.2} s",
+        start.elapsed().as_secs_f64() - ms_time
+    );
+    measure(&ms, &a, &b)
 }
 
 #[test]
@@ -229,8 +277,17 @@ fn two_rooms() -> Scene {
 #[test]
 fn base_views_agree_with_the_path_tracer() {
     let scene = two_rooms();
-    let quality = Quality::draft();
-    let (w, h) = (48, 32);
+    let accel = SceneAccel::new(&scene).unwrap();
+    let start = std::time::Instant::now();
+    let field = bake_field(&accel, &Quality::draft(), 0.0);
+    println!(
+        "field: {} points, {} inside solids, {} bounces, {:.2} s",
+        field.layout().point_count(),
+        field.invalid_points(),
+        field.bounces(),
+        start.elapsed().as_secs_f64()
+    );
+    let (w, h) = (32, 24);
     let views = [
         ("sunlit floor", Vec3::new(-3.0, 1.6, -1.0), 0.6, -0.6),
         ("mirror", Vec3::new(-1.0, 1.6, -1.2), 2.7, -0.1),
@@ -251,17 +308,17 @@ fn base_views_agree_with_the_path_tracer() {
     for (name, p, yaw, pitch) in views {
         let rotation = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch);
         let cam = PinholeCamera::new(p, rotation, 70f32.to_radians(), w, h).unwrap();
-        let (f, field) = base_view_frame(&scene, &quality, &cam, 0.0, 512);
+        let f = base_view_frame(
+            name,
+            &accel,
+            &field,
+            &cam,
+            std::env::var("EXP_SPP").map_or(4096, |s| s.parse().unwrap()),
+        );
         println!(
             "{name}: mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor \
-             {:.3}); field {} points, {} inside solids, {} bounces",
-            f.mean_ratio,
-            f.blocks_within,
-            f.corrected_lrms,
-            f.noise_floor,
-            field.layout().point_count(),
-            field.invalid_points(),
-            field.bounces(),
+             {:.3})",
+            f.mean_ratio, f.blocks_within, f.corrected_lrms, f.noise_floor,
         );
         if (f.mean_ratio - 1.0).abs() > 0.03 || f.blocks_within < 0.9 || f.corrected_lrms > 0.1 {
             failures.push((name, f));
@@ -282,9 +339,9 @@ fn tour_scene() -> Scene {
 #[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture"]
 fn tour_base_views() {
     let scene = tour_scene();
-    let mut quality = Quality::draft();
-    quality.max_space_depth = 2;
-    let (w, h) = (96, 56);
+    let accel = SceneAccel::new(&scene).unwrap();
+    let quality = Quality::draft();
+    let (w, h) = (80, 48);
     let views = [
         (
             "atrium centre, t = 0",
@@ -319,18 +376,19 @@ fn tour_base_views() {
         )
         .unwrap();
         let start = std::time::Instant::now();
-        let (f, field) = base_view_frame(&scene, &quality, &cam, t, 512);
+        let field = bake_field(&accel, &quality, t);
         println!(
-            "{name}: mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor \
-             {:.3}); field {} points, {} inside solids, {} bounces; {:.0} s",
-            f.mean_ratio,
-            f.blocks_within,
-            f.corrected_lrms,
-            f.noise_floor,
+            "{name}: field {} points, {} inside solids, {} bounces, {:.1} s",
             field.layout().point_count(),
             field.invalid_points(),
             field.bounces(),
             start.elapsed().as_secs_f64()
+        );
+        let f = base_view_frame(name, &accel, &field, &cam, 1024);
+        println!(
+            "{name}: mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor \
+             {:.3})",
+            f.mean_ratio, f.blocks_within, f.corrected_lrms, f.noise_floor,
         );
     }
 }

@@ -118,11 +118,7 @@ impl<'f> MultiStageRenderer<'f> {
             let albedo = bsdf
                 .sample(u_lobe, s.next_2d(), Lobes::Diffuse)
                 .map_or(Vec3::ZERO, |b| b.weight);
-            l += albedo
-                * self
-                    .field
-                    .irradiance_at(hit.object, hit.triangle, hit.barycentrics)
-                / PI;
+            l += albedo * self.field.irradiance_seen(placed, &hit, wo) / PI;
         }
         if depth < self.settings.max_specular_depth && bsdf.has(Lobes::Specular) {
             let rough = !bsdf.is_delta(Lobes::Specular);

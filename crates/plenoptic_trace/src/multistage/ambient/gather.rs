@@ -11,7 +11,8 @@
 //!   shadow sample; emission is added only behind a delta bounce: emission seen directly is
 //!   direct light, which the renderer computes per sample);
 //! - to row i of the sparse matrix K, the surface's one-sample non-delta albedo times the
-//!   field's interpolation weights at the hit: its share of the hit's own indirect light.
+//!   field's interpolation weights at the hit (those it can see, `super::visibility`): its
+//!   share of the hit's own indirect light.
 //!
 //! E_1 = D carries one bounce; E_(p+1) = D + K·E_p carries p + 1. The product reuses the same
 //! rays, so increments are noise-free and the iteration converges like the true bounce series
@@ -19,8 +20,11 @@
 //! estimated geometrically from the last two increments (r/(1−r)·|ΔE|), falls below
 //! `tolerance` of |E|, or after `max_bounces`.
 //!
-//! Points that lie inside a solid — more than half of their gather rays first meet a back
-//! face, as on a box face running under a wall — are **invalid**: their own gather is
+//! A ray that meets the back face of a single-sided surface has entered a closed solid and
+//! carries no light (the field is shared by both sides of a triangle, so reading it there
+//! would leak the lit side's light through the wall). Points that lie inside a solid — more
+//! than an eighth of their gather rays first meet such a back face, as on a box face running
+//! under a wall — are **invalid**: their own gather is
 //! dropped, and at every iteration they take the mean of their valid (or already filled)
 //! neighbours on the same surface, so interpolation next to a wall does not pull in the
 //! darkness inside it.
@@ -31,11 +35,18 @@ use rayon::prelude::*;
 
 use super::AmbientSettings;
 use super::layout::FieldLayout;
+use super::visibility::{Blocked, blocked_edges, visible_weights};
 use crate::accel::{PlacedScene, Ray};
 use crate::image::luminance;
 use crate::light::estimate_direct;
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::sampling::{Frame, Sampler, cosine_hemisphere};
+
+/// A point is inside a solid when more than 1/`INSIDE_FRACTION` of its rays first meet the
+/// back face of a single-sided surface. A point in the open meets none (rays hit the front
+/// faces of whatever surrounds it); one on the line where a box runs under a wall meets
+/// about half.
+const INSIDE_FRACTION: u32 = 8;
 
 /// What one gather point's rays found.
 struct PointGather {
@@ -52,11 +63,14 @@ pub(super) struct Gathered {
     pub(super) irradiance: Vec<Vec3>,
     pub(super) bounces: u32,
     pub(super) invalid: usize,
+    /// Points with a blocked grid edge (`super::visibility`).
+    pub(super) guarded: Vec<bool>,
 }
 
 fn gather_point(
     placed: &PlacedScene<'_>,
     layout: &FieldLayout,
+    guarded: &[bool],
     object: ObjectId,
     point: usize,
     settings: &AmbientSettings,
@@ -87,10 +101,15 @@ fn gather_point(
             let Some(hit) = placed.intersect(&ray) else {
                 break;
             };
-            if depth == 0 && !hit.front_face {
-                back_faces += 1;
-            }
             let props = SurfaceProps::at(scene, &hit);
+            if !hit.front_face && !props.double_sided {
+                // The inside of a closed solid: no light there. From the point itself it
+                // means the point is embedded in that solid.
+                if depth == 0 {
+                    back_faces += 1;
+                }
+                break;
+            }
             if depth > 0 {
                 out.direct += throughput * props.emission(&hit);
             }
@@ -119,11 +138,10 @@ fn gather_point(
             }
             // E_i = π · mean(L) under cosine sampling, L = albedo · E_hit / π.
             let c = throughput * bs.weight / rays as f32;
-            if let Some(w) = layout.weights(hit.object, hit.triangle, hit.barycentrics) {
-                let base = layout.offsets[hit.object as usize] as u32;
+            if let Some(w) = visible_weights(placed, layout, guarded, &hit, -ray.direction) {
                 for (j, wt) in w {
                     if wt > 0.0 {
-                        out.row.push((base + j, c * wt));
+                        out.row.push((j as u32, c * wt));
                     }
                 }
             }
@@ -132,7 +150,7 @@ fn gather_point(
     }
     // E = ∫ L cos dω ≈ π · mean(L) under cosine-weighted sampling.
     out.direct *= std::f32::consts::PI / rays as f32;
-    out.invalid = 2 * back_faces > rays;
+    out.invalid = back_faces * INSIDE_FRACTION > rays;
     if out.invalid {
         out.direct = Vec3::ZERO;
         out.row.clear();
@@ -207,6 +225,36 @@ fn apply_fill(values: &mut [Vec3], rounds: &[Vec<(u32, Vec<u32>)>]) {
     }
 }
 
+/// One pass of edge-aware averaging: each valid point becomes the mean of itself and its
+/// valid neighbours on the same surface whose grid edge is free and whose normal agrees
+/// (within about 25°), so the filter neither crosses walls nor creases.
+fn smooth(layout: &FieldLayout, values: &[Vec3], invalid: &[bool], blocked: &Blocked) -> Vec<Vec3> {
+    let mut out = values.to_vec();
+    for (o, l) in layout.objects.iter().enumerate() {
+        let base = layout.offsets[o];
+        for i in 0..l.points.len() {
+            let fi = base + i;
+            if invalid[fi] {
+                continue;
+            }
+            let ni = l.points[i].normal;
+            let (mut sum, mut count) = (values[fi], 1.0f32);
+            for &j in l.neighbours(i) {
+                let fj = base + j as usize;
+                if !invalid[fj]
+                    && l.points[j as usize].normal.dot(ni) > 0.9
+                    && blocked.edge_clear(fi as u32, fj as u32)
+                {
+                    sum += values[fj];
+                    count += 1.0;
+                }
+            }
+            out[fi] = sum / count;
+        }
+    }
+    out
+}
+
 fn luminance_sum(values: &[Vec3]) -> f64 {
     values.iter().map(|&v| f64::from(luminance(v))).sum()
 }
@@ -223,12 +271,14 @@ pub(super) fn gather(
         .enumerate()
         .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
         .collect();
+    let blocked = blocked_edges(placed, layout);
+    let guarded = &blocked.guarded;
     let points: Vec<PointGather> = jobs
         .par_iter()
         .enumerate()
         .map(|(index, &(o, p))| {
             let mut s = Sampler::new(settings.seed ^ 0xa3b1_e7c0, index as u64, 0);
-            gather_point(placed, layout, o as ObjectId, p, settings, &mut s)
+            gather_point(placed, layout, guarded, o as ObjectId, p, settings, &mut s)
         })
         .collect();
     let invalid_flags: Vec<bool> = points.iter().map(|g| g.invalid).collect();
@@ -273,9 +323,14 @@ pub(super) fn gather(
             break;
         }
     }
+    for _ in 0..settings.smoothing {
+        values = smooth(layout, &values, &invalid_flags, &blocked);
+        apply_fill(&mut values, &rounds);
+    }
     Gathered {
         irradiance: values,
         bounces,
         invalid,
+        guarded: blocked.guarded,
     }
 }
