@@ -71,8 +71,8 @@ pub struct Quality {
     /// Radiance samples per range-image pixel (direct light with soft shadows and specular
     /// paths). Bake time is linear in it; noise falls with its square root.
     pub samples_per_pixel: u32,
-    /// Hemisphere samples per point of the ambient field (indirect diffuse). Linear cost;
-    /// too few gives blotchy indirect light.
+    /// Hemisphere samples per point of the ambient field (indirect diffuse), each traced
+    /// once and reused for every bounce. Linear cost; too few gives blotchy indirect light.
     pub ambient_samples: u32,
     /// Relative RMS change of irradiance between interval ends above which the ambient field
     /// gets another key time. Smaller values cost more ambient keys and catch subtler changes.
@@ -98,7 +98,7 @@ impl Quality {
             max_space_depth: 3,
             max_time_depth: 4,
             samples_per_pixel: 4,
-            ambient_samples: 64,
+            ambient_samples: 128,
             ambient_rms: 0.2,
             temporal_volume_samples: 20_000,
             max_specular_depth: 2,
