@@ -8,7 +8,7 @@
 //!   bounces of indirect light iterated over those stored rays until they converge.
 //! - `visibility.rs`: interpolation that does not leak through walls thinner than a cell.
 //!
-//! Why it is built this way (docs/architecture.md, "What made version 1's bake dark"): a
+//! Why it is built this way (`docs/bake-accuracy.md` has the measurements): a
 //! field gathered in two passes and extrapolated by one global ratio reached 0.73–0.79 of
 //! the path tracer's mean luminance on the tour. The bounce ratio of a sunlit interior keeps
 //! rising from pass to pass, so the extrapolation undershoots; gather rays stopped at glass
