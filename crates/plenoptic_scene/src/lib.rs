@@ -46,6 +46,7 @@ pub mod error;
 pub mod import;
 pub mod model;
 pub mod recipe;
+pub mod texture;
 mod util;
 
 pub use anim::{Interpolation, Key, Track, TrsTrack};

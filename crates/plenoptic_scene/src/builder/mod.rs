@@ -34,6 +34,7 @@
 //! assert!(scene.object_is_animated(ball));
 //! ```
 
+mod material;
 pub mod shapes;
 mod write;
 
@@ -43,7 +44,7 @@ use glam::{Quat, Vec2, Vec3, Vec4};
 
 use crate::anim::Track;
 use crate::error::{Result, SceneError};
-use crate::model::{LightKind, Mesh, Scene, Trs};
+use crate::model::{AlphaMode, LightKind, Mesh, Scene, Trs, UvTransform, WrapMode};
 
 /// A material of the builder (glTF metallic-roughness plus emissive strength, transmission
 /// and IOR). Fields are public; the chaining methods set them one by one.
@@ -75,6 +76,11 @@ pub struct MaterialDesc {
     pub ior: f32,
     /// Whether back faces are shaded too.
     pub double_sided: bool,
+    /// glTF `alphaMode` (and `alphaCutoff` for [`AlphaMode::Mask`]).
+    pub alpha_mode: AlphaMode,
+    /// `KHR_texture_transform` written on every texture of the material; `None` (or the
+    /// identity) writes none.
+    pub texture_transform: Option<UvTransform>,
 }
 
 impl Default for MaterialDesc {
@@ -93,6 +99,8 @@ impl Default for MaterialDesc {
             transmission: 0.0,
             ior: 1.5,
             double_sided: false,
+            alpha_mode: AlphaMode::Opaque,
+            texture_transform: None,
         }
     }
 }
@@ -192,6 +200,22 @@ impl MaterialDesc {
     /// Sets the normal map.
     pub fn normal_texture(mut self, texture: TextureHandle) -> Self {
         self.normal_texture = Some(texture);
+        self
+    }
+    /// Sets the linear base colour with its alpha.
+    pub fn base_color_alpha(mut self, color: Vec4) -> Self {
+        self.base_color = color;
+        self
+    }
+    /// Sets the alpha mode: [`AlphaMode::Mask`] with a cutoff, or [`AlphaMode::Blend`]
+    /// (coverage).
+    pub fn alpha_mode(mut self, mode: AlphaMode) -> Self {
+        self.alpha_mode = mode;
+        self
+    }
+    /// Sets the `KHR_texture_transform` of all the material's textures.
+    pub fn texture_transform(mut self, transform: UvTransform) -> Self {
+        self.texture_transform = Some(transform);
         self
     }
 }
@@ -394,6 +418,8 @@ pub(crate) struct TextureDesc {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) rgba8: Vec<u8>,
+    pub(crate) wrap_s: WrapMode,
+    pub(crate) wrap_t: WrapMode,
 }
 
 /// A mesh of the builder: named, one primitive per (geometry, material).
@@ -440,12 +466,34 @@ impl SceneBuilder {
             width,
             height,
             rgba8,
+            wrap_s: WrapMode::Repeat,
+            wrap_t: WrapMode::Repeat,
         });
         TextureHandle(self.textures.len() - 1)
     }
 
-    /// Adds a mesh of one primitive. Normals may be empty (the importer computes them), UVs
-    /// and tangents may be empty.
+    /// Sets the wrap modes of `texture`'s sampler (REPEAT in both directions by default; a
+    /// sampler is written only for other modes). Fails for a handle of another builder.
+    pub fn set_texture_wrap(
+        &mut self,
+        texture: TextureHandle,
+        wrap_s: WrapMode,
+        wrap_t: WrapMode,
+    ) -> Result<&mut Self> {
+        let t = self.textures.get_mut(texture.0).ok_or_else(|| {
+            SceneError::invalid(
+                "<builder>",
+                format!("texture {}", texture.0),
+                "handle from another builder",
+            )
+        })?;
+        t.wrap_s = wrap_s;
+        t.wrap_t = wrap_t;
+        Ok(self)
+    }
+
+    /// Adds a mesh of one primitive. Normals may be empty (the importer computes them), UVs,
+    /// tangents and vertex colours may be empty (colours are written as float `COLOR_0`).
     pub fn add_mesh(
         &mut self,
         name: impl Into<String>,
