@@ -183,6 +183,7 @@ impl ProxyGeometry {
                 normals,
                 uvs: Vec::new(),
                 tangents: Vec::new(),
+                colors: Vec::new(),
                 triangles: mesh
                     .indices
                     .chunks_exact(3)

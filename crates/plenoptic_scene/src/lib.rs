@@ -10,7 +10,9 @@
 //!   places every object at any time t;
 //! - [imports](import) glTF 2.0 (`.gltf` with external or embedded buffers, `.glb`), naming the
 //!   file and the element in every error and naming unsupported features (skinning, morph
-//!   targets) in warnings;
+//!   targets, other extensions) in warnings; it keeps what architectural exports use:
+//!   `alphaMode`/`alphaCutoff`, `KHR_texture_transform`, sampler wrap modes and `COLOR_0`
+//!   ([`texture`]);
 //! - [builds](builder) scenes in code and writes them as glTF, for tests, benchmarks and tour
 //!   scenes;
 //! - reads the [bake recipe](recipe) (TOML): scenes, view space, time range, quality.
@@ -46,6 +48,7 @@ pub mod error;
 pub mod import;
 pub mod model;
 pub mod recipe;
+pub mod texture;
 mod util;
 
 pub use anim::{Interpolation, Key, Track, TrsTrack};

@@ -14,6 +14,7 @@
 use glam::{Affine3A, Quat, Vec2, Vec3, Vec4};
 
 use crate::anim::TrsTrack;
+pub use crate::texture::{AlphaMode, Texture, TextureRef, UvTransform, WrapMode};
 
 /// Index of an object in [`Scene::objects`]; the object id of id-images and of the pack.
 pub type ObjectId = u32;
@@ -33,26 +34,11 @@ pub struct Mesh {
     /// Unit tangents with handedness in w, one per position, or empty (normal maps need them;
     /// computed from UVs when absent).
     pub tangents: Vec<Vec4>,
+    /// Linear vertex colours with alpha (`COLOR_0`; alpha 1 for RGB files), one per position,
+    /// or empty. They multiply the material's base colour and alpha.
+    pub colors: Vec<Vec4>,
     /// Triangles as indices into the vertex arrays.
     pub triangles: Vec<[u32; 3]>,
-}
-
-/// A texture, decoded to linear floating point RGBA.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Texture {
-    /// Width in texels.
-    pub width: u32,
-    /// Height in texels.
-    pub height: u32,
-    /// Texels row by row from the top, linear (sRGB textures are linearised on import).
-    pub texels: Vec<Vec4>,
-}
-
-/// A reference from a material to a texture.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TextureRef {
-    /// Index into [`Scene::textures`].
-    pub texture: usize,
 }
 
 /// A glTF metallic-roughness material with the extensions plenoptic supports.
@@ -62,7 +48,7 @@ pub struct Material {
     pub name: String,
     /// Linear base colour and alpha.
     pub base_color: Vec4,
-    /// Multiplies `base_color`.
+    /// Multiplies `base_color` (colour and alpha).
     pub base_color_texture: Option<TextureRef>,
     /// Metalness in [0, 1].
     pub metallic: f32,
@@ -84,6 +70,8 @@ pub struct Material {
     pub ior: f32,
     /// Whether back faces are shaded as front faces.
     pub double_sided: bool,
+    /// How base-colour alpha is used: opaque, cut out, or coverage.
+    pub alpha_mode: AlphaMode,
 }
 
 impl Default for Material {
@@ -103,6 +91,7 @@ impl Default for Material {
             transmission: 0.0,
             ior: 1.5,
             double_sided: false,
+            alpha_mode: AlphaMode::Opaque,
         }
     }
 }

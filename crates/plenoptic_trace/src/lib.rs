@@ -6,6 +6,10 @@
 //!   compressed wide BVH) and a top level over the objects placed at time t
 //!   ([`PlacedScene`]): rigid animation costs a top-level rebuild only. Closest-hit and
 //!   shadow queries; id-images.
+//! - [`alpha`]: glTF `alphaMode` MASK (cut-outs) and BLEND (coverage: rays pass with
+//!   probability 1 − alpha, decided by a hash of the ray) as an any-hit filter of every
+//!   intersection and shadow query; [`texture`]: bilinear lookups with the sampler's wrap
+//!   modes and `KHR_texture_transform`, and `COLOR_0`.
 //! - [`camera`]: pinhole, cube (KTX2/Vulkan face order and orientation) and fisheye cameras.
 //! - [`pathtrace`]: the reference path tracer (next-event estimation, multiple importance
 //!   sampling, GGX, thick dielectric transmission), the ground truth for every metric.
@@ -42,6 +46,7 @@
 //! ```
 
 pub mod accel;
+pub mod alpha;
 pub mod camera;
 pub mod image;
 pub mod light;
@@ -52,6 +57,7 @@ pub mod pathtrace;
 pub mod render;
 pub mod sampling;
 pub mod shapes;
+pub mod texture;
 
 pub use accel::{FlatBvh, Hit, PlacedScene, Ray, SceneAccel};
 pub use camera::{

@@ -3,13 +3,15 @@
 //! sampling (power heuristic).
 
 use glam::{Vec2, Vec3};
-use plenoptic_scene::{Light, LightKind, ObjectId, PlacedLight, Scene};
+use plenoptic_scene::{AlphaMode, Light, LightKind, ObjectId, PlacedLight, Scene};
 use std::collections::HashMap;
 
 use crate::accel::{Hit, Instance, PlacedScene};
+use crate::alpha::coverage;
 use crate::image::luminance;
-use crate::material::{Bsdf, Lobes, sample_texture};
+use crate::material::{Bsdf, Lobes};
 use crate::sampling::{Distribution1d, Sampler, power_heuristic, uniform_triangle};
+use crate::texture::sample_ref;
 
 /// An emissive triangle placed in the world.
 #[derive(Debug, Clone, Copy)]
@@ -127,7 +129,9 @@ impl LightSet {
         self.punctual.len()
     }
 
-    /// Samples a point on the emissive triangles (by area × luminance) as seen from `p`.
+    /// Samples a point on the emissive triangles (by area × luminance) as seen from `p`. The
+    /// radiance is weighted by the surface's coverage there (0 where a MASK cuts it, alpha for
+    /// BLEND), matching what rays that hit emitters see.
     pub fn sample_emissive(
         &self,
         scene: &Scene,
@@ -157,7 +161,12 @@ impl LightSet {
         let mut value = material.emissive;
         if let Some(tex) = material.emissive_texture {
             let uv = e.uv[0] * (1.0 - b.x - b.y) + e.uv[1] * b.x + e.uv[2] * b.y;
-            value *= sample_texture(&scene.textures[tex.texture], uv).truncate();
+            value *= sample_ref(scene, &tex, uv).truncate();
+        }
+        if material.alpha_mode != AlphaMode::Opaque {
+            // A cut-out emits nothing; a BLEND emitter is met by a fraction alpha of the rays.
+            let mesh = &scene.meshes[scene.objects[e.object as usize].mesh];
+            value *= coverage(scene, material, mesh, e.triangle, b);
         }
         Some(LightSample {
             wi,

@@ -10,37 +10,19 @@
 //! BTDF), so a slab shows inter-reflections. Roughness below [`DELTA_ROUGHNESS`] gives delta
 //! (mirror / ideal refraction) lobes.
 
-use glam::{Vec2, Vec3, Vec4};
-use plenoptic_scene::{Scene, Texture};
+use glam::{Vec2, Vec3};
+use plenoptic_scene::Scene;
 use std::f32::consts::PI;
 
 use crate::accel::Hit;
 use crate::image::luminance;
 use crate::sampling::Frame;
+use crate::texture::{mesh_color, sample_opt};
 
 /// Perceptual roughness below which reflection and refraction are treated as ideal.
 pub const DELTA_ROUGHNESS: f32 = 0.02;
 
-/// Bilinear lookup with wrapping (glTF's default REPEAT), uv (0, 0) at the top-left texel.
-pub fn sample_texture(tex: &Texture, uv: Vec2) -> Vec4 {
-    if tex.width == 0 || tex.height == 0 || tex.texels.is_empty() {
-        return Vec4::ONE;
-    }
-    let (w, h) = (tex.width as i64, tex.height as i64);
-    let x = uv.x * w as f32 - 0.5;
-    let y = uv.y * h as f32 - 0.5;
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let at = |xi: i64, yi: i64| {
-        let xi = xi.rem_euclid(w) as usize;
-        let yi = yi.rem_euclid(h) as usize;
-        tex.texels[yi * tex.width as usize + xi]
-    };
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let top = at(x0, y0).lerp(at(x0 + 1, y0), fx);
-    let bottom = at(x0, y0 + 1).lerp(at(x0 + 1, y0 + 1), fx);
-    top.lerp(bottom, fy)
-}
+pub use crate::texture::sample_texture;
 
 /// The material evaluated at a surface point (textures applied).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,15 +44,20 @@ pub struct SurfaceProps {
 }
 
 impl SurfaceProps {
-    /// The material of the object at `hit`, with its textures sampled at the hit's uv.
+    /// The material of the object at `hit`, with its textures sampled at the hit's uv (each
+    /// through its reference's transform and wrap modes) and the base colour multiplied by
+    /// the `COLOR_0` vertex colour. Alpha is not part of the result: MASK and BLEND act in the
+    /// traversal ([`crate::alpha`]), so a hit that reaches shading is opaque.
     pub fn at(scene: &Scene, hit: &Hit) -> Self {
         let object = &scene.objects[hit.object as usize];
         let m = &scene.materials[object.material];
-        let tex = |r: Option<plenoptic_scene::TextureRef>| {
-            r.and_then(|r| scene.textures.get(r.texture))
-                .map_or(Vec4::ONE, |t| sample_texture(t, hit.uv))
-        };
-        let base = m.base_color * tex(m.base_color_texture);
+        let tex = |r: Option<plenoptic_scene::TextureRef>| sample_opt(scene, r.as_ref(), hit.uv);
+        let mut base = m.base_color * tex(m.base_color_texture);
+        if let Some(mesh) = scene.meshes.get(object.mesh)
+            && !mesh.colors.is_empty()
+        {
+            base *= mesh_color(mesh, hit.triangle, hit.barycentrics);
+        }
         let mr = tex(m.metallic_roughness_texture);
         let emissive = m.emissive * tex(m.emissive_texture).truncate();
         Self {

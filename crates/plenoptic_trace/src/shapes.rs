@@ -25,6 +25,7 @@ pub fn quad(size: Vec2) -> Mesh {
         normals: vec![Vec3::Y; 4],
         uvs: vec![Vec2::ZERO, Vec2::Y, Vec2::ONE, Vec2::X],
         tangents: Vec::new(),
+        colors: Vec::new(),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
     }
 }

@@ -34,167 +34,18 @@
 //! assert!(scene.object_is_animated(ball));
 //! ```
 
+mod material;
 pub mod shapes;
 mod write;
 
 use std::path::Path;
 
-use glam::{Quat, Vec2, Vec3, Vec4};
+use glam::{Quat, Vec2, Vec3};
 
+pub use self::material::MaterialDesc;
 use crate::anim::Track;
 use crate::error::{Result, SceneError};
-use crate::model::{LightKind, Mesh, Scene, Trs};
-
-/// A material of the builder (glTF metallic-roughness plus emissive strength, transmission
-/// and IOR). Fields are public; the chaining methods set them one by one.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MaterialDesc {
-    /// Name written to the file.
-    pub name: String,
-    /// Linear base colour and alpha.
-    pub base_color: Vec4,
-    /// Base colour texture (sRGB).
-    pub base_color_texture: Option<TextureHandle>,
-    /// Metalness in [0, 1].
-    pub metallic: f32,
-    /// Perceptual roughness in [0, 1].
-    pub roughness: f32,
-    /// Metallic (blue) and roughness (green) texture.
-    pub metallic_roughness_texture: Option<TextureHandle>,
-    /// Emissive colour; components above 1 are folded into the strength when written.
-    pub emissive: Vec3,
-    /// `KHR_materials_emissive_strength` multiplier.
-    pub emissive_strength: f32,
-    /// Emissive texture (sRGB).
-    pub emissive_texture: Option<TextureHandle>,
-    /// Tangent-space normal map.
-    pub normal_texture: Option<TextureHandle>,
-    /// `KHR_materials_transmission` factor in [0, 1].
-    pub transmission: f32,
-    /// `KHR_materials_ior`.
-    pub ior: f32,
-    /// Whether back faces are shaded too.
-    pub double_sided: bool,
-}
-
-impl Default for MaterialDesc {
-    fn default() -> Self {
-        Self {
-            name: String::new(),
-            base_color: Vec4::ONE,
-            base_color_texture: None,
-            metallic: 0.0,
-            roughness: 0.5,
-            metallic_roughness_texture: None,
-            emissive: Vec3::ZERO,
-            emissive_strength: 1.0,
-            emissive_texture: None,
-            normal_texture: None,
-            transmission: 0.0,
-            ior: 1.5,
-            double_sided: false,
-        }
-    }
-}
-
-impl MaterialDesc {
-    /// A rough dielectric (roughness 1) with linear base colour `color`.
-    pub fn diffuse(color: Vec3) -> Self {
-        Self {
-            base_color: color.extend(1.0),
-            roughness: 1.0,
-            ..Self::default()
-        }
-    }
-
-    /// A metal of colour `color` and roughness `roughness`.
-    pub fn metal(color: Vec3, roughness: f32) -> Self {
-        Self {
-            base_color: color.extend(1.0),
-            metallic: 1.0,
-            roughness,
-            ..Self::default()
-        }
-    }
-
-    /// A black emitter of radiance `color · strength`.
-    pub fn emitter(color: Vec3, strength: f32) -> Self {
-        Self {
-            base_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
-            emissive: color,
-            emissive_strength: strength,
-            ..Self::default()
-        }
-    }
-
-    /// Clear glass: full transmission, smooth, IOR `ior`.
-    pub fn glass(ior: f32) -> Self {
-        Self {
-            roughness: 0.0,
-            transmission: 1.0,
-            ior,
-            ..Self::default()
-        }
-    }
-
-    /// Sets the name.
-    pub fn named(mut self, name: impl Into<String>) -> Self {
-        self.name = name.into();
-        self
-    }
-    /// Sets the linear base colour (alpha 1).
-    pub fn base_color(mut self, color: Vec3) -> Self {
-        self.base_color = color.extend(1.0);
-        self
-    }
-    /// Sets metalness.
-    pub fn metallic(mut self, metallic: f32) -> Self {
-        self.metallic = metallic;
-        self
-    }
-    /// Sets perceptual roughness.
-    pub fn roughness(mut self, roughness: f32) -> Self {
-        self.roughness = roughness;
-        self
-    }
-    /// Sets the emissive colour and strength.
-    pub fn emissive(mut self, color: Vec3, strength: f32) -> Self {
-        self.emissive = color;
-        self.emissive_strength = strength;
-        self
-    }
-    /// Sets transmission and IOR.
-    pub fn transmission(mut self, transmission: f32, ior: f32) -> Self {
-        self.transmission = transmission;
-        self.ior = ior;
-        self
-    }
-    /// Sets double-sidedness.
-    pub fn double_sided(mut self, double_sided: bool) -> Self {
-        self.double_sided = double_sided;
-        self
-    }
-    /// Sets the base colour texture.
-    pub fn base_color_texture(mut self, texture: TextureHandle) -> Self {
-        self.base_color_texture = Some(texture);
-        self
-    }
-    /// Sets the metallic-roughness texture.
-    pub fn metallic_roughness_texture(mut self, texture: TextureHandle) -> Self {
-        self.metallic_roughness_texture = Some(texture);
-        self
-    }
-    /// Sets the emissive texture.
-    pub fn emissive_texture(mut self, texture: TextureHandle) -> Self {
-        self.emissive_texture = Some(texture);
-        self
-    }
-    /// Sets the normal map.
-    pub fn normal_texture(mut self, texture: TextureHandle) -> Self {
-        self.normal_texture = Some(texture);
-        self
-    }
-}
+use crate::model::{LightKind, Mesh, Scene, Trs, WrapMode};
 
 /// A punctual light of the builder (`KHR_lights_punctual`).
 #[derive(Debug, Clone, PartialEq)]
@@ -394,6 +245,8 @@ pub(crate) struct TextureDesc {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) rgba8: Vec<u8>,
+    pub(crate) wrap_s: WrapMode,
+    pub(crate) wrap_t: WrapMode,
 }
 
 /// A mesh of the builder: named, one primitive per (geometry, material).
@@ -440,12 +293,34 @@ impl SceneBuilder {
             width,
             height,
             rgba8,
+            wrap_s: WrapMode::Repeat,
+            wrap_t: WrapMode::Repeat,
         });
         TextureHandle(self.textures.len() - 1)
     }
 
-    /// Adds a mesh of one primitive. Normals may be empty (the importer computes them), UVs
-    /// and tangents may be empty.
+    /// Sets the wrap modes of `texture`'s sampler (REPEAT in both directions by default; a
+    /// sampler is written only for other modes). Fails for a handle of another builder.
+    pub fn set_texture_wrap(
+        &mut self,
+        texture: TextureHandle,
+        wrap_s: WrapMode,
+        wrap_t: WrapMode,
+    ) -> Result<&mut Self> {
+        let t = self.textures.get_mut(texture.0).ok_or_else(|| {
+            SceneError::invalid(
+                "<builder>",
+                format!("texture {}", texture.0),
+                "handle from another builder",
+            )
+        })?;
+        t.wrap_s = wrap_s;
+        t.wrap_t = wrap_t;
+        Ok(self)
+    }
+
+    /// Adds a mesh of one primitive. Normals may be empty (the importer computes them), UVs,
+    /// tangents and vertex colours may be empty (colours are written as float `COLOR_0`).
     pub fn add_mesh(
         &mut self,
         name: impl Into<String>,

@@ -6,7 +6,7 @@ use serde_json::{Map, Value, json};
 use super::{SceneBuilder, TrackDesc};
 use crate::anim::{Interpolation, Track};
 use crate::error::{Result, SceneError};
-use crate::model::{LightKind, Mesh};
+use crate::model::{LightKind, Mesh, WrapMode};
 
 const FILE: &str = "<builder>";
 const ARRAY_BUFFER: u32 = 34962;
@@ -14,7 +14,16 @@ const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
 const UNSIGNED_INT: u32 = 5125;
 
-fn invalid(element: impl Into<String>, problem: impl Into<String>) -> SceneError {
+/// The glTF sampler code of a wrap mode.
+fn wrap_code(mode: WrapMode) -> u32 {
+    match mode {
+        WrapMode::Repeat => 10497,
+        WrapMode::ClampToEdge => 33071,
+        WrapMode::MirroredRepeat => 33648,
+    }
+}
+
+pub(super) fn invalid(element: impl Into<String>, problem: impl Into<String>) -> SceneError {
     SceneError::invalid(FILE, element, problem)
 }
 
@@ -98,7 +107,7 @@ impl Bin {
     }
 }
 
-fn check_finite(element: &str, what: &str, values: &[f32]) -> Result<()> {
+pub(super) fn check_finite(element: &str, what: &str, values: &[f32]) -> Result<()> {
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(invalid(
             element,
@@ -117,6 +126,7 @@ fn check_mesh(element: &str, mesh: &Mesh) -> Result<()> {
         ("normals", mesh.normals.len()),
         ("uvs", mesh.uvs.len()),
         ("tangents", mesh.tangents.len()),
+        ("colors", mesh.colors.len()),
     ] {
         if len != 0 && len != n {
             return Err(invalid(element, format!("{len} {what} for {n} positions")));
@@ -190,6 +200,7 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
     // Textures as PNG images in buffer views.
     let mut images = Vec::new();
     let mut textures = Vec::new();
+    let mut samplers = Vec::new();
     for (i, t) in b.textures.iter().enumerate() {
         let element = format!("texture {i}");
         let expected = 4 * t.width as usize * t.height as usize;
@@ -210,95 +221,15 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
         .map_err(|e| invalid(element, format!("PNG encoding: {e}")))?;
         let view = bin.view(&png, None);
         images.push(json!({"bufferView": view, "mimeType": "image/png"}));
-        textures.push(json!({"source": i}));
-    }
-
-    let tex = |h: Option<super::TextureHandle>, element: &str| -> Result<Option<Value>> {
-        match h {
-            None => Ok(None),
-            Some(h) if h.0 < b.textures.len() => Ok(Some(json!({"index": h.0}))),
-            Some(h) => Err(invalid(
-                element,
-                format!("texture handle {} from another builder", h.0),
-            )),
-        }
-    };
-
-    let mut materials = Vec::new();
-    for (i, m) in b.materials.iter().enumerate() {
-        let element = format!("material {i} '{}'", m.name);
-        check_finite(
-            &element,
-            "factors",
-            &[
-                m.base_color.x,
-                m.base_color.y,
-                m.base_color.z,
-                m.base_color.w,
-                m.metallic,
-                m.roughness,
-                m.emissive.x,
-                m.emissive.y,
-                m.emissive.z,
-                m.emissive_strength,
-                m.transmission,
-                m.ior,
-            ],
-        )?;
-        let mut pbr = json!({
-            "baseColorFactor": m.base_color.to_array(),
-            "metallicFactor": m.metallic,
-            "roughnessFactor": m.roughness,
-        });
-        if let Some(t) = tex(m.base_color_texture, &element)? {
-            pbr["baseColorTexture"] = t;
-        }
-        if let Some(t) = tex(m.metallic_roughness_texture, &element)? {
-            pbr["metallicRoughnessTexture"] = t;
-        }
-        let mut mat = json!({"pbrMetallicRoughness": pbr, "doubleSided": m.double_sided});
-        if !m.name.is_empty() {
-            mat["name"] = json!(m.name);
-        }
-        let peak = m.emissive.max_element();
-        let (factor, strength) = if peak > 1.0 {
-            (m.emissive / peak, m.emissive_strength * peak)
+        if (t.wrap_s, t.wrap_t) == (WrapMode::Repeat, WrapMode::Repeat) {
+            textures.push(json!({"source": i}));
         } else {
-            (m.emissive, m.emissive_strength)
-        };
-        mat["emissiveFactor"] = json!(factor.to_array());
-        if let Some(t) = tex(m.emissive_texture, &element)? {
-            mat["emissiveTexture"] = t;
+            textures.push(json!({"source": i, "sampler": samplers.len()}));
+            samplers.push(json!({"wrapS": wrap_code(t.wrap_s), "wrapT": wrap_code(t.wrap_t)}));
         }
-        if let Some(t) = tex(m.normal_texture, &element)? {
-            mat["normalTexture"] = t;
-        }
-        let mut ext = Map::new();
-        if strength != 1.0 {
-            ext.insert(
-                "KHR_materials_emissive_strength".into(),
-                json!({"emissiveStrength": strength}),
-            );
-        }
-        if m.transmission != 0.0 {
-            ext.insert(
-                "KHR_materials_transmission".into(),
-                json!({"transmissionFactor": m.transmission}),
-            );
-        }
-        if m.ior != 1.5 {
-            ext.insert("KHR_materials_ior".into(), json!({"ior": m.ior}));
-        }
-        for key in ext.keys() {
-            if !used.contains(key) {
-                used.push(key.clone());
-            }
-        }
-        if !ext.is_empty() {
-            mat["extensions"] = Value::Object(ext);
-        }
-        materials.push(mat);
     }
+
+    let materials = super::material::materials(b, &mut used)?;
 
     let mut meshes = Vec::new();
     for (i, mesh) in b.meshes.iter().enumerate() {
@@ -333,6 +264,17 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
                 check_finite(&element, "uvs", &uv)?;
                 let a = bin.floats(&uv, 2, "VEC2", false, Some(ARRAY_BUFFER));
                 attributes.insert("TEXCOORD_0".into(), json!(a));
+            }
+            if !geometry.colors.is_empty() {
+                let c: Vec<f32> = geometry.colors.iter().flat_map(|v| v.to_array()).collect();
+                if let Some(i) = c.iter().position(|v| !(0.0..=1.0).contains(v)) {
+                    return Err(invalid(
+                        &element,
+                        format!("colors: component {i} is {} outside [0, 1]", c[i]),
+                    ));
+                }
+                let a = bin.floats(&c, 4, "VEC4", false, Some(ARRAY_BUFFER));
+                attributes.insert("COLOR_0".into(), json!(a));
             }
             if !geometry.tangents.is_empty() {
                 let t: Vec<f32> = geometry
@@ -471,7 +413,7 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
     }
 
     let mut channels = Vec::new();
-    let mut samplers = Vec::new();
+    let mut anim_samplers = Vec::new();
     for (k, (node, track)) in b.tracks.iter().enumerate() {
         let element = format!("track {k} (node {})", node.0);
         if node.0 >= b.nodes.len() {
@@ -494,8 +436,10 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
                 track_accessors(&mut bin, &element, t, 4, "VEC4", |v| v.to_array().to_vec())?,
             ),
         };
-        channels.push(json!({"sampler": samplers.len(), "target": {"node": node.0, "path": path}}));
-        samplers.push(json!({
+        channels.push(
+            json!({"sampler": anim_samplers.len(), "target": {"node": node.0, "path": path}}),
+        );
+        anim_samplers.push(json!({
             "input": input,
             "output": output,
             "interpolation": interpolation_name(interpolation),
@@ -520,13 +464,14 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
     put("materials", materials);
     put("images", images);
     put("textures", textures);
+    put("samplers", samplers);
     put("cameras", cameras);
     put("accessors", bin.accessors);
     put("bufferViews", bin.views);
     if !channels.is_empty() {
         put(
             "animations",
-            vec![json!({"name": "animation", "channels": channels, "samplers": samplers})],
+            vec![json!({"name": "animation", "channels": channels, "samplers": anim_samplers})],
         );
     }
     if !lights.is_empty() {

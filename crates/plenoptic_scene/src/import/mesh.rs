@@ -1,7 +1,5 @@
-//! Primitives to [`Mesh`]es (with normals and tangents computed where missing) and glTF
-//! materials to [`Material`]s with decoded textures.
-
-use std::collections::HashMap;
+//! Primitives to [`Mesh`]es: positions, indices, normals and tangents (computed where
+//! missing), texture coordinates and `COLOR_0` vertex colours.
 
 use glam::{Vec2, Vec3, Vec4};
 use gltf::Semantic;
@@ -9,7 +7,7 @@ use gltf::accessor::Dimensions;
 
 use super::data::Data;
 use crate::error::Result;
-use crate::model::{Material, Mesh, Texture, TextureRef};
+use crate::model::Mesh;
 
 /// Reads one triangle primitive. `label` names it in errors (`mesh 2 primitive 0`).
 pub(super) fn read_primitive(
@@ -90,6 +88,10 @@ pub(super) fn read_primitive(
         let uv = data.read_floats(&accessor, Dimensions::Vec2, true, "TEXCOORD_0")?;
         mesh.uvs = uv.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect();
     }
+    if let Some(accessor) = primitive.get(&Semantic::Colors(0)) {
+        same_count(&accessor, "COLOR_0")?;
+        mesh.colors = read_colors(data, &accessor)?;
+    }
     if let Some(accessor) = primitive.get(&Semantic::Tangents) {
         same_count(&accessor, "TANGENT")?;
         let t = data.read_floats(&accessor, Dimensions::Vec4, false, "TANGENT")?;
@@ -104,6 +106,56 @@ pub(super) fn read_primitive(
         mesh.tangents = uv_tangents(&mesh);
     }
     Ok(mesh)
+}
+
+/// `COLOR_0`: VEC3 or VEC4 of floats or normalised unsigned bytes/shorts (glTF 2.0 §3.7.2.1),
+/// as linear RGBA (alpha 1 for VEC3). Float values must lie in [0, 1] as the specification
+/// requires; anything else is an error naming the accessor.
+fn read_colors(data: &Data, accessor: &gltf::Accessor) -> Result<Vec<Vec4>> {
+    use gltf::accessor::DataType;
+    let element = format!("accessor {}", accessor.index());
+    let dims = accessor.dimensions();
+    let components = match dims {
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
+        other => {
+            return Err(data.err(
+                element,
+                format!("COLOR_0 must be Vec3 or Vec4, found {other:?}"),
+            ));
+        }
+    };
+    let ty = accessor.data_type();
+    if !(ty == DataType::F32
+        || (matches!(ty, DataType::U8 | DataType::U16) && accessor.normalized()))
+    {
+        return Err(data.err(
+            element,
+            format!(
+                "COLOR_0 must be float or normalized unsigned byte/short, found {ty:?}{}",
+                if accessor.normalized() {
+                    " (normalized)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let values = data.read_floats(accessor, dims, true, "COLOR_0")?;
+    if let Some(i) = values.iter().position(|v| !(0.0..=1.0).contains(v)) {
+        return Err(data.err(
+            element,
+            format!(
+                "COLOR_0: value {} at element {} outside [0, 1]",
+                values[i],
+                i / components
+            ),
+        ));
+    }
+    Ok(values
+        .chunks_exact(components)
+        .map(|c| Vec4::new(c[0], c[1], c[2], c.get(3).copied().unwrap_or(1.0)))
+        .collect())
 }
 
 fn to_vec3(v: &[f32]) -> Vec<Vec3> {
@@ -158,133 +210,6 @@ pub(crate) fn uv_tangents(mesh: &Mesh) -> Vec<Vec4> {
             t.extend(w)
         })
         .collect()
-}
-
-/// Materials and their decoded textures, each texture decoded once per colour space.
-#[derive(Default)]
-pub(super) struct Materials {
-    pub(super) textures: Vec<Texture>,
-    cache: HashMap<(usize, bool), usize>,
-}
-
-impl Materials {
-    /// Converts a glTF material; `warnings` collects unsupported texture coordinate sets.
-    pub(super) fn convert(
-        &mut self,
-        data: &Data,
-        material: &gltf::Material,
-        warnings: &mut Vec<String>,
-    ) -> Result<Material> {
-        let label = match material.index() {
-            Some(i) => format!("material {i}"),
-            None => "default material".to_owned(),
-        };
-        let pbr = material.pbr_metallic_roughness();
-        let strength = material.emissive_strength().unwrap_or(1.0);
-        let factors = [pbr.metallic_factor(), pbr.roughness_factor(), strength];
-        if factors
-            .iter()
-            .chain(&pbr.base_color_factor())
-            .chain(&material.emissive_factor())
-            .any(|v| !v.is_finite())
-        {
-            return Err(data.err(label, "non-finite factor"));
-        }
-        let mut texture = |info: Option<(gltf::Texture, u32)>,
-                           srgb: bool,
-                           what: &str|
-         -> Result<Option<TextureRef>> {
-            let Some((tex, set)) = info else {
-                return Ok(None);
-            };
-            if set != 0 {
-                warnings.push(format!(
-                    "{label}: {what} uses TEXCOORD_{set}; only set 0 is imported"
-                ));
-            }
-            Ok(Some(self.texture(data, &tex, srgb)?))
-        };
-        let base_color_texture = texture(
-            pbr.base_color_texture()
-                .map(|i| (i.texture(), i.tex_coord())),
-            true,
-            "base colour texture",
-        )?;
-        let metallic_roughness_texture = texture(
-            pbr.metallic_roughness_texture()
-                .map(|i| (i.texture(), i.tex_coord())),
-            false,
-            "metallic-roughness texture",
-        )?;
-        let emissive_texture = texture(
-            material
-                .emissive_texture()
-                .map(|i| (i.texture(), i.tex_coord())),
-            true,
-            "emissive texture",
-        )?;
-        let normal = material.normal_texture();
-        let normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
-        let normal_texture = texture(
-            normal.map(|n| (n.texture(), n.tex_coord())),
-            false,
-            "normal texture",
-        )?;
-        let base = pbr.base_color_factor();
-        Ok(Material {
-            name: material.name().unwrap_or_default().to_owned(),
-            base_color: Vec4::from_array(base),
-            base_color_texture,
-            metallic: pbr.metallic_factor(),
-            roughness: pbr.roughness_factor(),
-            metallic_roughness_texture,
-            emissive: Vec3::from_array(material.emissive_factor()) * strength,
-            emissive_texture,
-            normal_texture,
-            normal_scale,
-            transmission: material
-                .transmission()
-                .map_or(0.0, |t| t.transmission_factor()),
-            ior: material.ior().unwrap_or(1.5),
-            double_sided: material.double_sided(),
-        })
-    }
-
-    fn texture(&mut self, data: &Data, texture: &gltf::Texture, srgb: bool) -> Result<TextureRef> {
-        let image = texture.source();
-        let key = (image.index(), srgb);
-        if let Some(&index) = self.cache.get(&key) {
-            return Ok(TextureRef { texture: index });
-        }
-        let element = format!("image {}", image.index());
-        let bytes = match image.source() {
-            gltf::image::Source::View { view, .. } => data.view_bytes(&view)?.to_vec(),
-            gltf::image::Source::Uri { uri, .. } => data.resolve_uri(&element, uri)?,
-        };
-        let decoded = image::load_from_memory(&bytes)
-            .map_err(|e| data.err(&element, format!("cannot decode: {e}")))?;
-        let rgba = decoded.to_rgba32f();
-        let (width, height) = rgba.dimensions();
-        let texels = rgba
-            .pixels()
-            .map(|p| {
-                let [r, g, b, a] = p.0;
-                if srgb {
-                    Vec4::new(srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), a)
-                } else {
-                    Vec4::new(r, g, b, a)
-                }
-            })
-            .collect();
-        self.textures.push(Texture {
-            width,
-            height,
-            texels,
-        });
-        let index = self.textures.len() - 1;
-        self.cache.insert(key, index);
-        Ok(TextureRef { texture: index })
-    }
 }
 
 /// The sRGB transfer function's inverse.

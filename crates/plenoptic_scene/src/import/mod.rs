@@ -10,11 +10,21 @@
 //! Only the default scene (or scene 0) is imported. Its nodes are ordered depth first from the
 //! roots in document order, so parents precede children; object ids follow the same order,
 //! one per triangle primitive. Unsupported features — skinning, morph targets, non-triangle
-//! primitives, orthographic cameras, morph weight animation — are named in
-//! [`Scene::warnings`].
+//! primitives, orthographic cameras, morph weight animation, texture coordinate sets other
+//! than 0, extensions other than [`SUPPORTED_EXTENSIONS`] — are named in [`Scene::warnings`]
+//! with the element (`material 2 'Glass'`, `node 'Door'`); the bake prefixes each with the
+//! file. An unsupported extension in `extensionsRequired` is an error.
+//!
+//! Materials keep `alphaMode` and `alphaCutoff` (a negative cutoff is an error),
+//! `KHR_texture_transform` and the sampler's wrap modes on every texture reference, and
+//! primitives their `COLOR_0` (float or normalised unsigned byte/short, VEC3 or VEC4).
 
 mod data;
+mod extensions;
+mod material;
 pub(crate) mod mesh;
+
+pub use self::extensions::SUPPORTED_EXTENSIONS;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -24,7 +34,7 @@ use gltf::accessor::Dimensions;
 use gltf::animation::{Interpolation as GltfInterpolation, Property};
 
 use self::data::Data;
-use self::mesh::Materials;
+use self::material::Materials;
 use crate::anim::{Interpolation, Key, Track, TrsTrack};
 use crate::error::{Result, SceneError};
 use crate::model::{CameraDef, Light, LightKind, Node, Object, Scene, Trs};
@@ -74,10 +84,16 @@ pub fn load_slice(bytes: &[u8], name: &str, base_dir: Option<&Path>) -> Result<S
     })?;
     let gltf::Gltf { document, blob } = gltf;
     let data = Data::load(name, base_dir, &document, blob)?;
+    let raw = extensions::raw_json(bytes);
+    let scene = Scene {
+        warnings: extensions::unsupported_warnings(&document, raw.as_ref()),
+        ..Scene::default()
+    };
     Importer {
         data: &data,
         document: &document,
-        scene: Scene::default(),
+        raw: raw.as_ref(),
+        scene,
         materials: Materials::default(),
         material_map: HashMap::new(),
         mesh_map: HashMap::new(),
@@ -89,6 +105,8 @@ pub fn load_slice(bytes: &[u8], name: &str, base_dir: Option<&Path>) -> Result<S
 struct Importer<'a> {
     data: &'a Data<'a>,
     document: &'a gltf::Document,
+    /// The document's JSON, for extension data the `gltf` crate does not expose.
+    raw: Option<&'a serde_json::Value>,
     scene: Scene,
     materials: Materials,
     /// glTF material index (`None`: the default material) → index in the scene.
@@ -363,9 +381,14 @@ impl Importer<'_> {
         if let Some(&m) = self.material_map.get(&material.index()) {
             return Ok(m);
         }
-        let converted = self
-            .materials
-            .convert(self.data, material, &mut self.scene.warnings)?;
+        let raw = material.index().and_then(|i| {
+            self.raw
+                .and_then(|r| r.get("materials"))
+                .and_then(|m| m.get(i))
+        });
+        let converted =
+            self.materials
+                .convert(self.data, material, raw, &mut self.scene.warnings)?;
         self.scene.materials.push(converted);
         let index = self.scene.materials.len() - 1;
         self.material_map.insert(material.index(), index);

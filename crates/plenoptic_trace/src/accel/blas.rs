@@ -19,7 +19,13 @@ pub(crate) struct BlasTriangle {
     pub index: u32,
 }
 
-/// Möller–Trumbore: returns (t, b1, b2) with the hit at v0 + b1·e1 + b2·e2, both faces.
+/// How far outside [0, 1] a barycentric may fall and still count: rounding makes a ray that
+/// meets the edge shared by two triangles exactly (a camera looking straight down at the
+/// diagonal of a square) miss both without it.
+const EDGE_EPS: f32 = 1e-6;
+
+/// Möller–Trumbore: returns (t, b1, b2) with the hit at v0 + b1·e1 + b2·e2, both faces; a
+/// hit within [`EDGE_EPS`] of an edge counts, so neighbouring triangles leave no crack.
 #[inline(always)]
 pub(crate) fn intersect_triangle(
     v0: Vec3A,
@@ -38,12 +44,12 @@ pub(crate) fn intersect_triangle(
     let inv = 1.0 / det;
     let s = origin - v0;
     let b1 = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&b1) {
+    if !(-EDGE_EPS..=1.0 + EDGE_EPS).contains(&b1) {
         return None;
     }
     let q = s.cross(e1);
     let b2 = dir.dot(q) * inv;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
+    if b2 < -EDGE_EPS || b1 + b2 > 1.0 + EDGE_EPS {
         return None;
     }
     let t = e2.dot(q) * inv;
@@ -113,16 +119,24 @@ impl Blas {
         })
     }
 
-    /// Closest hit of an object-space ray (direction not necessarily unit; t in its units).
+    /// Closest hit of an object-space ray (direction not necessarily unit; t in its units)
+    /// among the candidates `accept(triangle, barycentrics)` keeps: a rejected candidate is no
+    /// hit and traversal goes on past it (an any-hit filter; each triangle is tested once).
     #[inline]
-    pub(crate) fn closest(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<BlasHit> {
+    pub(crate) fn closest(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        tmax: f32,
+        mut accept: impl FnMut(u32, Vec2) -> bool,
+    ) -> Option<BlasHit> {
         let ray = BvhRay::new(origin, dir + Vec3A::ZERO, 0.0, tmax);
         let mut hit = RayHit::none();
         let mut best: Option<BlasHit> = None;
         self.bvh.ray_traverse(ray, &mut hit, |r, slot| {
             let tri = &self.triangles[slot];
             match intersect_triangle(tri.v0, tri.e1, tri.e2, r.origin, r.direction, 0.0, r.tmax) {
-                Some((t, b1, b2)) => {
+                Some((t, b1, b2)) if accept(tri.index, Vec2::new(b1, b2)) => {
                     best = Some(BlasHit {
                         t,
                         triangle: tri.index,
@@ -130,21 +144,28 @@ impl Blas {
                     });
                     t
                 }
-                None => f32::INFINITY,
+                _ => f32::INFINITY,
             }
         });
         best
     }
 
-    /// Whether any triangle lies along the ray before `tmax`.
+    /// Whether any triangle that `accept(triangle, barycentrics)` keeps lies along the ray
+    /// before `tmax`.
     #[inline]
-    pub(crate) fn occluded(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> bool {
+    pub(crate) fn occluded(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        tmax: f32,
+        mut accept: impl FnMut(u32, Vec2) -> bool,
+    ) -> bool {
         let ray = BvhRay::new(origin, dir + Vec3A::ZERO, 0.0, tmax);
         !self.bvh.ray_traverse_miss(ray, |r, slot| {
             let tri = &self.triangles[slot];
             match intersect_triangle(tri.v0, tri.e1, tri.e2, r.origin, r.direction, 0.0, r.tmax) {
-                Some((t, _, _)) => t,
-                None => f32::INFINITY,
+                Some((t, b1, b2)) if accept(tri.index, Vec2::new(b1, b2)) => t,
+                _ => f32::INFINITY,
             }
         })
     }

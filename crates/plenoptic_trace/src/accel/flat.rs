@@ -1,5 +1,5 @@
 //! One flat BVH over every world-space triangle with obvhs's own triangle test: no instances,
-//! no transforms. The benchmark measures the two-level structure against it.
+//! no transforms, no alpha test. The benchmark measures the two-level structure against it.
 
 use glam::{Vec3, Vec3A};
 use obvhs::{

@@ -21,10 +21,11 @@ use obvhs::{
 use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
 use std::time::Duration;
 
+use crate::alpha::{AlphaTest, accepts};
 use crate::camera::Camera;
 use crate::image::Image;
 use crate::light::LightSet;
-use crate::material::sample_texture;
+use crate::texture::sample_ref;
 use crate::{Result, TraceError};
 
 /// A world-space ray: origin, unit direction and the largest distance of interest.
@@ -91,6 +92,8 @@ impl Hit {
 pub struct SceneAccel<'s> {
     scene: &'s Scene,
     blas: Vec<Option<Blas>>,
+    /// Per object id, how its hits are alpha-tested.
+    alpha: Vec<AlphaTest>,
 }
 
 /// One object placed in the world.
@@ -131,7 +134,8 @@ impl<'s> SceneAccel<'s> {
         if !drawable {
             return Err(TraceError::EmptyScene);
         }
-        Ok(Self { scene, blas })
+        let alpha = AlphaTest::per_object(scene);
+        Ok(Self { scene, blas, alpha })
     }
 
     /// The scene.
@@ -231,7 +235,8 @@ impl<'a> PlacedScene<'a> {
         }
     }
 
-    /// The closest hit along `ray`, if any.
+    /// The closest hit along `ray`, if any. Hits that the material's alpha removes (glTF MASK
+    /// below the cutoff, BLEND by coverage; see [`crate::alpha`]) are passed through.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let origin = Vec3A::from(ray.origin);
         // −0.0 components would disagree with obvhs's sign tests (its safe inverse keeps the sign
@@ -247,7 +252,13 @@ impl<'a> PlacedScene<'a> {
             };
             let o = inst.to_object.transform_point3a(r.origin);
             let d = inst.to_object.transform_vector3a(r.direction);
-            match blas.closest(o, d, r.tmax) {
+            let hit = match self.accel.alpha[inst.object as usize] {
+                AlphaTest::Opaque => blas.closest(o, d, r.tmax, |_, _| true),
+                test => blas.closest(o, d, r.tmax, |tri, bary| {
+                    self.accepts(test, inst, tri, bary, ray)
+                }),
+            };
+            match hit {
                 Some(h) => {
                     best = Some((slot, h));
                     h.t
@@ -259,7 +270,8 @@ impl<'a> PlacedScene<'a> {
         Some(self.make_hit(ray, &self.instances[slot], h))
     }
 
-    /// Whether anything lies along `ray` before `ray.tmax`.
+    /// Whether anything lies along `ray` before `ray.tmax`, with the same alpha test as
+    /// [`PlacedScene::intersect`].
     pub fn occluded(&self, ray: &Ray) -> bool {
         let origin = Vec3A::from(ray.origin);
         // −0.0 components would disagree with obvhs's sign tests (its safe inverse keeps the sign
@@ -273,12 +285,37 @@ impl<'a> PlacedScene<'a> {
             };
             let o = inst.to_object.transform_point3a(r.origin);
             let d = inst.to_object.transform_vector3a(r.direction);
-            if blas.occluded(o, d, r.tmax) {
-                0.0
-            } else {
-                f32::INFINITY
-            }
+            let blocked = match self.accel.alpha[inst.object as usize] {
+                AlphaTest::Opaque => blas.occluded(o, d, r.tmax, |_, _| true),
+                test => blas.occluded(o, d, r.tmax, |tri, bary| {
+                    self.accepts(test, inst, tri, bary, ray)
+                }),
+            };
+            if blocked { 0.0 } else { f32::INFINITY }
         })
+    }
+
+    /// Whether a candidate hit of world ray `ray` on `inst` survives the alpha test.
+    #[inline]
+    fn accepts(
+        &self,
+        test: AlphaTest,
+        inst: &Instance,
+        triangle: u32,
+        bary: Vec2,
+        ray: &Ray,
+    ) -> bool {
+        let scene = self.accel.scene;
+        accepts(
+            test,
+            scene,
+            inst.object,
+            &scene.meshes[inst.mesh],
+            triangle,
+            bary,
+            ray.origin,
+            ray.direction,
+        )
     }
 
     /// Whether the segment from `a` to `b` is blocked (both ends excluded by a small margin).
@@ -329,7 +366,7 @@ impl<'a> PlacedScene<'a> {
             if t != Vec3::ZERO {
                 let sign = if mesh.tangents[i0].w < 0.0 { -1.0 } else { 1.0 };
                 let b = ns.cross(t) * sign;
-                let m = sample_texture(&scene.textures[tex.texture], uv);
+                let m = sample_ref(scene, &tex, uv);
                 let s = material.normal_scale;
                 let local = Vec3::new(
                     (m.x * 2.0 - 1.0) * s,
