@@ -15,8 +15,8 @@ use bevy::asset::LoadState;
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamingStats;
-use pack::{PackSpec, room, write_pack};
 use common::*;
+use pack::{PackSpec, room, write_pack};
 use plenoptic_pack::{ChunkKind, PackReader};
 
 fn make_pack(dir: &std::path::Path) -> std::path::PathBuf {

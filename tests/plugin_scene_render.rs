@@ -16,8 +16,8 @@ use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::proxy::ProxyOf;
 use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
 use bevy_plenoptic::streaming::{StreamState, StreamingStats, key_bytes};
-use pack::{PackSpec, room, write_pack};
 use common::*;
+use pack::{PackSpec, room, write_pack};
 
 fn room_pack(dir: &std::path::Path, views: usize) {
     write_pack(

@@ -55,8 +55,8 @@ pub fn render_reference(
             .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
         let placed = accel.at_time(f.scene_time);
         let image = tracer.render(&placed, &camera).radiance();
-        let e = *exposure
-            .get_or_insert_with(|| plenoptic_eval::frame_io::auto_exposure(&image.pixels));
+        let e =
+            *exposure.get_or_insert_with(|| plenoptic_eval::frame_io::auto_exposure(&image.pixels));
         plenoptic_eval::tools::write_frame_files(
             out,
             f.index,

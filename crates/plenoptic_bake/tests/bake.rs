@@ -446,7 +446,10 @@ fn reference_render_and_compare_commands() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(stdout.contains("rel. LRMS") && stdout.contains("\nimage "), "{stdout}");
+    assert!(
+        stdout.contains("rel. LRMS") && stdout.contains("\nimage "),
+        "{stdout}"
+    );
     assert!(csv.exists() && plot.exists() && plot.with_extension("svg").exists());
 
     // Variance-corrected against the two halves.
@@ -478,7 +481,9 @@ fn reference_render_and_compare_commands() {
     );
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
-        text.starts_with("frame,noise_floor,image_lrms_corrected,image_lrms,image_psnr,image_mean_ratio"),
+        text.starts_with(
+            "frame,noise_floor,image_lrms_corrected,image_lrms,image_psnr,image_mean_ratio"
+        ),
         "{text}"
     );
     assert_eq!(text.lines().count(), 3, "{text}");

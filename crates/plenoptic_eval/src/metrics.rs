@@ -28,9 +28,9 @@
 //! ratio mean(x)/mean(m) shows a bias that noise would otherwise hide.
 
 use glam::Vec3;
+use plenoptic_trace::Image;
 pub use plenoptic_trace::image::luminance;
 pub use plenoptic_trace::metrics::{psnr, relative_lrms};
-use plenoptic_trace::Image;
 
 /// Mean luminance of `test` over mean luminance of `reference` (NaN for a black reference
 /// or images of different sizes).
@@ -214,7 +214,11 @@ mod tests {
         let small = Image::render(4, 4, |_, _| Vec3::ONE);
         assert!(corrected_relative_lrms(&small, &s, &s).corrected.is_nan());
         let black = Image::render(W, H, |_, _| Vec3::ZERO);
-        assert!(corrected_relative_lrms(&s, &black, &black).corrected.is_nan());
+        assert!(
+            corrected_relative_lrms(&s, &black, &black)
+                .corrected
+                .is_nan()
+        );
         assert!(mean_luminance_ratio(&s, &black).is_nan());
         assert_eq!(corrected_relative_lrms(&s, &s, &s).corrected, 0.0);
     }

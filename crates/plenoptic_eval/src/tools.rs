@@ -21,8 +21,7 @@ use plenoptic_trace::Image;
 
 use crate::frame_io::{auto_exposure, read_exr, write_exr, write_png};
 use crate::metrics::{
-    CorrectedLrms, corrected_relative_lrms, mean_image, mean_luminance_ratio, psnr,
-    relative_lrms,
+    CorrectedLrms, corrected_relative_lrms, mean_image, mean_luminance_ratio, psnr, relative_lrms,
 };
 use crate::{EvalError, Result};
 
@@ -416,7 +415,8 @@ pub fn compare_with(
                 ),
                 None => (f64::NAN, f64::NAN, f64::NAN),
             };
-            m.relative_lrms.push(if l.is_finite() { l } else { f64::NAN });
+            m.relative_lrms
+                .push(if l.is_finite() { l } else { f64::NAN });
             m.psnr.push(if p.is_finite() || p == f64::INFINITY {
                 p
             } else {
@@ -424,9 +424,9 @@ pub fn compare_with(
             });
             m.mean_ratio.push(r);
             if let Some(b) = &b {
-                let cm = c
-                    .as_ref()
-                    .map_or(CorrectedLrms::NAN, |img| corrected_relative_lrms(img, &a, b));
+                let cm = c.as_ref().map_or(CorrectedLrms::NAN, |img| {
+                    corrected_relative_lrms(img, &a, b)
+                });
                 m.corrected_lrms.push(cm.corrected);
                 if cm.noise_floor.is_finite() {
                     frame_floor = cm.noise_floor;

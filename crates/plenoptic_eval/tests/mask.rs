@@ -61,7 +61,11 @@ fn reconstruction_from_the_ray_cast_mask_matches_the_rasterized_one() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("mask.pack");
     let scene = room(true);
-    write_pack(&scene, &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 16), &path);
+    write_pack(
+        &scene,
+        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 16),
+        &path,
+    );
     let rec = Reconstructor::open(&path).unwrap();
     let proxy = rec.proxy().unwrap();
     let proxies = proxy_scene(proxy);

@@ -139,7 +139,10 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
     assert!(floor > 0.05, "{floor}");
     for (m, clean) in cmp.candidates.iter().zip(&metrics) {
         let (c, u, truth) = (m.mean_corrected_lrms(), m.mean_lrms(), clean.mean_lrms());
-        println!("{}: corrected {c:.4}, uncorrected {u:.4}, clean {truth:.4}", m.label);
+        println!(
+            "{}: corrected {c:.4}, uncorrected {u:.4}, clean {truth:.4}",
+            m.label
+        );
         assert!(u > c, "{m:?}");
         assert!((c - truth).abs() < 0.25 * truth + 0.01, "{c} vs {truth}");
     }

@@ -176,7 +176,10 @@ mod tests {
         let b = c.basis();
         // The centre pixel's ray points at the target.
         let centre = b.direction(20.0, 15.0);
-        assert!(centre.abs_diff_eq(-c.position.normalize(), 1e-5), "{centre}");
+        assert!(
+            centre.abs_diff_eq(-c.position.normalize(), 1e-5),
+            "{centre}"
+        );
         for (x, y) in [(0, 0), (39, 29), (13, 7)] {
             let d = b.direction(x as f32 + 0.5, y as f32 + 0.5);
             let (px, py, _) = b.project(c.position + d * 2.5).unwrap();

@@ -90,8 +90,8 @@ pub mod warp;
 
 pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
-pub use path::{CameraPath, Keyframe, PathSample};
 pub use motion::ObjectMotion;
+pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
 pub use reconstructor::{CubeFilter, ReconSettings, Reconstructor};
 

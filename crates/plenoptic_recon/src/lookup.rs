@@ -648,6 +648,10 @@ mod tests {
                 );
             }
         }
-        assert_eq!(powi4(Vec4::splat(0.5), 3).x, 0.125, "exact where no rounding occurs");
+        assert_eq!(
+            powi4(Vec4::splat(0.5), 3).x,
+            0.125,
+            "exact where no rounding occurs"
+        );
     }
 }

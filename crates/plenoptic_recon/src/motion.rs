@@ -114,7 +114,13 @@ impl ObjectMotion {
     }
 
     /// The channels kept (translation, rotation, scale), as the pack stores them.
-    pub fn tracks(&self) -> (Option<&Track<Vec3>>, Option<&Track<Quat>>, Option<&Track<Vec3>>) {
+    pub fn tracks(
+        &self,
+    ) -> (
+        Option<&Track<Vec3>>,
+        Option<&Track<Quat>>,
+        Option<&Track<Vec3>>,
+    ) {
         (
             self.translation.as_ref().map(|c| &c.0),
             self.rotation.as_ref().map(|c| &c.0),
@@ -125,8 +131,12 @@ impl ObjectMotion {
     /// Translation, rotation and scale at time `t`.
     pub fn sample(&self, t: f32) -> (Vec3, Quat, Vec3) {
         (
-            self.translation.as_ref().map_or(Vec3::ZERO, |c| c.sample(t)),
-            self.rotation.as_ref().map_or(Quat::IDENTITY, |c| c.sample(t)),
+            self.translation
+                .as_ref()
+                .map_or(Vec3::ZERO, |c| c.sample(t)),
+            self.rotation
+                .as_ref()
+                .map_or(Quat::IDENTITY, |c| c.sample(t)),
             self.scale.as_ref().map_or(Vec3::ONE, |c| c.sample(t)),
         )
     }
@@ -167,7 +177,10 @@ mod tests {
             )),
         });
         let (t, r, s) = m.sample(0.5);
-        assert_eq!((t, r, s), (Vec3::new(0.5, 0.0, 0.0), Quat::IDENTITY, Vec3::ONE));
+        assert_eq!(
+            (t, r, s),
+            (Vec3::new(0.5, 0.0, 0.0), Quat::IDENTITY, Vec3::ONE)
+        );
         assert_eq!(m.sample(1.5).2, Vec3::splat(2.0));
         assert_eq!(m.sample(-1.0).0, Vec3::ZERO);
         assert_eq!(m.sample(9.0).0, Vec3::new(2.0, 0.0, 0.0));
@@ -197,7 +210,11 @@ mod tests {
         for s in [0.0f32, 0.25, 0.5, 0.9, 1.0] {
             assert!((m.sample(s).0.x - s.powi(3)).abs() < 1e-5, "{s}");
         }
-        assert!(m.sample(0.5).1.abs_diff_eq(Quat::from_rotation_y(0.5), 1e-5));
+        assert!(
+            m.sample(0.5)
+                .1
+                .abs_diff_eq(Quat::from_rotation_y(0.5), 1e-5)
+        );
     }
 
     #[test]

@@ -150,7 +150,11 @@ impl ProxyGeometry {
         }
         let pack_ids: Vec<u32> = proxies.iter().map(|p| p.id).collect();
         Some(ProxyGeometry {
-            index_of: pack_ids.iter().enumerate().map(|(i, &id)| (id, i)).collect(),
+            index_of: pack_ids
+                .iter()
+                .enumerate()
+                .map(|(i, &id)| (id, i))
+                .collect(),
             pack_ids,
             meshes: proxies
                 .iter()

@@ -212,7 +212,10 @@ pub(crate) fn raster_band(
 }
 
 /// Rasterizes `objects` (pack id, object-to-world transform, mesh) for `camera`.
-pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)]) -> GeometryMask {
+pub(crate) fn rasterize(
+    camera: &Camera,
+    objects: &[(u32, Affine3A, &TriangleMesh)],
+) -> GeometryMask {
     let b = camera.basis();
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tris = project(camera, objects);
