@@ -8,7 +8,7 @@
 //! one BVH per object once ([`RayCastMask::new`]) and rebuilds only the top level per frame.
 //! The scene is borrowed, so the caller keeps it alive:
 //!
-//! ```ignore
+//! ```text
 //! let scene = proxy_scene(proxy);
 //! let caster = RayCastMask::new(&scene, proxy)?;
 //! let mask = caster.mask(&camera, t);
