@@ -63,11 +63,11 @@ pub fn convert_track<T: Copy>(track: &PackTrack<T>) -> Option<Track<T>> {
 
 /// An object's motion as the scene crate's node track.
 pub fn trs_track(motion: &ObjectMotion) -> TrsTrack {
-    let (translation, rotation, scale) = motion.tracks();
+    let tracks = motion.tracks();
     TrsTrack {
-        translation: translation.and_then(convert_track),
-        rotation: rotation.and_then(convert_track),
-        scale: scale.and_then(convert_track),
+        translation: tracks.translation.and_then(convert_track),
+        rotation: tracks.rotation.and_then(convert_track),
+        scale: tracks.scale.and_then(convert_track),
     }
 }
 

@@ -94,6 +94,17 @@ impl<T: Channel> Checked<T> {
     }
 }
 
+/// The channels of an [`ObjectMotion`], borrowed ([`ObjectMotion::tracks`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionTracks<'a> {
+    /// Translation, if the object has a usable one.
+    pub translation: Option<&'a Track<Vec3>>,
+    /// Rotation, if any.
+    pub rotation: Option<&'a Track<Quat>>,
+    /// Scale, if any.
+    pub scale: Option<&'a Track<Vec3>>,
+}
+
 /// The motion of one object: its pack tracks, ready to be evaluated at any time.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ObjectMotion {
@@ -114,18 +125,12 @@ impl ObjectMotion {
     }
 
     /// The channels kept (translation, rotation, scale), as the pack stores them.
-    pub fn tracks(
-        &self,
-    ) -> (
-        Option<&Track<Vec3>>,
-        Option<&Track<Quat>>,
-        Option<&Track<Vec3>>,
-    ) {
-        (
-            self.translation.as_ref().map(|c| &c.0),
-            self.rotation.as_ref().map(|c| &c.0),
-            self.scale.as_ref().map(|c| &c.0),
-        )
+    pub fn tracks(&self) -> MotionTracks<'_> {
+        MotionTracks {
+            translation: self.translation.as_ref().map(|c| &c.0),
+            rotation: self.rotation.as_ref().map(|c| &c.0),
+            scale: self.scale.as_ref().map(|c| &c.0),
+        }
     }
 
     /// Translation, rotation and scale at time `t`.
