@@ -66,7 +66,7 @@ fn bench(c: &mut Criterion) {
         samples_per_pixel: PATH_SPP,
         ..PathTracerSettings::default()
     });
-    let pin = camera(640, 360).to_pinhole().unwrap();
+    let pin = plenoptic_eval::camera::to_pinhole(&camera(640, 360)).unwrap();
     group.bench_function(format!("path_tracer_{PATH_SPP}spp/640x360"), |b| {
         b.iter(|| {
             let placed = accel.at_time(T);

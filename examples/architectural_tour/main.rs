@@ -78,8 +78,8 @@ use image::{Delay, Frame as GifFrame, RgbaImage};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plenoptic_bake::BakeOptions;
 use plenoptic_bake::progress::Progress;
-use plenoptic_recon::frame_io::{auto_exposure, tonemap, write_png};
-use plenoptic_recon::tools::frame_name;
+use plenoptic_eval::frame_io::{auto_exposure, tonemap, write_png};
+use plenoptic_eval::tools::frame_name;
 use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor};
 use plenoptic_scene::recipe::Recipe;
 

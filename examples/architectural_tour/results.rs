@@ -22,8 +22,8 @@ use std::time::Instant;
 
 use image::{Rgb, RgbImage};
 use plenoptic_bake::progress::Progress;
+use plenoptic_eval::tools::{compare, frame_name, write_frame_files};
 use plenoptic_pack::{ChunkKind, PackReader};
-use plenoptic_recon::tools::{compare, frame_name, write_frame_files};
 use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor};
 
 use crate::BoxError;
@@ -238,7 +238,7 @@ fn figures(
     o: &ResultsOptions,
     reference: &plenoptic_bake::reference::ReferenceSummary,
     results: &[ModeResult],
-    floor: &plenoptic_recon::tools::CandidateMetrics,
+    floor: &plenoptic_eval::tools::CandidateMetrics,
 ) -> Result<String, BoxError> {
     const MIB: f64 = 1024.0 * 1024.0;
     let reader = PackReader::open(pack)?;

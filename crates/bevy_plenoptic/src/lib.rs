@@ -2,7 +2,7 @@
 //!
 //! The Bevy plugin of plenoptic: it streams a radiance pack and reconstructs globally
 //! illuminated frames for the camera's position and the current time (thesis chapters 6–7
-//! and 8.2.3; `design.md`, "The runtime plugin").
+//! and 8.2.3; `docs/architecture.md`, "The runtime plugin").
 //!
 //! - [`asset`]: the [`RadiancePack`] asset; its loader reads only the header, manifest and
 //!   directory (and the small proxy meshes and tracks), never a cube.

@@ -1,7 +1,7 @@
 //! # plenoptic_bake
 //!
 //! The baker: turns a bake recipe and its animated glTF scenes into a radiance pack
-//! (design.md, "Baking", steps 4–8), following the "recipe" of Nimeroff's thesis (1997),
+//! (docs/architecture.md, "Baking", steps 4–8), following the "recipe" of Nimeroff's thesis (1997),
 //! chapter 6 (decomposition of space by id-image coherence, of time by light and view
 //! id-images, of indirect illumination by irradiance RMS) and chapter 7 (temporal volumes).
 //!
@@ -24,8 +24,8 @@
 //!
 //! The `plenoptic` command (`src/main.rs`) exposes `plan`, `bake` (`--resume`,
 //! `--shard i/N`, `--volume-complex`), `merge`, `inspect`, `reference` (path-traced frames
-//! along a camera path), and `render` / `compare` (reconstruction and metrics from
-//! `plenoptic_recon::tools`). Cluster use: `docs/baking-on-a-cluster.md`.
+//! along a camera path, `--halves` for two independent halves), and `render` / `compare`
+//! (reconstruction and variance-corrected metrics from `plenoptic_eval::tools`). Cluster use: `docs/baking-on-a-cluster.md`.
 //!
 //! Decisions the design leaves open, documented in the modules: object ids are stored as scene
 //! id + 1 (0 = none, [`render::pack_object_id`]); the decomposition of space uses the scene at

@@ -5,10 +5,17 @@
 //! plenoptic bake RECIPE [--resume] [--shard i/N] [--keep-work] [--timings-in-manifest] [-q]
 //! plenoptic merge RECIPE [--keep-work]              join shards into the pack
 //! plenoptic inspect PACK [--chunks] [--extract N OUT]
-//! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--exposure E]
+//! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
+//!                    [--exposure E]
 //! plenoptic render PACK --path PATH.json [--mode image|volume|geometry] --out DIR
-//! plenoptic compare --reference DIR [LABEL=]DIR... [--csv OUT.csv] [--plot OUT.png]
+//! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
+//!                   [--plot OUT.svg]
 //! ```
+//!
+//! Variance-corrected comparison: `plenoptic reference … --out ref --halves` renders two
+//! independent halves (`ref` and `ref_b`, half the samples each, different seeds); then
+//! `plenoptic compare --reference ref --reference-b ref_b …` compares against their mean and
+//! subtracts the reference's estimated variance (`plenoptic_eval::metrics`).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -107,20 +114,31 @@ enum Command {
         #[arg(long, default_value = "frames")]
         out: PathBuf,
     },
-    /// Compare frame directories with a reference directory: relative LRMS and PSNR per frame
-    /// (CSV) and an error-along-path plot (PNG).
+    /// Compare frame directories with a reference directory: relative LRMS, PSNR and the
+    /// mean-luminance ratio per frame (CSV), a table of the means, and an error-along-path
+    /// plot (SVG and PNG).
+    ///
+    /// With --reference-b the reference is the mean of two independent halves A and B, and the
+    /// error is variance-corrected: the reference's per-pixel variance, estimated as
+    /// |A − B|²/4, is subtracted from the mean squared luminance error (clamped at 0) before
+    /// the relative LRMS is taken. The table then shows corrected and uncorrected errors and
+    /// the reference's noise floor (relative LRMS of (A − B)/2).
     Compare {
-        /// The reference frames (from `plenoptic reference`).
+        /// The reference frames (from `plenoptic reference`; the first half with --halves).
         #[arg(long)]
         reference: PathBuf,
+        /// The second, independent half of the reference (same frame names), e.g. the `DIR_b`
+        /// that `plenoptic reference --halves` writes.
+        #[arg(long)]
+        reference_b: Option<PathBuf>,
         /// Candidate frame directories, as DIR or LABEL=DIR.
         #[arg(required = true)]
         candidates: Vec<String>,
         /// The CSV to write.
         #[arg(long, default_value = "compare.csv")]
         csv: PathBuf,
-        /// The plot to write.
-        #[arg(long, default_value = "compare.png")]
+        /// The plot to write: `<stem>.svg` (with text) and `<stem>.png` (curves only).
+        #[arg(long, default_value = "compare.svg")]
         plot: PathBuf,
     },
     /// Render reference frames along a camera path with the path tracer (EXR + PNG).
@@ -133,9 +151,18 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "reference")]
         out: PathBuf,
-        /// Samples per pixel (default: the recipe's reference_samples_per_pixel).
+        /// Samples per pixel (default: the recipe's reference_samples_per_pixel); with
+        /// --halves, the total over both halves.
         #[arg(long)]
         spp: Option<u32>,
+        /// Seed of the random sequence (default 0). References with different seeds are
+        /// independent.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Render two independent halves for `plenoptic compare --reference-b`: OUT with seed S
+        /// and OUT_b with seed S + 1, each with half the samples.
+        #[arg(long)]
+        halves: bool,
         /// Exposure of the PNGs (default: automatic from the first frame).
         #[arg(long)]
         exposure: Option<f32>,
@@ -226,7 +253,7 @@ fn run(command: Command) -> Result<()> {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
                 BakeError::Invalid(format!("mode '{mode}': expected image, volume or geometry"))
             })?;
-            let summary = plenoptic_recon::tools::render_path(&pack, &path, mode, &out, true)
+            let summary = plenoptic_eval::tools::render_path(&pack, &path, mode, &out, true)
                 .map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
             println!(
                 "{} frames in {} ({:.1} ms per frame), report {}",
@@ -239,6 +266,7 @@ fn run(command: Command) -> Result<()> {
         }
         Command::Compare {
             reference,
+            reference_b,
             candidates,
             csv,
             plot,
@@ -256,12 +284,21 @@ fn run(command: Command) -> Result<()> {
                     }
                 })
                 .collect();
-            let metrics = plenoptic_recon::tools::compare(&reference, &candidates, &csv, &plot)
-                .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
-            for m in &metrics {
-                println!("{}: mean relative LRMS {:.4}", m.label, m.mean_lrms());
-            }
-            println!("wrote {} and {}", csv.display(), plot.display());
+            let comparison = plenoptic_eval::tools::compare_with(
+                &reference,
+                reference_b.as_deref(),
+                &candidates,
+                &csv,
+                &plot,
+            )
+            .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
+            print!("{}", comparison.table());
+            let plots: Vec<String> = comparison
+                .plots
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
+            println!("wrote {} and {}", csv.display(), plots.join(", "));
             Ok(())
         }
         Command::Reference {
@@ -269,8 +306,10 @@ fn run(command: Command) -> Result<()> {
             path,
             out,
             spp,
+            seed,
+            halves,
             exposure,
-        } => cmd_reference(&recipe, &path, &out, spp, exposure),
+        } => cmd_reference(&recipe, &path, &out, spp, seed, halves, exposure),
     }
 }
 
@@ -441,25 +480,51 @@ fn cmd_reference(
     path: &Path,
     out: &Path,
     spp: Option<u32>,
+    seed: Option<u64>,
+    halves: bool,
     exposure: Option<f32>,
 ) -> Result<()> {
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
     let frames = plenoptic_bake::reference::path_frames(path)?;
     let spp = spp.unwrap_or(recipe.quality.reference_samples_per_pixel);
-    let summary = plenoptic_bake::reference::render_reference(
-        &scene,
-        &frames,
-        spp,
-        None,
-        out,
-        exposure,
-        &Progress::new(true),
-    )?;
-    println!(
-        "{} reference frames written to {} ({:.1} s per frame at {spp} spp)",
-        summary.frames,
-        out.display(),
-        summary.seconds_per_frame
-    );
+    let seed = seed.unwrap_or(0);
+    // Two halves: half the samples each, seeds S and S + 1 (independent streams), the same
+    // exposure for both PNG sets.
+    let runs: Vec<(PathBuf, u32, u64)> = if halves {
+        let mut b = out.as_os_str().to_owned();
+        b.push("_b");
+        let half = spp.div_ceil(2).max(1);
+        vec![
+            (out.to_path_buf(), half, seed),
+            (PathBuf::from(b), half, seed.wrapping_add(1)),
+        ]
+    } else {
+        vec![(out.to_path_buf(), spp, seed)]
+    };
+    let mut exposure = exposure;
+    for (dir, spp, seed) in runs {
+        let summary = plenoptic_bake::reference::render_reference(
+            &scene,
+            &frames,
+            spp,
+            Some(seed),
+            &dir,
+            exposure,
+            &Progress::new(true),
+        )?;
+        exposure = Some(summary.exposure);
+        println!(
+            "{} reference frames written to {} ({:.1} s per frame at {spp} spp, seed {seed})",
+            summary.frames,
+            dir.display(),
+            summary.seconds_per_frame
+        );
+    }
+    if halves {
+        println!(
+            "compare with: plenoptic compare --reference {0} --reference-b {0}_b …",
+            out.display()
+        );
+    }
     Ok(())
 }

@@ -51,15 +51,13 @@ pub fn render_reference(
     let mut exposure = exposure;
     let clock = Instant::now();
     for f in samples {
-        let camera = f
-            .camera
-            .to_pinhole()
+        let camera = plenoptic_eval::camera::to_pinhole(&f.camera)
             .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
         let placed = accel.at_time(f.scene_time);
         let image = tracer.render(&placed, &camera).radiance();
-        let e = *exposure
-            .get_or_insert_with(|| plenoptic_recon::frame_io::auto_exposure(&image.pixels));
-        plenoptic_recon::tools::write_frame_files(
+        let e =
+            *exposure.get_or_insert_with(|| plenoptic_eval::frame_io::auto_exposure(&image.pixels));
+        plenoptic_eval::tools::write_frame_files(
             out,
             f.index,
             image.width,

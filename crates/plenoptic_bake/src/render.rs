@@ -1,4 +1,4 @@
-//! Rendering the plan (design.md Baking steps 6–7): range images at every base view and time
+//! Rendering the plan (docs/architecture.md Baking steps 6–7): range images at every base view and time
 //! key (thesis ch. 6) and temporal volumes per base view (thesis ch. 7), with the multi-stage
 //! renderer and the ambient field interpolated linearly in time between its key times.
 //!

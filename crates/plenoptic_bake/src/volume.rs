@@ -1,4 +1,4 @@
-//! Temporal volumes (thesis ch. 7, §7.2 "directional and temporal sampling"; design.md Baking
+//! Temporal volumes (thesis ch. 7, §7.2 "directional and temporal sampling"; docs/architecture.md Baking
 //! step 7).
 //!
 //! The (direction, t) domain of one base view is cut into cells: the six cube faces in an

@@ -1,4 +1,4 @@
-//! Writing the pack (design.md Baking step 8): encoding work items into chunks, proxy geometry
+//! Writing the pack (docs/architecture.md Baking step 8): encoding work items into chunks, proxy geometry
 //! and animation tracks, the manifest, and the assembly of the pack from the work directory
 //! in canonical order.
 //!

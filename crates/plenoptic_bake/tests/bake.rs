@@ -377,7 +377,8 @@ fn reference_render_and_compare_commands() {
             "--out",
             reference.to_str().unwrap(),
             "--spp",
-            "2",
+            "4",
+            "--halves",
         ],
         None,
     );
@@ -386,8 +387,16 @@ fn reference_render_and_compare_commands() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(reference.join("frame_00000.exr").exists());
-    assert!(reference.join("frame_00001.png").exists());
+    let reference_b = dir.path().join("reference_b");
+    for half in [&reference, &reference_b] {
+        assert!(half.join("frame_00000.exr").exists());
+        assert!(half.join("frame_00001.png").exists());
+    }
+    // Different seeds: the halves differ.
+    assert_ne!(
+        std::fs::read(reference.join("frame_00000.exr")).unwrap(),
+        std::fs::read(reference_b.join("frame_00000.exr")).unwrap()
+    );
 
     let out = plenoptic(&["bake", r, "-q"], None);
     assert!(
@@ -436,6 +445,46 @@ fn reference_render_and_compare_commands() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(String::from_utf8_lossy(&out.stdout).contains("image: mean relative LRMS"));
-    assert!(csv.exists() && plot.exists());
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        stdout.contains("rel. LRMS") && stdout.contains("\nimage "),
+        "{stdout}"
+    );
+    assert!(csv.exists() && plot.exists() && plot.with_extension("svg").exists());
+
+    // Variance-corrected against the two halves.
+    let out = plenoptic(
+        &[
+            "compare",
+            "--reference",
+            reference.to_str().unwrap(),
+            "--reference-b",
+            reference_b.to_str().unwrap(),
+            &format!("image={}", frames.display()),
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    println!("{stdout}");
+    assert!(
+        stdout.contains("corrected") && stdout.contains("noise floor"),
+        "{stdout}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        text.starts_with(
+            "frame,noise_floor,image_lrms_corrected,image_lrms,image_psnr,image_mean_ratio"
+        ),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 3, "{text}");
 }

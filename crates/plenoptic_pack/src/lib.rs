@@ -1,7 +1,7 @@
 //! # plenoptic_pack
 //!
 //! The *radiance pack*: the one file a bake produces and the runtime streams. This crate is the
-//! file format of `design.md` § "The pack" and nothing else: no engine, no renderer. The byte
+//! file format of `docs/architecture.md` § "The pack" and nothing else: no engine, no renderer. The byte
 //! layout, quantization, error bounds and limits are specified in `docs/pack-format.md`.
 //!
 //! What it stores comes from Nimeroff's thesis (1997): the *range images* of chapter 6 (per base

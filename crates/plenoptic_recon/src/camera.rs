@@ -1,10 +1,10 @@
-//! The reconstruction camera: a pinhole with the same convention as
-//! [`plenoptic_trace::PinholeCamera`] (looks along its local −Z with +Y up, row 0 at the top,
-//! pixel centres at half-integer offsets), plus the inverse mapping (world → pixel) that depth
-//! reprojection needs (thesis appendix A.2).
+//! The reconstruction camera: a pinhole with the same convention as the tracer's pinhole
+//! camera (looks along its local −Z with +Y up, row 0 at the top, pixel centres at
+//! half-integer offsets), plus the inverse mapping (world → pixel) that depth reprojection
+//! needs (thesis appendix A.2). `plenoptic_eval::camera` converts it to and from the tracer's
+//! camera and tests that both cast the same rays.
 
 use glam::{Quat, Vec3};
-use plenoptic_trace::PinholeCamera;
 
 use crate::{Error, Result};
 
@@ -40,7 +40,7 @@ impl Camera {
             width,
             height,
         };
-        c.to_pinhole()?;
+        c.validate()?;
         Ok(c)
     }
 
@@ -53,32 +53,41 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self> {
-        let p = PinholeCamera::look_at(eye, target, up, vfov, width, height)
-            .map_err(|e| Error::Camera(e.to_string()))?;
-        Ok(Self::from_pinhole(&p))
-    }
-
-    /// The same camera as the tracer's pinhole.
-    pub fn to_pinhole(&self) -> Result<PinholeCamera> {
-        PinholeCamera::new(
-            self.position,
-            self.orientation,
-            self.vfov,
-            self.width,
-            self.height,
-        )
-        .map_err(|e| Error::Camera(e.to_string()))
-    }
-
-    /// The tracer's pinhole as a reconstruction camera.
-    pub fn from_pinhole(p: &PinholeCamera) -> Self {
-        Camera {
-            position: p.position,
-            orientation: p.rotation,
-            vfov: p.yfov,
-            width: p.width,
-            height: p.height,
+        let forward = (target - eye).normalize_or_zero();
+        let right = forward.cross(up).normalize_or_zero();
+        if forward == Vec3::ZERO || right == Vec3::ZERO {
+            return Err(Error::Camera(
+                "look_at: eye equals target or up is parallel to the view".into(),
+            ));
         }
+        let true_up = right.cross(forward);
+        let orientation = Quat::from_mat3(&glam::Mat3::from_cols(right, true_up, -forward));
+        Self::new(eye, orientation.normalize(), vfov, width, height)
+    }
+
+    /// Checks the resolution (not empty), the pose (finite, a unit quaternion) and the field
+    /// of view (inside (0, π)).
+    pub fn validate(&self) -> Result<()> {
+        if self.width == 0 || self.height == 0 {
+            return Err(Error::Camera(format!(
+                "resolution {}×{} is empty",
+                self.width, self.height
+            )));
+        }
+        let q = self.orientation;
+        if !self.position.is_finite() || !q.is_finite() || !q.is_normalized() {
+            return Err(Error::Camera(format!(
+                "position {} or rotation {q} is not finite and normalised",
+                self.position
+            )));
+        }
+        if !(self.vfov > 0.0 && self.vfov < std::f32::consts::PI) {
+            return Err(Error::Camera(format!(
+                "vertical field of view {} rad is outside (0, π)",
+                self.vfov
+            )));
+        }
+        Ok(())
     }
 
     /// Number of pixels.
@@ -159,20 +168,31 @@ impl CameraBasis {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plenoptic_trace::Camera as _;
 
     #[test]
-    fn matches_tracer_rays_and_projects_back() {
+    fn projects_pixel_rays_back_to_their_pixels() {
         let c =
             Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, Vec3::Y, 1.0, 40, 30).unwrap();
-        let p = c.to_pinhole().unwrap();
         let b = c.basis();
+        // The centre pixel's ray points at the target.
+        let centre = b.direction(20.0, 15.0);
+        assert!(
+            centre.abs_diff_eq(-c.position.normalize(), 1e-5),
+            "{centre}"
+        );
         for (x, y) in [(0, 0), (39, 29), (13, 7)] {
-            let r = p.ray(x, y, glam::Vec2::splat(0.5)).unwrap();
             let d = b.direction(x as f32 + 0.5, y as f32 + 0.5);
-            assert!(r.direction.abs_diff_eq(d, 1e-5));
             let (px, py, _) = b.project(c.position + d * 2.5).unwrap();
             assert!((px - x as f32 - 0.5).abs() < 1e-3 && (py - y as f32 - 0.5).abs() < 1e-3);
         }
+    }
+
+    #[test]
+    fn rejects_bad_cameras() {
+        let q = Quat::IDENTITY;
+        assert!(Camera::new(Vec3::ZERO, q, 1.0, 0, 4).is_err());
+        assert!(Camera::new(Vec3::ZERO, q, 3.2, 4, 4).is_err());
+        assert!(Camera::new(Vec3::NAN, q, 1.0, 4, 4).is_err());
+        assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 1.0, 4, 4).is_err());
     }
 }

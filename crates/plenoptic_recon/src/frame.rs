@@ -1,7 +1,6 @@
 //! Reconstructed frames and what their reconstruction reports.
 
 use glam::Vec3;
-use plenoptic_trace::Image;
 use serde::{Deserialize, Serialize};
 
 /// A reconstructed frame: linear HDR radiance, depth (distance from the eye along each pixel's
@@ -33,18 +32,9 @@ impl Frame {
             object: vec![0; n],
         }
     }
-
-    /// The radiance as the tracer's image type (for [`plenoptic_trace::metrics`]).
-    pub fn to_image(&self) -> Image<Vec3> {
-        Image {
-            width: self.width,
-            height: self.height,
-            pixels: self.radiance.clone(),
-        }
-    }
 }
 
-/// The reconstruction modes (design.md, "Reconstruction").
+/// The reconstruction modes (docs/architecture.md, "Reconstruction").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {

@@ -33,7 +33,7 @@ use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Report};
 use crate::lookup::{FastKey, NO_SLOT, PackedTexels, Scratch, Shade};
 use crate::proxy::GeometryMask;
-use crate::reconstructor::{CubeFilter, KeyCubes, MaskMethod, Reconstructor};
+use crate::reconstructor::{CubeFilter, KeyCubes, Reconstructor};
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
 use crate::{Error, Result, sample};
@@ -57,6 +57,7 @@ pub(crate) fn render(
     rec: &Reconstructor,
     camera: &Camera,
     t: f32,
+    mask: Option<&GeometryMask>,
     report: &mut Report,
 ) -> Result<Frame> {
     let start = Instant::now();
@@ -134,11 +135,11 @@ pub(crate) fn render(
     report.base_views = views;
     report.stage_ms.push(("setup".into(), ms(start)));
     let start = Instant::now();
-    // The mask: rasterized band by band inside the pixel loop (the default), or ray cast
-    // beforehand.
-    let source = match rec.settings.mask {
-        MaskMethod::Raster => MaskSource::Raster(proxy.project(camera, t)),
-        MaskMethod::RayCast => MaskSource::Mask(proxy.mask(camera, t)),
+    // The mask: rasterized band by band inside the pixel loop, or given (computed
+    // beforehand, e.g. ray cast by plenoptic_eval).
+    let source = match mask {
+        None => MaskSource::Raster(proxy.project(camera, t)),
+        Some(m) => MaskSource::Mask(m),
     };
     report.stage_ms.push(("mask_setup".into(), ms(start)));
     let start = Instant::now();
@@ -339,11 +340,11 @@ pub(crate) fn render(
 const ROWS: usize = 4;
 
 /// Where the geometry mask comes from.
-enum MaskSource {
+enum MaskSource<'a> {
     /// Projected proxy triangles, rasterized per band.
     Raster(crate::raster::Projected),
     /// A mask computed beforehand.
-    Mask(GeometryMask),
+    Mask(&'a GeometryMask),
 }
 
 /// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search);

@@ -1,8 +1,12 @@
 //! # plenoptic_recon
 //!
-//! CPU reconstruction of frames from a radiance pack (design.md, "Reconstruction"): the
-//! reference the GPU passes of `bevy_plenoptic` are tested against, their fallback, and the
-//! quality tools (`plenoptic render`, `plenoptic compare`).
+//! The runtime core of reconstruction (docs/architecture.md, "Reconstruction"): frames from a
+//! radiance pack on the CPU, the reference the GPU passes of `bevy_plenoptic` are tested
+//! against, their fallback, and the pieces the plugin shares with it (temporal blending,
+//! view-space weights, volumes, proxies and their motion). It depends on the pack format and
+//! small numeric crates only: not on the tracer or the scene importer. The offline tools
+//! (`plenoptic render`, `plenoptic compare`, frame files, plots, the ray-cast mask) are in
+//! `plenoptic_eval`.
 //!
 //! From Nimeroff's thesis (1997):
 //!
@@ -15,13 +19,13 @@
 //!   the samples filtered around t and triangulated; [`delaunay3`]: that (x, y, t) Delaunay
 //!   complex (the baker builds it with this module, reconstruction slices it);
 //! - [`proxy`] and the geometry-assisted mode: geometry masks and motion-compensated lookups,
-//!   the improvement the thesis proposes in §8.2.3.
+//!   the improvement the thesis proposes in §8.2.3; [`motion`]: the objects' tracks
+//!   evaluated at any time.
 //!
 //! [`Reconstructor::render`] runs one of the three [`Mode`]s and returns a [`Frame`]
 //! (radiance, depth, object id) and a [`Report`] (fallback fractions, missing chunks). A
 //! damaged pack degrades the frame instead of failing it. [`path`] is the camera-path file
-//! shared with the reference renderer, [`tools`] and [`plot`] write frames, metrics (relative
-//! LRMS and PSNR from [`plenoptic_trace::metrics`]) and error-along-path plots.
+//! shared with the reference renderer.
 //!
 //! ```
 //! use plenoptic_pack::*;
@@ -41,15 +45,17 @@
 //!     else if a.y >= a.z { Vec3::new(0.0, -d.y.signum(), 0.0) }
 //!     else { Vec3::new(0.0, 0.0, -d.z.signum()) }
 //! });
-//! let mesh = plenoptic_trace::shapes::cuboid(Vec3::splat(4.0));
+//! // The box's proxy: 8 corners, 12 triangles.
+//! let positions: Vec<Vec3> = (0..8)
+//!     .map(|i| Vec3::new([-2.0, 2.0][i & 1], [-2.0, 2.0][(i >> 1) & 1], [-2.0, 2.0][i >> 2]))
+//!     .collect();
+//! let indices = vec![
+//!     0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+//!     2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3,
+//! ];
 //! let mut writer = PackWriter::create(&path).unwrap();
 //! writer.add_range_image(0, 0, &image, CubeFormats::default()).unwrap();
-//! writer.add_proxy_mesh(&ProxyMesh {
-//!     object_id: 1,
-//!     positions: mesh.positions.clone(),
-//!     indices: mesh.triangles.iter().flatten().copied().collect(),
-//!     normals: None,
-//! }).unwrap();
+//! writer.add_proxy_mesh(&ProxyMesh { object_id: 1, positions, indices, normals: None }).unwrap();
 //! let mut manifest = Manifest::new(TimeRange { start: 0.0, end: 1.0 }, 0.5);
 //! manifest.base_views.push(BaseView { id: 0, position: Vec3::ZERO, time_keys: vec![0.0] });
 //! manifest.objects.push(ObjectEntry {
@@ -69,26 +75,25 @@
 pub mod camera;
 pub mod delaunay3;
 pub mod frame;
-pub mod frame_io;
 mod geometry;
 mod lookup;
+pub mod motion;
 pub mod path;
-pub mod plot;
 pub mod proxy;
 mod raster;
 pub mod reconstructor;
 mod sample;
 pub mod temporal;
-pub mod tools;
 pub mod viewspace;
 pub mod volume;
 pub mod warp;
 
 pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
+pub use motion::ObjectMotion;
 pub use path::{CameraPath, Keyframe, PathSample};
-pub use proxy::{GeometryMask, ProxyGeometry};
-pub use reconstructor::{CubeFilter, MaskMethod, ReconSettings, Reconstructor};
+pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
+pub use reconstructor::{CubeFilter, ReconSettings, Reconstructor};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -8,11 +8,10 @@
 //! The image is split into bands of rows rasterized in parallel.
 
 use glam::{Affine3A, Vec3, Vec4};
-use plenoptic_scene::Mesh;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::proxy::GeometryMask;
+use crate::proxy::{GeometryMask, TriangleMesh};
 
 const NEAR: f32 = 1e-3;
 const BAND: usize = 16;
@@ -35,7 +34,7 @@ pub(crate) struct Projected {
 }
 
 /// Places, clips and projects `objects` for `camera`.
-pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> Projected {
+pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)]) -> Projected {
     let b = camera.basis();
     let (sx, sy) = (0.5 * b.width / b.tan_x, 0.5 * b.height / b.tan_y);
     let mut tris = Vec::new();
@@ -213,7 +212,10 @@ pub(crate) fn raster_band(
 }
 
 /// Rasterizes `objects` (pack id, object-to-world transform, mesh) for `camera`.
-pub(crate) fn rasterize(camera: &Camera, objects: &[(u32, Affine3A, &Mesh)]) -> GeometryMask {
+pub(crate) fn rasterize(
+    camera: &Camera,
+    objects: &[(u32, Affine3A, &TriangleMesh)],
+) -> GeometryMask {
     let b = camera.basis();
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tris = project(camera, objects);

@@ -16,7 +16,7 @@ use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::lookup::PackedTexels;
-use crate::proxy::ProxyGeometry;
+use crate::proxy::{GeometryMask, ProxyGeometry};
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::viewspace::ViewWeights;
 use crate::volume::BlockBins;
@@ -47,8 +47,6 @@ pub struct ReconSettings {
     pub background_passes: u32,
     /// Bytes of decoded chunks kept in the cache.
     pub cache_bytes: usize,
-    /// How the geometry mask is computed.
-    pub mask: MaskMethod,
     /// How the geometry-assisted mode reads radiance from the cubes.
     pub cube_filter: CubeFilter,
 }
@@ -69,16 +67,6 @@ pub enum CubeFilter {
     Bilinear,
 }
 
-/// How the geometry mask is computed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum MaskMethod {
-    /// Rasterize the placed proxy triangles (fast; the default).
-    #[default]
-    Raster,
-    /// Cast one ray per pixel through the tracer's BVH (the reference; slower).
-    RayCast,
-}
-
 impl Default for ReconSettings {
     fn default() -> Self {
         ReconSettings {
@@ -90,7 +78,6 @@ impl Default for ReconSettings {
             hole_fill_radius: 12,
             background_passes: 24,
             cache_bytes: 512 << 20,
-            mask: MaskMethod::Raster,
             cube_filter: CubeFilter::Nearest,
         }
     }
@@ -427,7 +414,7 @@ impl Reconstructor {
 
     /// Reconstructs the frame `camera` sees at time `t` in `mode`.
     pub fn render(&self, camera: &Camera, t: f32, mode: Mode) -> Result<(Frame, Report)> {
-        camera.to_pinhole()?;
+        camera.validate()?;
         let mut report = Report {
             mode,
             used_mode: mode,
@@ -436,7 +423,7 @@ impl Reconstructor {
         };
         let frame = match mode {
             Mode::GeometryAssisted if self.proxy.is_some() => {
-                crate::geometry::render(self, camera, t, &mut report)?
+                crate::geometry::render(self, camera, t, None, &mut report)?
             }
             Mode::GeometryAssisted => {
                 report
@@ -448,6 +435,38 @@ impl Reconstructor {
             Mode::Image => self.render_image(camera, t, &mut report)?,
             Mode::Volume => crate::volume::render(self, camera, t, &mut report)?,
         };
+        Ok((frame, report))
+    }
+
+    /// Reconstructs the frame `camera` sees at time `t` in geometry-assisted mode from a
+    /// geometry mask computed elsewhere (`plenoptic_eval`'s ray-cast mask, the reference the
+    /// rasterized mask is tested against) instead of rasterizing the proxies. Fails when the
+    /// pack has no proxy geometry or the mask's size is not the camera's.
+    pub fn render_with_mask(
+        &self,
+        camera: &Camera,
+        t: f32,
+        mask: &GeometryMask,
+    ) -> Result<(Frame, Report)> {
+        camera.validate()?;
+        let n = camera.pixel_count();
+        if (mask.width, mask.height) != (camera.width, camera.height)
+            || mask.object.len() != n
+            || mask.position.len() != n
+            || mask.depth.len() != n
+        {
+            return Err(Error::Camera(format!(
+                "geometry mask of {}×{} for a {}×{} camera",
+                mask.width, mask.height, camera.width, camera.height
+            )));
+        }
+        let mut report = Report {
+            mode: Mode::GeometryAssisted,
+            used_mode: Mode::GeometryAssisted,
+            missing: self.proxy_missing.clone(),
+            ..Report::default()
+        };
+        let frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
         Ok((frame, report))
     }
 

@@ -1,5 +1,5 @@
 //! Blending weights of base views by the camera's position in the view space (thesis §6.7:
-//! view interpolation between the base views around the camera; design.md, "Reconstruction").
+//! view interpolation between the base views around the camera; docs/architecture.md, "Reconstruction").
 //!
 //! - segment: the base views are ordered by their parameter along the segment; the camera's
 //!   parameter picks the bracketing pair, weighted linearly;

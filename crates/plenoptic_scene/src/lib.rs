@@ -1,6 +1,6 @@
 //! # plenoptic_scene
 //!
-//! The scene side of baking: design.md "Baking", step 1, and the scene and bake description
+//! The scene side of baking: docs/architecture.md "Baking", step 1, and the scene and bake description
 //! that the thesis (Nimeroff 1997, ch. 5) takes as the input of the decomposition of space and
 //! time. This crate
 //!

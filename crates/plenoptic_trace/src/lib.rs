@@ -1,6 +1,6 @@
 //! # plenoptic_trace
 //!
-//! Ray tracing for the baker (design.md, Baking steps 2–3):
+//! Ray tracing for the baker (docs/architecture.md, Baking steps 2–3):
 //!
 //! - [`accel`]: a BVH per mesh in object space ([`SceneAccel`], built once with obvhs's
 //!   compressed wide BVH) and a top level over the objects placed at time t

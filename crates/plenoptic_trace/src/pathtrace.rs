@@ -1,7 +1,7 @@
 //! The reference path tracer: unbiased, next-event estimation for emissive triangles with
 //! multiple importance sampling against BSDF sampling (power heuristic), punctual lights by
 //! next-event estimation only, Russian roulette. It is the ground truth of every quality
-//! figure (design.md, "Measuring").
+//! figure (docs/architecture.md, "Measuring").
 
 use glam::Vec3;
 

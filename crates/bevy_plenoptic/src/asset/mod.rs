@@ -4,7 +4,7 @@
 //! proxy meshes and animation tracks the geometry mask needs); cube chunks stay on disk and
 //! are read on demand by the streaming scheduler ([`crate::streaming`]).
 //!
-//! Design choice (see `design.md`, "The runtime plugin"): the loader resolves the asset path
+//! Design choice (see `docs/architecture.md`, "The runtime plugin"): the loader resolves the asset path
 //! to a file under the asset root and opens a [`PackReader`] on that file, so later chunk
 //! reads are positional reads of exactly their byte range (random access, many threads at
 //! once). Where the asset does not come from the file system (an embedded or remote source),
@@ -17,7 +17,7 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 use plenoptic_pack::PackReader;
-use plenoptic_scene::TrsTrack;
+use plenoptic_recon::ObjectMotion;
 
 pub use loader::{RadiancePackLoader, RadiancePackLoaderError};
 
@@ -76,7 +76,7 @@ pub struct ProxyObject {
     /// Its proxy mesh, a labeled sub-asset `proxy{id}` of the pack.
     pub mesh: Handle<Mesh>,
     /// Its animation track (None: static, placed by the identity).
-    pub track: Option<TrsTrack>,
+    pub track: Option<ObjectMotion>,
 }
 
 impl ProxyObject {
@@ -87,11 +87,11 @@ impl ProxyObject {
         match &self.track {
             None => Transform::IDENTITY,
             Some(track) => {
-                let trs = track.sample(t, plenoptic_scene::Trs::default());
+                let (translation, rotation, scale) = track.sample(t);
                 Transform {
-                    translation: trs.translation,
-                    rotation: trs.rotation,
-                    scale: trs.scale,
+                    translation,
+                    rotation,
+                    scale,
                 }
             }
         }

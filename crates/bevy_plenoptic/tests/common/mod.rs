@@ -1,11 +1,8 @@
 //! Headless rendering harness shared by the GPU tests: an app without a window whose camera
-//! renders into an image that is read back to the CPU.
+//! renders into an image that is read back to the CPU. Also included (by `#[path]`) by the
+//! facade package's plugin tests (`tests/plugin_*.rs` at the workspace root), which build
+//! their packs through the tracer.
 #![allow(dead_code, reason = "each test binary uses a part of it")]
-
-/// The reconstruction crate's test pack builder (analytic scenes written with `PackWriter`),
-/// shared so that the GPU is tested on the very packs the CPU reconstruction is.
-#[path = "../../../plenoptic_recon/tests/common/mod.rs"]
-pub mod pack;
 
 use std::sync::{Arc, Mutex};
 
@@ -35,6 +32,10 @@ pub fn headless_app() -> App {
 
 /// `DefaultPlugins` without a window (and without winit's event loop, which must run on the
 /// main thread and needs a display, when the `winit` feature is on).
+#[allow(
+    unexpected_cfgs,
+    reason = "each package that includes this file has one of the two window features"
+)]
 pub fn headless_plugins() -> bevy::app::PluginGroupBuilder {
     let plugins = DefaultPlugins
         .set(WindowPlugin {
@@ -43,7 +44,9 @@ pub fn headless_plugins() -> bevy::app::PluginGroupBuilder {
             ..default()
         })
         .build();
-    #[cfg(feature = "winit")]
+    // `winit` is this crate's feature; `window` the facade package's (its default), which
+    // turns on the same Bevy window backend when the facade's tests include this file.
+    #[cfg(any(feature = "winit", feature = "window"))]
     let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
     plugins
 }

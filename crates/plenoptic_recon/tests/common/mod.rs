@@ -172,6 +172,15 @@ pub fn range_image(placed: &PlacedScene<'_>, position: Vec3, n: u32) -> RangeIma
     r
 }
 
+/// The radiance of a reconstructed frame as the tracer's image type (for its metrics).
+pub fn to_image(frame: &plenoptic_recon::Frame) -> Image<Vec3> {
+    Image {
+        width: frame.width,
+        height: frame.height,
+        pixels: frame.radiance.clone(),
+    }
+}
+
 /// The reference image of a pinhole camera (1 ray per pixel centre, same shading).
 pub fn reference(placed: &PlacedScene<'_>, camera: &plenoptic_recon::Camera) -> Image<Vec3> {
     let b = camera.basis();

@@ -47,7 +47,7 @@ impl Preset {
     }
 }
 
-/// Bake quality settings (design.md "Baking"; thesis ch. 5–7). Start from a preset and
+/// Bake quality settings (docs/architecture.md "Baking"; thesis ch. 5–7). Start from a preset and
 /// override single fields; every field states its cost.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Quality {

@@ -1,7 +1,7 @@
 //! Acceleration structures: a BVH per mesh in object space ([`SceneAccel`], built once) and a
 //! top level over the objects placed at time t ([`PlacedScene`], rebuilt per time).
 //!
-//! Rigid animation therefore costs only a top-level rebuild over the instance bounds (design.md,
+//! Rigid animation therefore costs only a top-level rebuild over the instance bounds (docs/architecture.md,
 //! Baking step 2). Rays are carried into object space by each instance's inverse transform
 //! without renormalising the direction, so hit distances stay world distances.
 

@@ -1,0 +1,225 @@
+//! Image metrics: the thesis's relative LRMS and PSNR ([`plenoptic_trace::metrics`],
+//! re-exported), the mean-luminance ratio, and the relative LRMS corrected for the noise of
+//! a path-traced reference (docs/architecture.md, "Measuring against a noisy reference").
+//!
+//! # Variance correction
+//!
+//! Render the reference as two independent halves A and B (each with half the samples, from
+//! different random sequences) and use their mean M = (A + B)/2 as the reference. Per pixel,
+//! with luminances a, b, m and true luminance s: if each half has variance σ²_half, then
+//!
+//! - Var[m] = σ²_half / 2 (the mean of two independent estimates), and
+//! - E[(a − b)²] = Var[a] + Var[b] = 2 σ²_half,
+//!
+//! so (a − b)²/4 is an unbiased estimate of Var[m]. For a test image x independent of the
+//! reference's noise, E[(x − m)²] = (x − s)² + Var[m]: the squared error against a noisy
+//! reference overstates the true squared error by the reference's variance. The corrected
+//! mean squared error is therefore
+//!
+//! ```text
+//! MSE_c = max(0, mean (x − m)² − mean (a − b)²/4)
+//! ```
+//!
+//! and the corrected relative LRMS is √MSE_c / mean(m). The reference's *noise floor* is the
+//! relative LRMS of that noise alone, √(mean (a − b)²/4) / mean(m): what a perfect image
+//! scores uncorrected. The correction removes the floor in expectation; what remains is the
+//! estimate's own scatter (its standard deviation is about √(2/N) of the floor's square for
+//! N pixels), so corrected errors well below the floor are not resolved. The mean-luminance
+//! ratio mean(x)/mean(m) shows a bias that noise would otherwise hide.
+
+use glam::Vec3;
+use plenoptic_trace::Image;
+pub use plenoptic_trace::image::luminance;
+pub use plenoptic_trace::metrics::{psnr, relative_lrms};
+
+/// Mean luminance of `test` over mean luminance of `reference` (NaN for a black reference
+/// or images of different sizes).
+pub fn mean_luminance_ratio(test: &Image<Vec3>, reference: &Image<Vec3>) -> f64 {
+    if (test.width, test.height) != (reference.width, reference.height) {
+        return f64::NAN;
+    }
+    let r = reference.mean_luminance();
+    if r > 0.0 {
+        test.mean_luminance() / r
+    } else {
+        f64::NAN
+    }
+}
+
+/// The mean (A + B)/2 of two reference halves (None for different sizes).
+pub fn mean_image(a: &Image<Vec3>, b: &Image<Vec3>) -> Option<Image<Vec3>> {
+    ((a.width, a.height) == (b.width, b.height)).then(|| Image {
+        width: a.width,
+        height: a.height,
+        pixels: a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(&x, &y)| 0.5 * (x + y))
+            .collect(),
+    })
+}
+
+/// What [`corrected_relative_lrms`] measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CorrectedLrms {
+    /// √max(0, mean (x − m)² − mean (a − b)²/4) / mean(m).
+    pub corrected: f64,
+    /// √mean (x − m)² / mean(m): the relative LRMS against the mean of the halves.
+    pub uncorrected: f64,
+    /// √(mean (a − b)²/4) / mean(m): the relative LRMS of the reference's own noise.
+    pub noise_floor: f64,
+    /// mean(x) / mean(m).
+    pub mean_ratio: f64,
+}
+
+impl CorrectedLrms {
+    /// Every field NaN (a missing or mismatched frame).
+    pub const NAN: Self = CorrectedLrms {
+        corrected: f64::NAN,
+        uncorrected: f64::NAN,
+        noise_floor: f64::NAN,
+        mean_ratio: f64::NAN,
+    };
+}
+
+/// The relative LRMS of `test` against the noisy reference given as two independent halves
+/// `ref_a` and `ref_b`, with the reference's variance estimated from |A − B|²/4 and
+/// subtracted (see the module docs for the derivation). All NaN when the sizes differ or
+/// the reference is black.
+pub fn corrected_relative_lrms(
+    test: &Image<Vec3>,
+    ref_a: &Image<Vec3>,
+    ref_b: &Image<Vec3>,
+) -> CorrectedLrms {
+    let size = (test.width, test.height);
+    if size != (ref_a.width, ref_a.height)
+        || size != (ref_b.width, ref_b.height)
+        || test.pixels.len() != ref_a.pixels.len()
+        || test.pixels.len() != ref_b.pixels.len()
+        || test.pixels.is_empty()
+    {
+        return CorrectedLrms::NAN;
+    }
+    let (mut err, mut var, mut sum_m, mut sum_x) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for ((&x, &a), &b) in test.pixels.iter().zip(&ref_a.pixels).zip(&ref_b.pixels) {
+        let (x, a, b) = (
+            f64::from(luminance(x)),
+            f64::from(luminance(a)),
+            f64::from(luminance(b)),
+        );
+        let m = 0.5 * (a + b);
+        err += (x - m) * (x - m);
+        var += 0.25 * (a - b) * (a - b);
+        sum_m += m;
+        sum_x += x;
+    }
+    let n = test.pixels.len() as f64;
+    let mean = sum_m / n;
+    if mean <= 0.0 || !mean.is_finite() {
+        return CorrectedLrms::NAN;
+    }
+    let (mse, var) = (err / n, var / n);
+    CorrectedLrms {
+        corrected: (mse - var).max(0.0).sqrt() / mean,
+        uncorrected: mse.sqrt() / mean,
+        noise_floor: var.sqrt() / mean,
+        mean_ratio: sum_x / n / mean,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic standard normal samples (xorshift + Box–Muller).
+    struct Normal(u64);
+    impl Normal {
+        fn uniform(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        }
+        fn next(&mut self) -> f32 {
+            let (u, v) = (self.uniform(), self.uniform());
+            ((-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()) as f32
+        }
+    }
+
+    const W: u32 = 512;
+    const H: u32 = 384;
+
+    /// A grey signal from 0.5 to 1.5 (mean 1): luminance = the grey value.
+    fn signal() -> Image<Vec3> {
+        Image::render(W, H, |x, y| {
+            Vec3::splat(0.5 + (x as f32 / W as f32 + y as f32 / H as f32) * 0.5)
+        })
+    }
+
+    /// `signal` plus independent grey noise of standard deviation `sigma` per pixel.
+    fn noisy(signal: &Image<Vec3>, sigma: f32, seed: u64) -> Image<Vec3> {
+        let mut n = Normal(seed);
+        Image {
+            width: signal.width,
+            height: signal.height,
+            pixels: signal
+                .pixels
+                .iter()
+                .map(|&s| s + Vec3::splat(sigma * n.next()))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_noise_of_the_reference_is_removed() {
+        let s = signal();
+        let sigma_half = 0.3;
+        let (a, b) = (noisy(&s, sigma_half, 1), noisy(&s, sigma_half, 2));
+        let m = corrected_relative_lrms(&s, &a, &b);
+        // The mean of the halves has standard deviation σ/√2 ≈ 0.212 over a mean of 1.
+        let floor = f64::from(sigma_half) / 2f64.sqrt();
+        assert!((m.noise_floor - floor).abs() < 0.01 * floor, "{m:?}");
+        assert!((m.uncorrected - floor).abs() < 0.02 * floor, "{m:?}");
+        assert!(m.corrected < 0.04 && m.uncorrected > 0.2, "{m:?}");
+        assert!((m.mean_ratio - 1.0).abs() < 0.005, "{m:?}");
+        // The uncorrected figure is the tracer's relative LRMS against the mean.
+        let mean = mean_image(&a, &b).unwrap();
+        assert!((relative_lrms(&s, &mean) - m.uncorrected).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_bias_is_given_back_despite_the_noise() {
+        let s = signal();
+        let (a, b) = (noisy(&s, 0.3, 3), noisy(&s, 0.3, 4));
+        // A constant bias of 0.1 over a mean of 1: true relative LRMS 0.1.
+        let biased = Image {
+            width: W,
+            height: H,
+            pixels: s.pixels.iter().map(|&c| c + Vec3::splat(0.1)).collect(),
+        };
+        let m = corrected_relative_lrms(&biased, &a, &b);
+        assert!((m.corrected - 0.1).abs() < 0.01, "{m:?}");
+        assert!(m.uncorrected > 0.2, "noise dominates uncorrected: {m:?}");
+        assert!((m.mean_ratio - 1.1).abs() < 0.005, "{m:?}");
+        // A test image as noisy as a third independent half: the correction removes only
+        // the reference's share, leaving the test's own noise (σ = 0.3 over mean 1).
+        let m = corrected_relative_lrms(&noisy(&s, 0.3, 5), &a, &b);
+        assert!((m.corrected - 0.3).abs() < 0.015, "{m:?}");
+    }
+
+    #[test]
+    fn mismatched_or_black_references_give_nan() {
+        let s = signal();
+        let small = Image::render(4, 4, |_, _| Vec3::ONE);
+        assert!(corrected_relative_lrms(&small, &s, &s).corrected.is_nan());
+        let black = Image::render(W, H, |_, _| Vec3::ZERO);
+        assert!(
+            corrected_relative_lrms(&s, &black, &black)
+                .corrected
+                .is_nan()
+        );
+        assert!(mean_luminance_ratio(&s, &black).is_nan());
+        assert_eq!(corrected_relative_lrms(&s, &s, &s).corrected, 0.0);
+    }
+}
