@@ -1,5 +1,5 @@
-//! Ambient-field key times (thesis §6.6.1, "indirect illumination coherence"; design.md
-//! Baking step 5, last sentence).
+//! Ambient-field key times (thesis §6.6.1, "indirect illumination coherence";
+//! docs/architecture.md, Baking step 5, last sentence).
 //!
 //! The ambient field (indirect irradiance on the simplified scene, `plenoptic_trace`) is
 //! gathered at both ends of the time range; an interval is bisected on the time lattice while

@@ -1,4 +1,4 @@
-//! Decomposing space (thesis §6.5, "motion independence"; design.md Baking step 4).
+//! Decomposing space (thesis §6.5, "motion independence"; docs/architecture.md, Baking step 4).
 //!
 //! The view space (segment, rectangle or box) is a cell in a dyadic lattice with
 //! `2^max_space_depth` steps per axis. A cube id-image is rendered at each corner of a cell;

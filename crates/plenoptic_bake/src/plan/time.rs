@@ -1,5 +1,5 @@
 //! Decomposing time (thesis §6.6.2 "view independent direct illumination coherence" and
-//! §6.6.3 "view dependent temporal refinement"; design.md Baking step 5).
+//! §6.6.3 "view dependent temporal refinement"; docs/architecture.md, Baking step 5).
 //!
 //! Times live on a dyadic lattice of `2^max_time_depth` steps over the time range. An interval
 //! is tested by comparing id-images rendered at its two ends; while the fitness is below q
