@@ -265,12 +265,7 @@ pub(super) fn gather(
     layout: &FieldLayout,
     settings: &AmbientSettings,
 ) -> Gathered {
-    let jobs: Vec<(usize, usize)> = layout
-        .objects
-        .iter()
-        .enumerate()
-        .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
-        .collect();
+    let jobs = layout.flat_points();
     let blocked = blocked_edges(placed, layout);
     let guarded = &blocked.guarded;
     let points: Vec<PointGather> = jobs

@@ -286,6 +286,15 @@ impl ObjectLayout {
 }
 
 impl FieldLayout {
+    /// (object, object-local point index) of every point, in the flat order.
+    pub(super) fn flat_points(&self) -> Vec<(usize, usize)> {
+        self.objects
+            .iter()
+            .enumerate()
+            .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
+            .collect()
+    }
+
     /// Total number of gather points.
     pub fn point_count(&self) -> usize {
         self.objects.iter().map(|o| o.points.len()).sum()

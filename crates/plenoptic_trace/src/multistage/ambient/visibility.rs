@@ -65,12 +65,7 @@ impl Blocked {
 /// Tests every grid edge of `layout` with one ray.
 pub(super) fn blocked_edges(placed: &PlacedScene<'_>, layout: &FieldLayout) -> Blocked {
     use rayon::prelude::*;
-    let jobs: Vec<(usize, usize)> = layout
-        .objects
-        .iter()
-        .enumerate()
-        .flat_map(|(o, l)| (0..l.points.len()).map(move |p| (o, p)))
-        .collect();
+    let jobs = layout.flat_points();
     let blocked: Vec<Vec<u32>> = jobs
         .par_iter()
         .map(|&(o, i)| {
