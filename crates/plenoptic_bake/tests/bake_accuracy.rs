@@ -38,6 +38,22 @@ fn lum(img: &Image<Vec3>) -> Vec<f64> {
         .collect()
 }
 
+impl std::fmt::Display for Figures {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor {:.3})",
+            self.mean_ratio, self.blocks_within, self.corrected_lrms, self.noise_floor
+        )
+    }
+}
+
+/// A 70° camera at `p` turned by `yaw` about +Y, then tilted by `pitch`.
+fn camera(p: Vec3, yaw: f32, pitch: f32, w: u32, h: u32) -> PinholeCamera {
+    let rotation = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch);
+    PinholeCamera::new(p, rotation, 70f32.to_radians(), w, h).unwrap()
+}
+
 fn measure(test: &Image<Vec3>, a: &Image<Vec3>, b: &Image<Vec3>) -> Figures {
     let c = corrected_relative_lrms(test, a, b);
     let (t, a_l, b_l) = (lum(test), lum(a), lum(b));
@@ -261,14 +277,8 @@ fn base_views_agree_with_the_path_tracer() {
     ];
     let mut failures = Vec::new();
     for (name, p, yaw, pitch) in views {
-        let rotation = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch);
-        let cam = PinholeCamera::new(p, rotation, 70f32.to_radians(), w, h).unwrap();
-        let f = base_view_frame(name, &accel, &field, &cam, 4096);
-        println!(
-            "{name}: mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor \
-             {:.3})",
-            f.mean_ratio, f.blocks_within, f.corrected_lrms, f.noise_floor,
-        );
+        let f = base_view_frame(name, &accel, &field, &camera(p, yaw, pitch, w, h), 4096);
+        println!("{name}: {f}");
         if (f.mean_ratio - 1.0).abs() > 0.03 || f.blocks_within < 0.9 || f.corrected_lrms > 0.1 {
             failures.push((name, f));
         }
@@ -316,14 +326,6 @@ fn tour_base_views() {
         ),
     ];
     for (name, p, t, yaw, pitch) in views {
-        let cam = PinholeCamera::new(
-            p,
-            Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch),
-            70f32.to_radians(),
-            w,
-            h,
-        )
-        .unwrap();
         let start = std::time::Instant::now();
         let field = bake_field(&accel, &quality, t);
         println!(
@@ -333,11 +335,7 @@ fn tour_base_views() {
             field.bounces(),
             start.elapsed().as_secs_f64()
         );
-        let f = base_view_frame(name, &accel, &field, &cam, 1024);
-        println!(
-            "{name}: mean {:.3}, blocks within 5 % {:.2}, corrected LRMS {:.3} (noise floor \
-             {:.3})",
-            f.mean_ratio, f.blocks_within, f.corrected_lrms, f.noise_floor,
-        );
+        let f = base_view_frame(name, &accel, &field, &camera(p, yaw, pitch, w, h), 1024);
+        println!("{name}: {f}");
     }
 }
