@@ -15,6 +15,7 @@ use glam::{Affine3A, Quat, Vec2, Vec3, Vec4};
 
 use crate::anim::TrsTrack;
 pub use crate::texture::{AlphaMode, Texture, TextureRef, UvTransform, WrapMode};
+pub use plenoptic_sky::{Environment, PlacedEnvironment, SunTrack, SunTrackSample};
 
 /// Index of an object in [`Scene::objects`]; the object id of id-images and of the pack.
 pub type ObjectId = u32;
@@ -181,8 +182,22 @@ pub struct Light {
     pub intensity: f32,
     /// Range beyond which the light is ignored; `None` for infinite.
     pub range: Option<f32>,
+    /// Angular radius of a directional light's disc, radians: 0 is a delta light with hard
+    /// shadows; the sun is 0.00465 (soft shadows). Ignored for point and spot lights.
+    pub angular_radius: f32,
     /// The node that places the light.
     pub node: usize,
+}
+
+/// The sun: the directional light that drives the sky, and its path when a sun study moves
+/// it (the recipe's `[sun]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sun {
+    /// Index into [`Scene::lights`] of the sun's directional light.
+    pub light: usize,
+    /// The sun's direction and illuminance over time; `None`: the light's node and its
+    /// colour × intensity decide, as for any light.
+    pub track: Option<SunTrack>,
 }
 
 /// A camera from the file.
@@ -206,8 +221,11 @@ pub struct PlacedLight {
     pub light: usize,
     /// World position (unused for directional lights).
     pub position: Vec3,
-    /// Unit world direction the light travels along (the node's −Z).
+    /// Unit world direction the light travels along (the node's −Z, or opposite the sun
+    /// track's direction).
     pub direction: Vec3,
+    /// Linear colour × intensity at this time.
+    pub emitted: Vec3,
 }
 
 /// An imported scene: everything the tracer needs, with geometry in object space.
@@ -225,6 +243,10 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Punctual lights.
     pub lights: Vec<Light>,
+    /// What rays that leave the scene see.
+    pub environment: Environment,
+    /// The sun, when one light is the sun (sun studies, or the sky's sun).
+    pub sun: Option<Sun>,
     /// Perspective cameras.
     pub cameras: Vec<CameraDef>,
     /// Warnings from import (unsupported features, named by node).
@@ -308,14 +330,80 @@ impl Scene {
         self.node_is_animated(self.objects[id as usize].node)
     }
 
-    /// Light `light` placed at time `t`.
+    /// Light `light` placed at time `t`: the sun follows its track when it has one.
     pub fn placed_light(&self, light: usize, t: f32) -> PlacedLight {
-        let m = self.node_transform(self.lights[light].node, t);
-        PlacedLight {
+        let l = &self.lights[light];
+        let m = self.node_transform(l.node, t);
+        let mut placed = PlacedLight {
             light,
             position: m.translation.into(),
             direction: m.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
+            emitted: l.color * l.intensity,
+        };
+        if let Some(Sun {
+            light: sun,
+            track: Some(track),
+        }) = &self.sun
+            && *sun == light
+        {
+            let (towards, illuminance) = track.at(t);
+            placed.direction = -towards;
+            placed.emitted = illuminance;
         }
+        placed
+    }
+
+    /// Unit direction towards the sun and its illuminance at time `t`, when the scene has a
+    /// sun.
+    pub fn sun_at(&self, t: f32) -> Option<(Vec3, Vec3)> {
+        let sun = self.sun.as_ref()?;
+        let p = self.placed_light(sun.light, t);
+        Some((-p.direction, p.emitted))
+    }
+
+    /// The environment at time `t` (a sky lit by the sun's direction then).
+    pub fn environment_at(&self, t: f32) -> PlacedEnvironment {
+        self.environment.at(self.sun_at(t).map(|s| s.0))
+    }
+
+    /// Whether the environment changes over time: a sky whose sun moves or changes.
+    pub fn environment_is_animated(&self) -> bool {
+        self.environment.follows_the_sun() && self.sun_is_animated()
+    }
+
+    /// Whether the sun moves or changes: its track does, or its light's node is animated.
+    pub fn sun_is_animated(&self) -> bool {
+        self.sun.as_ref().is_some_and(|s| match &s.track {
+            Some(track) => track.is_animated(),
+            None => self.node_is_animated(self.lights[s.light].node),
+        })
+    }
+
+    /// The sun over `[start, end]` as the runtime needs it: the sun study's track, or the
+    /// sun light sampled at `samples` times (one sample when it does not move). `None`
+    /// without a sun.
+    pub fn sun_track(&self, start: f32, end: f32, samples: usize) -> Option<SunTrack> {
+        let sun = self.sun.as_ref()?;
+        if let Some(track) = &sun.track {
+            return Some(track.clone());
+        }
+        if !self.sun_is_animated() || end <= start {
+            let (d, e) = self.sun_at(start)?;
+            return Some(SunTrack::fixed(d, e));
+        }
+        let n = samples.clamp(2, SunTrack::MAX_SAMPLES);
+        let list = (0..n)
+            .map(|i| {
+                let t = start + (end - start) * i as f32 / (n - 1) as f32;
+                let p = self.placed_light(sun.light, t);
+                SunTrackSample {
+                    time: t,
+                    direction: -p.direction,
+                    illuminance: p.emitted,
+                }
+            })
+            .collect();
+        SunTrack::new(list).ok()
     }
 
     /// The time range covered by the animation tracks, `(0, 0)` for a static scene.

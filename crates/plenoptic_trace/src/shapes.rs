@@ -215,6 +215,7 @@ impl SceneBuilder {
             color,
             intensity,
             range: None,
+            angular_radius: 0.0,
             node,
         });
         self.scene.lights.len() - 1

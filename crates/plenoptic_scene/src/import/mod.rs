@@ -349,6 +349,7 @@ impl Importer<'_> {
                 color,
                 intensity: light.intensity(),
                 range: light.range(),
+                angular_radius: 0.0,
                 node: ours,
             });
         }
