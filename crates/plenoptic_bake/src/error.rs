@@ -71,6 +71,14 @@ pub enum BakeError {
     /// A command-line value or setting is invalid.
     #[error("{0}")]
     Invalid(String),
+    /// An environment image that cannot be used.
+    #[error("environment image {}: {message}", path.display())]
+    Environment {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 impl BakeError {

@@ -18,13 +18,15 @@ pub fn load_recipe(path: &Path) -> Result<(BakeRecipe, Scene)> {
     Ok((recipe, scene))
 }
 
-/// Loads every scene file of `recipe` and joins them into one scene.
+/// Loads every scene file of `recipe`, joins them into one scene, and applies the recipe's
+/// sun and sky ([`crate::daylight`]).
 pub fn load_scenes(recipe: &BakeRecipe) -> Result<Scene> {
     let mut out = Scene::default();
     for source in &recipe.scenes {
         let scene = plenoptic_scene::load(&source.path)?;
         append(&mut out, scene, source.transform, &source.path);
     }
+    crate::daylight::apply(&mut out, recipe)?;
     Ok(out)
 }
 
@@ -95,8 +97,10 @@ pub fn append(out: &mut Scene, scene: Scene, transform: Trs, path: &Path) {
     );
 }
 
-/// Whether anything in the scene moves: an object or a light under an animated node.
+/// Whether anything in the scene changes: an object or a light under an animated node, or a
+/// sun that moves (a sun study).
 pub fn scene_is_animated(scene: &Scene) -> bool {
     (0..scene.objects.len()).any(|i| scene.object_is_animated(i as u32))
         || scene.lights.iter().any(|l| scene.node_is_animated(l.node))
+        || scene.sun_is_animated()
 }

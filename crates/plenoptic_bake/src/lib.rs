@@ -81,6 +81,7 @@
 //! ```
 
 pub mod bake;
+pub mod daylight;
 pub mod error;
 pub mod input;
 pub mod plan;

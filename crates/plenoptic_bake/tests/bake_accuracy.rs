@@ -121,6 +121,7 @@ fn base_view_frame(
             max_depth: 32,
             rr_start_depth: 5,
             seed,
+            environment_sampling: true,
         })
         .render(&placed, camera)
         .radiance()

@@ -48,6 +48,7 @@
 pub mod accel;
 pub mod alpha;
 pub mod camera;
+pub mod environment;
 pub mod image;
 pub mod light;
 pub mod material;

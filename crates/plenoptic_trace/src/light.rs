@@ -1,16 +1,18 @@
 //! Lights at one time: emissive triangles in world space with a distribution by area ×
-//! luminance, the punctual lights placed, and next-event estimation with multiple importance
-//! sampling (power heuristic).
+//! luminance, the punctual lights placed (directional lights with a disc, such as the sun,
+//! sampled over it for soft shadows), the environment ([`crate::environment`]), and
+//! next-event estimation with multiple importance sampling (power heuristic).
 
 use glam::{Vec2, Vec3};
 use plenoptic_scene::{AlphaMode, Light, LightKind, ObjectId, PlacedLight, Scene};
 use std::collections::HashMap;
 
-use crate::accel::{Hit, Instance, PlacedScene};
+use crate::accel::{Hit, Instance, PlacedScene, Ray};
 use crate::alpha::coverage;
+use crate::environment::EnvLight;
 use crate::image::luminance;
 use crate::material::{Bsdf, Lobes};
-use crate::sampling::{Distribution1d, Sampler, power_heuristic, uniform_triangle};
+use crate::sampling::{Distribution1d, Frame, Sampler, power_heuristic, uniform_triangle};
 use crate::texture::sample_ref;
 
 /// An emissive triangle placed in the world.
@@ -56,6 +58,7 @@ pub struct LightSet {
     distribution: Distribution1d,
     index: HashMap<(ObjectId, u32), usize>,
     punctual: Vec<(Light, PlacedLight)>,
+    env: EnvLight,
 }
 
 impl LightSet {
@@ -111,7 +114,13 @@ impl LightSet {
             distribution: Distribution1d::new(weights),
             index,
             punctual,
+            env: EnvLight::new(scene.environment_at(t)),
         }
+    }
+
+    /// The environment at this time.
+    pub fn environment(&self) -> &EnvLight {
+        &self.env
     }
 
     /// Emissive triangles.
@@ -195,18 +204,32 @@ impl LightSet {
 
     /// Punctual light `i` seen from `p`: direction, distance and normal irradiance
     /// (I·colour/r² for point and spot lights with the glTF cone falloff, E·colour for
-    /// directional ones); `None` outside a spot cone or beyond the range.
-    pub fn punctual_at(&self, i: usize, p: Vec3) -> Option<LightSample> {
+    /// directional ones); `None` outside a spot cone or beyond the range. A directional light
+    /// with a disc (`angular_radius` > 0) gives a direction drawn uniformly over the disc's
+    /// cone with `u`, carrying the whole disc's irradiance: averaged over draws, the soft
+    /// shadow of a sun of that size.
+    pub fn punctual_at(&self, i: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
         let (light, placed) = &self.punctual[i];
-        let radiant = light.color * light.intensity;
+        let radiant = placed.emitted;
         match light.kind {
-            LightKind::Directional => Some(LightSample {
-                wi: -placed.direction,
-                distance: f32::INFINITY,
-                value: radiant,
-                pdf: f32::INFINITY,
-                position: p - placed.direction * 1e9,
-            }),
+            LightKind::Directional => {
+                let mut wi = -placed.direction;
+                if light.angular_radius > 0.0 {
+                    let cos_max = light.angular_radius.min(0.5).cos();
+                    let cos_t = 1.0 - u.x * (1.0 - cos_max);
+                    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+                    let phi = 2.0 * std::f32::consts::PI * u.y;
+                    let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+                    wi = Frame::from_normal(wi).to_world(local).normalize();
+                }
+                Some(LightSample {
+                    wi,
+                    distance: f32::INFINITY,
+                    value: radiant,
+                    pdf: f32::INFINITY,
+                    position: p + wi * 1e9,
+                })
+            }
             LightKind::Point | LightKind::Spot { .. } => {
                 let d = placed.position - p;
                 let dist2 = d.length_squared();
@@ -239,20 +262,49 @@ impl LightSet {
     }
 }
 
+/// Which lights [`estimate_direct`] samples and which BSDF sampling strategies of the caller
+/// compete with it. Each strategy is a set of lobes the caller samples on its own and whose
+/// rays add what they find (emission, or the environment when they leave the scene) with
+/// `power_heuristic(bsdf_pdf, light_pdf)`. The part of the BSDF in a strategy is weighted by
+/// the power heuristic against that strategy's density; the part in none counts fully.
+#[derive(Debug, Clone, Copy)]
+pub struct Competing<'a> {
+    /// Strategies that find emissive triangles.
+    pub emissive: &'a [Lobes],
+    /// `None`: the environment is not sampled (the caller gets it elsewhere). Else the lobes
+    /// whose reflection of it is estimated, and the strategies that also find it.
+    pub environment: Option<(Lobes, &'a [Lobes])>,
+}
+
+impl Competing<'static> {
+    /// Light sampling alone, the environment included through every lobe.
+    pub const NONE: Self = Self {
+        emissive: &[],
+        environment: Some((Lobes::All, &[])),
+    };
+}
+
+/// `f` with the parts in `strategies` weighted by the power heuristic against `light_pdf`.
+fn weighted(bsdf: &Bsdf, wi: Vec3, f_all: Vec3, light_pdf: f32, strategies: &[Lobes]) -> Vec3 {
+    let mut f = f_all;
+    for &l in strategies {
+        let (f_c, p_c) = bsdf.eval(wi, l);
+        f += f_c * (power_heuristic(light_pdf, p_c) - 1.0);
+    }
+    f
+}
+
 /// Direct light reflected by `bsdf` at `hit` towards its `wo`: every punctual light once plus
-/// `emissive_samples` samples of the emissive triangles, each shadow-tested.
-///
-/// `lobes` selects the part of the BSDF evaluated. `mis_lobes` (a subset of `lobes`) names the lobes whose BSDF sampling also finds emitters (the caller adds the
-/// emission it hits with [`power_heuristic`]`(bsdf_pdf, light_pdf)`): the part of the BSDF in
-/// those lobes is weighted by the power heuristic, the rest counts fully. `None`: no lobe
-/// competes.
+/// `samples` samples of the emissive triangles and as many of the environment, each
+/// shadow-tested. `lobes` selects the part of the BSDF evaluated; `competing` says which of
+/// the caller's BSDF strategies also find emitters and the environment (see [`Competing`]).
 pub fn estimate_direct(
     placed: &PlacedScene<'_>,
     hit: &Hit,
     bsdf: &Bsdf,
     lobes: Lobes,
-    mis_lobes: Option<Lobes>,
-    emissive_samples: u32,
+    competing: Competing<'_>,
+    samples: u32,
     sampler: &mut Sampler,
 ) -> Vec3 {
     let scene = placed.scene();
@@ -260,7 +312,12 @@ pub fn estimate_direct(
     let n = bsdf.normal();
     let mut total = Vec3::ZERO;
     for i in 0..lights.punctual_count() {
-        let Some(ls) = lights.punctual_at(i, hit.position) else {
+        let u = if lights.punctual[i].0.angular_radius > 0.0 {
+            sampler.next_2d()
+        } else {
+            Vec2::splat(0.5)
+        };
+        let Some(ls) = lights.punctual_at(i, hit.position, u) else {
             continue;
         };
         let (f, _) = bsdf.eval(ls.wi, lobes);
@@ -273,9 +330,9 @@ pub fn estimate_direct(
         }
         total += f * ls.value * ls.wi.dot(n).abs();
     }
-    if emissive_samples > 0 && lights.has_emissive() {
+    if samples > 0 && lights.has_emissive() {
         let mut sum = Vec3::ZERO;
-        for _ in 0..emissive_samples {
+        for _ in 0..samples {
             let u_pick = sampler.next_f32();
             let u = sampler.next_2d();
             let Some(ls) = lights.sample_emissive(scene, hit.position, u_pick, u) else {
@@ -285,20 +342,39 @@ pub fn estimate_direct(
             if f_all == Vec3::ZERO || ls.value == Vec3::ZERO {
                 continue;
             }
-            let f = match mis_lobes {
-                None => f_all,
-                Some(l) => {
-                    let (f_c, p_c) = bsdf.eval(ls.wi, l);
-                    (f_all - f_c) + f_c * power_heuristic(ls.pdf, p_c)
-                }
-            };
+            let f = weighted(bsdf, ls.wi, f_all, ls.pdf, competing.emissive);
             let origin = hit.offset_origin(ls.wi);
             if placed.segment_occluded(origin, ls.position) {
                 continue;
             }
             sum += f * ls.value * (ls.wi.dot(n).abs() / ls.pdf);
         }
-        total += sum / emissive_samples as f32;
+        total += sum / samples as f32;
+    }
+    if let Some((env_lobes, env_competing)) = competing.environment
+        && samples > 0
+        && lights.env.can_sample()
+    {
+        let mut sum = Vec3::ZERO;
+        for _ in 0..samples {
+            let Some(es) = lights.env.sample(sampler.next_2d()) else {
+                continue;
+            };
+            if es.radiance == Vec3::ZERO {
+                continue;
+            }
+            let (f_all, _) = bsdf.eval(es.wi, env_lobes);
+            if f_all == Vec3::ZERO {
+                continue;
+            }
+            let f = weighted(bsdf, es.wi, f_all, es.pdf, env_competing);
+            let origin = hit.offset_origin(es.wi);
+            if placed.occluded(&Ray::new(origin, es.wi)) {
+                continue;
+            }
+            sum += f * es.radiance * (es.wi.dot(n).abs() / es.pdf);
+        }
+        total += sum / samples as f32;
     }
     total
 }

@@ -1,6 +1,8 @@
-//! The reference path tracer: unbiased, next-event estimation for emissive triangles with
-//! multiple importance sampling against BSDF sampling (power heuristic), punctual lights by
-//! next-event estimation only, Russian roulette. It is the ground truth of every quality
+//! The reference path tracer: unbiased, next-event estimation for emissive triangles and the
+//! environment with multiple importance sampling against BSDF sampling (power heuristic),
+//! punctual lights by next-event estimation only, Russian roulette. Without environment
+//! sampling ([`PathTracerSettings::environment_sampling`] off, for comparisons) the sky is
+//! found by BSDF sampling alone. It is the ground truth of every quality
 //! figure (docs/architecture.md, "Measuring").
 
 use glam::Vec3;
@@ -8,7 +10,7 @@ use glam::Vec3;
 use crate::accel::{PlacedScene, Ray};
 use crate::camera::Camera;
 use crate::image::Image;
-use crate::light::estimate_direct;
+use crate::light::{Competing, estimate_direct};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::render::{RadianceSample, render_camera};
 use crate::sampling::{Sampler, power_heuristic};
@@ -25,6 +27,9 @@ pub struct PathTracerSettings {
     pub rr_start_depth: u32,
     /// Seed of the random streams.
     pub seed: u64,
+    /// Next-event estimation towards the environment (on by default; off only to measure what
+    /// it gains).
+    pub environment_sampling: bool,
 }
 
 impl Default for PathTracerSettings {
@@ -34,6 +39,7 @@ impl Default for PathTracerSettings {
             max_depth: 64,
             rr_start_depth: 3,
             seed: 0,
+            environment_sampling: true,
         }
     }
 }
@@ -68,6 +74,16 @@ impl PathTracer {
         let mut prev_delta = true;
         for depth in 0..=self.settings.max_depth {
             let Some(hit) = placed.intersect(&ray) else {
+                let env = lights.environment();
+                if !env.is_none() {
+                    let le = env.radiance(ray.direction);
+                    let w = if prev_delta || !self.settings.environment_sampling {
+                        1.0
+                    } else {
+                        power_heuristic(prev_pdf, env.pdf(ray.direction))
+                    };
+                    l += beta * le * w;
+                }
                 break;
             };
             if depth == 0 {
@@ -95,7 +111,13 @@ impl PathTracer {
                         &hit,
                         &bsdf,
                         Lobes::All,
-                        Some(Lobes::All),
+                        Competing {
+                            emissive: &[Lobes::All],
+                            environment: self
+                                .settings
+                                .environment_sampling
+                                .then_some((Lobes::All, &[Lobes::All][..])),
+                        },
                         1,
                         sampler,
                     );

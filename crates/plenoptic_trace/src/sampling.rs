@@ -162,6 +162,25 @@ impl Distribution1d {
         (i, self.pmf(i))
     }
 
+    /// Draws an index as [`Distribution1d::sample`] does, with `u` remapped to [0, 1) inside
+    /// the chosen bin (for a continuous position in it).
+    pub fn sample_remapped(&self, u: f32) -> (usize, f32, f32) {
+        let (i, pmf) = self.sample(u);
+        let prev = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        let width = self.cdf[i] - prev;
+        let r = if width > 0.0 {
+            ((u * self.total - prev) / width).clamp(0.0, 0.999_999_9)
+        } else {
+            0.5
+        };
+        (i, pmf, r)
+    }
+
+    /// Number of bins.
+    pub fn len(&self) -> usize {
+        self.cdf.len()
+    }
+
     /// Probability of index `i`.
     pub fn pmf(&self, i: usize) -> f32 {
         let prev = if i == 0 { 0.0 } else { self.cdf[i - 1] };

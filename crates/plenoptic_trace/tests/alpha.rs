@@ -32,6 +32,7 @@ fn pt(spp: u32) -> PathTracer {
         max_depth: 16,
         rr_start_depth: 3,
         seed: 5,
+        environment_sampling: true,
     })
 }
 

@@ -19,6 +19,7 @@ fn pt(spp: u32) -> PathTracer {
         max_depth: 64,
         rr_start_depth: 3,
         seed: 7,
+        environment_sampling: true,
     })
 }
 

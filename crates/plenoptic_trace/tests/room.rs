@@ -24,6 +24,7 @@ fn multi_stage_matches_reference_in_furnished_room() {
         max_depth: 16,
         rr_start_depth: 3,
         seed: 1,
+        environment_sampling: true,
     })
     .render(&placed, &cam)
     .radiance();
@@ -59,6 +60,7 @@ fn multi_stage_matches_reference_in_furnished_room() {
         max_depth: 16,
         rr_start_depth: 3,
         seed: 9,
+        environment_sampling: true,
     })
     .render(&placed, &cam)
     .radiance();

@@ -1,5 +1,6 @@
 //! Id-images for the coherence tests: cubes around a point, orthographic views along a
-//! directional light, and the fitness of a set of id-images (thesis §6.5.2: the fraction of
+//! directional light (the sun of a sun study follows its track) and along a changing sky's
+//! mean direction, and the fitness of a set of id-images (thesis §6.5.2: the fraction of
 //! pixels whose object id is the same in every image).
 
 use glam::Vec3;
@@ -69,6 +70,14 @@ pub fn light_ids(
             LightKind::Directional => ortho_ids(placed, p.direction, centre, radius, size),
         });
     }
+    if scene.environment_is_animated() {
+        // A sky that changes (it follows a moving sun) is a light too: its id-image looks
+        // along the direction its light arrives from on average.
+        let towards = sky_direction(placed);
+        if towards != Vec3::ZERO {
+            out.push(ortho_ids(placed, -towards, centre, radius, size));
+        }
+    }
     let emissive = placed.lights().emissive();
     let probes = emissive.len().min(EMISSIVE_PROBES);
     for k in 0..probes {
@@ -78,6 +87,27 @@ pub fn light_ids(
         out.push(cube_ids(placed, c + tri.normal * offset, size));
     }
     out
+}
+
+/// The luminance-weighted mean direction towards the environment over the upper hemisphere
+/// (zero for a black sky), on a 32 × 8 grid of directions.
+pub fn sky_direction(placed: &PlacedScene<'_>) -> Vec3 {
+    let env = placed.lights().environment();
+    let mut sum = Vec3::ZERO;
+    for i in 0..8 {
+        let theta = (i as f32 + 0.5) / 8.0 * std::f32::consts::FRAC_PI_2;
+        for j in 0..32 {
+            let phi = (j as f32 + 0.5) / 32.0 * std::f32::consts::TAU;
+            let d = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            let l = plenoptic_trace::image::luminance(env.radiance(d));
+            sum += d * l * theta.sin();
+        }
+    }
+    sum.normalize_or_zero()
 }
 
 /// Fraction of pixels whose id is the same in every image (1 for no images or no pixels).

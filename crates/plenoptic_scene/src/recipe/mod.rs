@@ -31,6 +31,7 @@
 //! q = 0.93                          # any Quality field overrides the preset
 //! ```
 
+pub mod daylight;
 mod quality;
 
 use std::path::{Path, PathBuf};
@@ -58,6 +59,12 @@ pub struct Recipe {
     /// Quality preset and overrides.
     #[serde(default)]
     pub quality: QualityToml,
+    /// A sun study (see [`daylight`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<daylight::SunToml>,
+    /// The environment (see [`daylight`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sky: Option<daylight::SkyToml>,
 }
 
 /// One `[[scene]]` entry: a glTF file and its placement.
@@ -166,6 +173,8 @@ pub struct BakeRecipe {
     pub quality: Quality,
     /// The pack to write, path resolved.
     pub output: PathBuf,
+    /// Sun study and sky.
+    pub daylight: daylight::Daylight,
 }
 
 /// A scene file and its placement.
@@ -367,6 +376,7 @@ impl Recipe {
         }
 
         let quality = self.quality.validate(&err)?;
+        let daylight = daylight::validate(self.sun.as_ref(), self.sky.as_ref(), base_dir, &err)?;
         Ok(BakeRecipe {
             name: name.to_owned(),
             scenes,
@@ -378,6 +388,7 @@ impl Recipe {
             },
             quality,
             output: base_dir.join(&self.output),
+            daylight,
         })
     }
 }

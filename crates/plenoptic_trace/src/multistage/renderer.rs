@@ -3,14 +3,19 @@
 //!
 //! Radiance leaving a hit towards the viewer =
 //! emission
-//! + direct light from punctual lights (one shadow ray each) and emissive triangles
-//!   (`shadow_samples` shadow rays: soft shadows), through the full BSDF
-//! + diffuse directional albedo × ambient-field irradiance / π
+//! + direct light from punctual lights (one shadow ray each; the sun's disc sampled for soft
+//!   shadows) and emissive triangles (`shadow_samples` shadow rays), through the full BSDF
+//! + the environment's reflection in the specular lobes (`shadow_samples` samples)
+//! + diffuse directional albedo × ambient-field irradiance / π, where the field holds the
+//!   environment's direct light too: a sky seen through a window is a large, smooth source,
+//!   gathered once per field point instead of sampled per pixel (which in a room lit through
+//!   a small window needs hundreds of shadow rays to converge)
 //! + specular reflection and refraction traced recursively up to `max_specular_depth`
 //!   (one ray for ideal lobes, `glossy_samples` GGX samples for rough ones at the first hit).
 //!
-//! Emitters found by glossy rays and by light sampling are combined with the power heuristic;
-//! the diffuse lobe sees emitters through light sampling only.
+//! Emitters and the environment found by glossy rays and by light sampling are combined with
+//! the power heuristic; the diffuse lobe sees emitters through light sampling only. A ray that
+//! leaves the scene returns the environment's radiance (the sky behind windows).
 
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -19,7 +24,7 @@ use super::AmbientField;
 use crate::accel::{PlacedScene, Ray};
 use crate::camera::{Camera, CubeCamera};
 use crate::image::Image;
-use crate::light::estimate_direct;
+use crate::light::{Competing, estimate_direct};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::render::{RadianceSample, render_camera};
 use crate::sampling::{Sampler, power_heuristic};
@@ -91,7 +96,17 @@ impl<'f> MultiStageRenderer<'f> {
         on_hit: &mut dyn FnMut(&crate::Hit),
     ) -> Vec3 {
         let Some(hit) = placed.intersect(ray) else {
-            return Vec3::ZERO;
+            // The environment: seen directly, through delta bounces, or weighted against
+            // light sampling after a glossy one.
+            let env = placed.lights().environment();
+            if env.is_none() {
+                return Vec3::ZERO;
+            }
+            let w = match prev_pdf {
+                None => 1.0,
+                Some(p) => power_heuristic(p, env.pdf(ray.direction)),
+            };
+            return env.radiance(ray.direction) * w;
         };
         on_hit(&hit);
         let scene = placed.scene();
@@ -109,7 +124,13 @@ impl<'f> MultiStageRenderer<'f> {
         let bsdf = Bsdf::new(&props, &hit, wo);
         if !bsdf.is_delta(Lobes::All) {
             let n = self.settings.shadow_samples.max(1);
-            l += estimate_direct(placed, &hit, &bsdf, Lobes::All, Some(Lobes::Specular), n, s);
+            // Emitters and the environment compete with the glossy rays below. The diffuse
+            // lobe's share of the environment is in the ambient field, like indirect light.
+            let competing = Competing {
+                emissive: &[Lobes::Specular],
+                environment: Some((Lobes::Specular, &[Lobes::Specular])),
+            };
+            l += estimate_direct(placed, &hit, &bsdf, Lobes::All, competing, n, s);
         }
         if bsdf.has(Lobes::Diffuse) {
             // One-sample estimate of the Lambertian lobe's directional albedo (its Fresnel

@@ -8,8 +8,11 @@
 //! with a non-delta lobe. There it contributes:
 //!
 //! - to D_i, the light that surface reflects of direct light (next-event estimation, one
-//!   shadow sample; emission is added only behind a delta bounce: emission seen directly is
-//!   direct light, which the renderer computes per sample);
+//!   shadow sample towards the lights; emission is added only behind a delta bounce: seen
+//!   directly it is direct light, which the renderer computes per sample), plus the
+//!   environment where the ray leaves the scene, straight or through delta bounces. The sky
+//!   is in the field as a source: the renderer does not sample it for diffuse reflection, and
+//!   at gather hits it is not sampled either, since the hit's own field value holds it;
 //! - to row i of the sparse matrix K, the surface's one-sample non-delta albedo times the
 //!   field's interpolation weights at the hit (those it can see, `super::visibility`): its
 //!   share of the hit's own indirect light.
@@ -38,15 +41,22 @@ use super::layout::FieldLayout;
 use super::visibility::{Blocked, blocked_edges, visible_weights};
 use crate::accel::{PlacedScene, Ray};
 use crate::image::luminance;
-use crate::light::estimate_direct;
+use crate::light::{Competing, estimate_direct};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
-use crate::sampling::{Frame, Sampler, cosine_hemisphere};
+use crate::sampling::{Frame, Sampler, cosine_hemisphere, power_heuristic};
 
 /// A point is inside a solid when more than 1/`INSIDE_FRACTION` of its rays first meet the
 /// back face of a single-sided surface. A point in the open meets none (rays hit the front
 /// faces of whatever surrounds it); one on the line where a box runs under a wall meets
 /// about half.
 const INSIDE_FRACTION: u32 = 8;
+
+/// Direct light at gather hits: lights and emitters, not the environment, which reaches the
+/// hit's own field point (E of the hit includes it) and so enters through K.
+const LIGHTS_ONLY: Competing<'static> = Competing {
+    emissive: &[],
+    environment: None,
+};
 
 /// What one gather point's rays found.
 struct PointGather {
@@ -92,13 +102,41 @@ fn gather_point(
     let scene = placed.scene();
     let rays = settings.rays_per_point.max(1);
     let mut back_faces = 0u32;
+    let env = placed.lights().environment();
+    let sample_env = env.can_sample();
     for _ in 0..rays {
         let d = frame.to_world(cosine_hemisphere(s.next_2d()));
+        if sample_env {
+            // The environment seen straight from the point, by its own distribution, weighted
+            // against the cosine rays (power heuristic); in units of the cosine rays' sum,
+            // which is scaled by π/rays below.
+            if let Some(e) = env.sample(s.next_2d()) {
+                let cos = e.wi.dot(n);
+                if cos > 0.0
+                    && e.radiance != Vec3::ZERO
+                    && !placed.occluded(&Ray::new(p + n * eps, e.wi))
+                {
+                    let w = power_heuristic(e.pdf, cos / std::f32::consts::PI);
+                    out.direct += e.radiance * (cos * w / (e.pdf * std::f32::consts::PI));
+                }
+            }
+        }
         let mut ray = Ray::new(p + n * eps, d);
         let mut throughput = Vec3::ONE;
         for depth in 0..=settings.max_delta_depth {
-            // A miss finds no light: the scene has no environment yet.
             let Some(hit) = placed.intersect(&ray) else {
+                // The environment: the field holds its light (seen straight or through delta
+                // bounces), which the renderer does not sample for the diffuse lobe. Straight
+                // from the point it competes with the sample above.
+                let w = if depth == 0 && sample_env {
+                    power_heuristic(
+                        ray.direction.dot(n) / std::f32::consts::PI,
+                        env.pdf(ray.direction),
+                    )
+                } else {
+                    1.0
+                };
+                out.direct += throughput * env.radiance(ray.direction) * w;
                 break;
             };
             let props = SurfaceProps::at(scene, &hit);
@@ -118,8 +156,8 @@ fn gather_point(
                 break;
             }
             if !bsdf.is_delta(Lobes::All) {
-                out.direct +=
-                    throughput * estimate_direct(placed, &hit, &bsdf, Lobes::All, None, 1, s);
+                out.direct += throughput
+                    * estimate_direct(placed, &hit, &bsdf, Lobes::All, LIGHTS_ONLY, 1, s);
             }
             // One sample of the whole BSDF: a delta lobe carries the ray on; a non-delta lobe
             // ends it, its weight being a one-sample estimate of the non-delta albedo that
@@ -297,12 +335,19 @@ pub(super) fn gather(
             .collect();
         let mut next = next;
         apply_fill(&mut next, &rounds);
+        // The increment relative to each point's own value, averaged: a bright exterior lit
+        // by the sky must not declare a dim interior converged.
+        let total = luminance_sum(&next);
+        let floor = 1e-3 * total / next.len().max(1) as f64;
         let increment: f64 = next
             .iter()
             .zip(&values)
-            .map(|(a, b)| f64::from(luminance(*a - *b)).abs())
-            .sum();
-        let total = luminance_sum(&next);
+            .map(|(a, b)| {
+                let d = f64::from(luminance(*a - *b)).abs();
+                d / f64::from(luminance(*a)).max(floor).max(f64::MIN_POSITIVE)
+            })
+            .sum::<f64>()
+            / next.len().max(1) as f64;
         values = next;
         bounces += 1;
         if total <= 0.0 || increment <= 0.0 {
@@ -314,7 +359,7 @@ pub(super) fn gather(
         let tail = increment * r / (1.0 - r);
         let first = !previous_increment.is_finite();
         previous_increment = increment;
-        if !first && tail <= f64::from(settings.tolerance) * total {
+        if !first && tail <= f64::from(settings.tolerance) {
             break;
         }
     }

@@ -1,0 +1,335 @@
+//! The recipe's daylight: `[sun]` (a sun study: place, date, time of day) and `[sky]` (the
+//! environment), validated into a [`Daylight`] (docs/architecture.md, "Daylight").
+//!
+//! ```toml
+//! [sun]                          # a sun study over the bake's time range
+//! latitude = 48.8566             # degrees north
+//! longitude = 2.3522             # degrees east
+//! date = "2026-06-21"
+//! utc_offset = 2.0               # hours of local time ahead of UTC
+//! local_time = [6.0, 21.0]       # hours, mapped onto [time.start, time.end]
+//! north_deg = 0.0                # compass north: degrees from the model's −Z towards +X
+//! illuminance = 100000.0         # lux with the sun at the zenith (falls with air mass)
+//! color = [1.0, 1.0, 1.0]
+//! angular_diameter_deg = 0.533   # the sun's disc: soft shadows (0: hard)
+//! light = "Sun"                  # optional: drive this glTF directional light instead of adding one
+//!
+//! [sky]
+//! kind = "hosek-wilkie"          # or "image", "uniform", "none"
+//! turbidity = 3.0                # hosek-wilkie: 1 (clear) to 10 (hazy)
+//! ground_albedo = [0.2, 0.2, 0.2]
+//! scale = 1000.0                 # hosek-wilkie: model kcd/m² to the scene's lux units
+//! sun = "Sun"                    # hosek-wilkie without [sun]: the glTF directional light that is the sun
+//! # file = "studio.exr"          # image: equirectangular .hdr or .exr
+//! # intensity = 1.0              # image: multiplies the texels
+//! # rotation_deg = 0.0           # image: turn about +Y
+//! # color = [0.5, 0.6, 0.8]      # uniform: radiance
+//! ```
+//!
+//! With `[sun]` and no `[sky]` the sky is Hosek–Wilkie with its defaults. A `[sky]` of kind
+//! hosek-wilkie without `[sun]` takes its sun from the light named by `sky.sun`, else from
+//! the scene's first directional light.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use plenoptic_sky::{SkyParams, SunStudy};
+use serde::{Deserialize, Serialize};
+
+use super::ErrFn;
+use crate::error::RecipeError;
+
+/// The `[sun]` table.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(
+    missing_docs,
+    reason = "each key is documented in the module's example"
+)]
+pub struct SunToml {
+    pub latitude: f64,
+    pub longitude: f64,
+    pub date: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub utc_offset: Option<f64>,
+    pub local_time: [f64; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub north_deg: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub illuminance: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_diameter_deg: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<String>,
+}
+
+/// The `[sky]` table.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(
+    missing_docs,
+    reason = "each key is documented in the module's example"
+)]
+pub struct SkyToml {
+    pub kind: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turbidity: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ground_albedo: Option<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intensity: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_deg: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<[f32; 3]>,
+}
+
+/// A validated sun study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunSpec {
+    /// Where, when, how bright.
+    pub study: SunStudy,
+    /// Angular diameter of the disc, degrees.
+    pub angular_diameter_deg: f32,
+    /// The glTF directional light it drives; `None`: a light named "Sun" is added.
+    pub light: Option<String>,
+}
+
+/// A validated sky.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum SkySpec {
+    /// No environment.
+    #[default]
+    None,
+    /// Hosek–Wilkie, with the light that is its sun when there is no `[sun]`.
+    HosekWilkie {
+        /// Model parameters.
+        params: SkyParams,
+        /// `sky.sun`.
+        sun_light: Option<String>,
+    },
+    /// An equirectangular image file.
+    Image {
+        /// The file, resolved against the recipe's directory.
+        path: PathBuf,
+        /// Multiplies the texels.
+        intensity: f32,
+        /// Turn about +Y, degrees.
+        rotation_deg: f32,
+    },
+    /// A uniform radiance.
+    Uniform(Vec3),
+}
+
+/// The recipe's daylight.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Daylight {
+    /// The sun study, if any.
+    pub sun: Option<SunSpec>,
+    /// The sky.
+    pub sky: SkySpec,
+}
+
+fn vec3(key: &str, v: [f32; 3], err: &ErrFn) -> Result<Vec3, RecipeError> {
+    let v = Vec3::from_array(v);
+    if !v.is_finite() || v.min_element() < 0.0 {
+        return Err(err(key, "must be finite and non-negative"));
+    }
+    Ok(v)
+}
+
+fn date(text: &str, err: &ErrFn) -> Result<(i32, u32, u32), RecipeError> {
+    let bad = || err("sun.date", "must be a date written YYYY-MM-DD");
+    let mut parts = text.trim().split('-');
+    let (Some(y), Some(m), Some(d), None) =
+        (parts.next(), parts.next(), parts.next(), parts.next())
+    else {
+        return Err(bad());
+    };
+    Ok((
+        y.parse().map_err(|_| bad())?,
+        m.parse().map_err(|_| bad())?,
+        d.parse().map_err(|_| bad())?,
+    ))
+}
+
+impl SunToml {
+    pub(super) fn validate(&self, err: &ErrFn) -> Result<SunSpec, RecipeError> {
+        let defaults = SunStudy::default();
+        let study = SunStudy {
+            latitude: self.latitude,
+            longitude: self.longitude,
+            date: date(&self.date, err)?,
+            utc_offset_hours: self.utc_offset.unwrap_or(0.0),
+            local_hours: (self.local_time[0], self.local_time[1]),
+            north_deg: self.north_deg.unwrap_or(0.0),
+            illuminance: self.illuminance.unwrap_or(defaults.illuminance),
+            color: match self.color {
+                Some(c) => vec3("sun.color", c, err)?,
+                None => Vec3::ONE,
+            },
+        };
+        study.validate().map_err(|e| {
+            let text = e.to_string();
+            let key = [
+                "latitude",
+                "longitude",
+                "utc_offset",
+                "local_time",
+                "north_deg",
+                "illuminance",
+                "color",
+            ]
+            .into_iter()
+            .find(|k| text.starts_with(k))
+            .map_or("sun.date".to_owned(), |k| format!("sun.{k}"));
+            err(&key, &text)
+        })?;
+        let angular_diameter_deg = self
+            .angular_diameter_deg
+            .unwrap_or(plenoptic_sky::sun::SUN_ANGULAR_DIAMETER_DEG);
+        if !(0.0..=20.0).contains(&angular_diameter_deg) {
+            return Err(err(
+                "sun.angular_diameter_deg",
+                "must be in [0, 20] degrees",
+            ));
+        }
+        if self.light.as_deref().is_some_and(|l| l.trim().is_empty()) {
+            return Err(err(
+                "sun.light",
+                "must name a directional light of the scene",
+            ));
+        }
+        Ok(SunSpec {
+            study,
+            angular_diameter_deg,
+            light: self.light.clone(),
+        })
+    }
+}
+
+impl SkyToml {
+    pub(super) fn validate(&self, base_dir: &Path, err: &ErrFn) -> Result<SkySpec, RecipeError> {
+        let kind = self.kind.as_str();
+        let allowed: &[&str] = match kind {
+            "none" => &[],
+            "hosek-wilkie" => &["turbidity", "ground_albedo", "scale", "sun"],
+            "image" => &["file", "intensity", "rotation_deg"],
+            "uniform" => &["color"],
+            _ => {
+                return Err(err(
+                    "sky.kind",
+                    "must be \"hosek-wilkie\", \"image\", \"uniform\" or \"none\"",
+                ));
+            }
+        };
+        let present = [
+            ("turbidity", self.turbidity.is_some()),
+            ("ground_albedo", self.ground_albedo.is_some()),
+            ("scale", self.scale.is_some()),
+            ("sun", self.sun.is_some()),
+            ("file", self.file.is_some()),
+            ("intensity", self.intensity.is_some()),
+            ("rotation_deg", self.rotation_deg.is_some()),
+            ("color", self.color.is_some()),
+        ];
+        if let Some((k, _)) = present.iter().find(|(k, p)| *p && !allowed.contains(k)) {
+            return Err(err(
+                &format!("sky.{k}"),
+                &format!("not used by kind = \"{kind}\""),
+            ));
+        }
+        Ok(match kind {
+            "none" => SkySpec::None,
+            "hosek-wilkie" => {
+                let d = SkyParams::default();
+                let params = SkyParams {
+                    turbidity: self.turbidity.unwrap_or(d.turbidity),
+                    ground_albedo: match self.ground_albedo {
+                        Some(a) => vec3("sky.ground_albedo", a, err)?,
+                        None => d.ground_albedo,
+                    },
+                    scale: self.scale.unwrap_or(d.scale),
+                };
+                params.validate().map_err(|e| {
+                    let text = e.to_string();
+                    let key = ["turbidity", "ground_albedo", "scale"]
+                        .into_iter()
+                        .find(|k| text.starts_with(k))
+                        .unwrap_or("turbidity");
+                    err(&format!("sky.{key}"), &text)
+                })?;
+                SkySpec::HosekWilkie {
+                    params,
+                    sun_light: self.sun.clone(),
+                }
+            }
+            "image" => {
+                let file = self.file.as_deref().unwrap_or("");
+                let lower = file.to_ascii_lowercase();
+                if !(lower.ends_with(".hdr") || lower.ends_with(".exr")) {
+                    return Err(err(
+                        "sky.file",
+                        "must name an equirectangular .hdr or .exr file",
+                    ));
+                }
+                let intensity = self.intensity.unwrap_or(1.0);
+                if !(intensity.is_finite() && intensity >= 0.0) {
+                    return Err(err("sky.intensity", "must be finite and non-negative"));
+                }
+                let rotation_deg = self.rotation_deg.unwrap_or(0.0);
+                if !rotation_deg.is_finite() {
+                    return Err(err("sky.rotation_deg", "must be finite"));
+                }
+                SkySpec::Image {
+                    path: base_dir.join(file),
+                    intensity,
+                    rotation_deg,
+                }
+            }
+            _ => SkySpec::Uniform(vec3(
+                "sky.color",
+                self.color
+                    .ok_or_else(|| err("sky.color", "required for kind = \"uniform\""))?,
+                err,
+            )?),
+        })
+    }
+}
+
+/// Validates the two tables together.
+pub(super) fn validate(
+    sun: Option<&SunToml>,
+    sky: Option<&SkyToml>,
+    base_dir: &Path,
+    err: &ErrFn,
+) -> Result<Daylight, RecipeError> {
+    let sun = sun.map(|s| s.validate(err)).transpose()?;
+    let sky = match sky {
+        Some(s) => s.validate(base_dir, err)?,
+        None if sun.is_some() => SkySpec::HosekWilkie {
+            params: SkyParams::default(),
+            sun_light: None,
+        },
+        None => SkySpec::None,
+    };
+    if sun.is_some()
+        && let SkySpec::HosekWilkie {
+            sun_light: Some(_), ..
+        } = sky
+    {
+        return Err(err(
+            "sky.sun",
+            "not used with [sun]: name the light in sun.light",
+        ));
+    }
+    Ok(Daylight { sun, sky })
+}
