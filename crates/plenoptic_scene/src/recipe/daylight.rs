@@ -333,3 +333,103 @@ pub(super) fn validate(
     }
     Ok(Daylight { sun, sky })
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::recipe::Recipe;
+    use std::path::Path;
+
+    const BASE: &str = r#"
+output = "out.pack"
+[[scene]]
+file = "a.glb"
+[view_space]
+kind = "segment"
+a = [0.0, 1.0, 0.0]
+b = [1.0, 1.0, 0.0]
+[time]
+start = 0.0
+end = 14.0
+frame_rate = 30.0
+"#;
+
+    fn parse(extra: &str) -> Result<super::Daylight, String> {
+        Recipe::from_str_named(&format!("{BASE}{extra}"), "r.toml", Path::new("/d"))
+            .map(|r| r.daylight)
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_sun_study_with_the_default_sky() {
+        let d = parse(
+            "[sun]\nlatitude = 48.85\nlongitude = 2.35\ndate = \"2026-06-21\"\nutc_offset = 2.0\nlocal_time = [6.0, 21.0]\n",
+        )
+        .unwrap();
+        let sun = d.sun.unwrap();
+        assert_eq!(sun.study.date, (2026, 6, 21));
+        assert_eq!(sun.study.local_hours, (6.0, 21.0));
+        assert!((sun.angular_diameter_deg - 0.533).abs() < 1e-6);
+        assert!(matches!(d.sky, super::SkySpec::HosekWilkie { .. }));
+        assert_eq!(parse("").unwrap(), super::Daylight::default());
+    }
+
+    #[test]
+    fn skies_of_each_kind() {
+        let d = parse("[sky]\nkind = \"image\"\nfile = \"sky.exr\"\nintensity = 2.0\n").unwrap();
+        match d.sky {
+            super::SkySpec::Image {
+                path, intensity, ..
+            } => {
+                assert_eq!(path, Path::new("/d/sky.exr"));
+                assert_eq!(intensity, 2.0);
+            }
+            other => panic!("{other:?}"),
+        }
+        let d = parse("[sky]\nkind = \"uniform\"\ncolor = [0.1, 0.2, 0.3]\n").unwrap();
+        assert!(matches!(d.sky, super::SkySpec::Uniform(_)));
+        let d = parse("[sky]\nkind = \"hosek-wilkie\"\nturbidity = 5.0\nsun = \"Key\"\n").unwrap();
+        assert!(matches!(
+            d.sky,
+            super::SkySpec::HosekWilkie {
+                sun_light: Some(_),
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let sun = |extra: &str| {
+            parse(&format!(
+                "[sun]\nlatitude = 48.85\nlongitude = 2.35\ndate = \"2026-06-21\"\nlocal_time = [6.0, 21.0]\n{extra}"
+            ))
+        };
+        for (extra, key) in [
+            ("", ""),
+            ("angular_diameter_deg = -1.0\n", "sun.angular_diameter_deg"),
+            ("illuminance = -5.0\n", "sun.illuminance"),
+        ] {
+            match sun(extra) {
+                Ok(_) => assert!(key.is_empty(), "{extra} should fail"),
+                Err(e) => assert!(e.contains(key) && !key.is_empty(), "{e}"),
+            }
+        }
+        let e = parse("[sun]\nlatitude = 95.0\nlongitude = 0.0\ndate = \"2026-06-21\"\nlocal_time = [6.0, 21.0]\n").unwrap_err();
+        assert!(e.contains("sun.latitude"), "{e}");
+        let e = parse("[sun]\nlatitude = 0.0\nlongitude = 0.0\ndate = \"2026-13-01\"\nlocal_time = [6.0, 21.0]\n").unwrap_err();
+        assert!(e.contains("sun.date"), "{e}");
+        let e = parse("[sky]\nkind = \"rainbow\"\n").unwrap_err();
+        assert!(e.contains("sky.kind"), "{e}");
+        let e = parse("[sky]\nkind = \"uniform\"\ncolor = [1.0, 1.0, 1.0]\nturbidity = 3.0\n")
+            .unwrap_err();
+        assert!(e.contains("sky.turbidity") && e.contains("not used"), "{e}");
+        let e = parse("[sky]\nkind = \"image\"\nfile = \"sky.png\"\n").unwrap_err();
+        assert!(e.contains("sky.file"), "{e}");
+        let e = parse("[sky]\nkind = \"hosek-wilkie\"\nturbidity = 11.0\n").unwrap_err();
+        assert!(e.contains("sky.turbidity"), "{e}");
+        let e = parse("[sky]\nkind = \"uniform\"\n").unwrap_err();
+        assert!(e.contains("sky.color"), "{e}");
+        let e = parse("[sun]\nlatitude = 0.0\nlongitude = 0.0\ndate = \"2026-06-21\"\nlocal_time = [6.0, 21.0]\nbogus = 1\n").unwrap_err();
+        assert!(e.contains("bogus"), "{e}");
+    }
+}

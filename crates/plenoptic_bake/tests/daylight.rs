@@ -1,0 +1,346 @@
+//! Daylight through the baker's input: environment images read from disk, a recipe's
+//! `[sun]`/`[sky]` applied to the scene, a generated building in the style of a BIM export
+//! (alpha-blended glass, no lights of its own, sun and sky from the recipe) lit inside as the
+//! path tracer lights it, and a sun study's plan.
+
+use exr::prelude::WritableImage;
+use std::io::Write;
+use std::path::Path;
+
+use glam::{Quat, Vec3, Vec4};
+use plenoptic_bake::daylight::read_equirect;
+use plenoptic_bake::input::load_recipe;
+use plenoptic_bake::plan::{ambient, decompose};
+use plenoptic_scene::builder::shapes::cuboid;
+use plenoptic_scene::builder::{MaterialDesc, NodeDesc, SceneBuilder};
+use plenoptic_scene::{AlphaMode, Trs};
+use plenoptic_trace::{
+    AmbientField, Image, MultiStageRenderer, MultiStageSettings, PathTracer, PathTracerSettings,
+    PinholeCamera, SceneAccel,
+};
+
+/// A flat (uncompressed) Radiance file of `w` × `h` RGBE texels, `w` < 8 so that no run-length
+/// encoding is expected.
+fn write_hdr(path: &Path, w: usize, h: usize, rgbe: &[[u8; 4]], claim: Option<(usize, usize)>) {
+    let (cw, ch) = claim.unwrap_or((w, h));
+    let mut f = std::fs::File::create(path).unwrap();
+    write!(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {ch} +X {cw}\n").unwrap();
+    for t in rgbe {
+        f.write_all(t).unwrap();
+    }
+}
+
+#[test]
+fn environment_images_are_read_and_bad_ones_named() {
+    let dir = tempfile::tempdir().unwrap();
+    // RGBE (128, 64, 32, 129): mantissas × 2^(129 − 136) → (1, 0.5, 0.25).
+    let hdr = dir.path().join("sky.hdr");
+    write_hdr(&hdr, 4, 2, &[[128, 64, 32, 129]; 8], None);
+    let img = read_equirect(&hdr).unwrap();
+    assert_eq!((img.width, img.height), (4, 2));
+    assert!(
+        (img.texels[5] - Vec3::new(1.0, 0.5, 0.25)).length() < 0.01,
+        "{}",
+        img.texels[5]
+    );
+
+    // An EXR written by the exr crate (ZIP, half floats, as compositors write by default).
+    let exr_path = dir.path().join("sky.exr");
+    let pixels = |p: exr::math::Vec2<usize>| {
+        let v = (p.x() + 4 * p.y()) as f32 * 0.25;
+        (
+            half::f16::from_f32(v),
+            half::f16::from_f32(1.0),
+            half::f16::from_f32(2.0),
+        )
+    };
+    let layer = exr::prelude::Layer::new(
+        (4, 2),
+        exr::prelude::LayerAttributes::named("rgb"),
+        exr::prelude::Encoding::SMALL_LOSSLESS,
+        exr::prelude::SpecificChannels::rgb(pixels),
+    );
+    exr::prelude::Image::from_layer(layer)
+        .write()
+        .to_file(&exr_path)
+        .unwrap();
+    let img = read_equirect(&exr_path).unwrap();
+    assert_eq!((img.width, img.height), (4, 2));
+    assert!(
+        (img.texels[6] - Vec3::new(1.5, 1.0, 2.0)).length() < 1e-3,
+        "{}",
+        img.texels[6]
+    );
+
+    // A header claiming 100 000 × 100 000 texels is refused before anything is allocated.
+    let hostile = dir.path().join("hostile.hdr");
+    write_hdr(
+        &hostile,
+        4,
+        2,
+        &[[128, 64, 32, 129]; 8],
+        Some((100_000, 100_000)),
+    );
+    let e = read_equirect(&hostile).unwrap_err().to_string();
+    assert!(e.contains("hostile.hdr") && e.contains("outside"), "{e}");
+    // Truncated: the header promises more scanlines than the file has.
+    let short = dir.path().join("short.hdr");
+    write_hdr(&short, 4, 2, &[[128, 64, 32, 129]; 3], Some((4, 2)));
+    let e = read_equirect(&short).unwrap_err().to_string();
+    assert!(e.contains("short.hdr"), "{e}");
+    let e = read_equirect(&dir.path().join("missing.exr"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("missing.exr"), "{e}");
+}
+
+/// A 10 × 3 × 7 m building of 0.25 m slabs, as a CAD export has it: windows as openings with
+/// BLEND glass panes of alpha 0.12 in the south (+z) wall, a skylight in the roof, no lights.
+fn bim_building(path: &Path) {
+    let mut b = SceneBuilder::new();
+    let plaster = b.add_material(MaterialDesc::diffuse(Vec3::splat(0.75)).named("plaster"));
+    let floor = b.add_material(MaterialDesc::diffuse(Vec3::new(0.45, 0.35, 0.25)).named("oak"));
+    let glass = b.add_material(
+        MaterialDesc::diffuse(Vec3::splat(0.9))
+            .base_color_alpha(Vec4::new(0.9, 0.95, 0.95, 0.12))
+            .alpha_mode(AlphaMode::Blend)
+            .double_sided(true)
+            .named("Glazing"),
+    );
+    let t = 0.25;
+    let slab = |b: &mut SceneBuilder, name: &str, size: Vec3, at: Vec3, m| {
+        b.add_object(
+            name,
+            cuboid(size),
+            m,
+            Trs {
+                translation: at,
+                ..Trs::default()
+            },
+        );
+    };
+    let (w, h, d) = (10.0f32, 3.0f32, 7.0f32);
+    slab(
+        &mut b,
+        "Floor",
+        Vec3::new(w, t, d),
+        Vec3::new(0.0, -t / 2.0, 0.0),
+        floor,
+    );
+    // The roof in two parts around a 2 × 2 m skylight at x ∈ [2, 4], z ∈ [−1, 1].
+    slab(
+        &mut b,
+        "RoofW",
+        Vec3::new(7.0, t, d),
+        Vec3::new(-1.5, h + t / 2.0, 0.0),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "RoofE",
+        Vec3::new(1.0, t, d),
+        Vec3::new(4.5, h + t / 2.0, 0.0),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "RoofN",
+        Vec3::new(2.0, t, 2.5),
+        Vec3::new(3.0, h + t / 2.0, -2.25),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "RoofS",
+        Vec3::new(2.0, t, 2.5),
+        Vec3::new(3.0, h + t / 2.0, 2.25),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "Skylight",
+        Vec3::new(2.0, 0.01, 2.0),
+        Vec3::new(3.0, h + t / 2.0, 0.0),
+        glass,
+    );
+    slab(
+        &mut b,
+        "North",
+        Vec3::new(w, h, t),
+        Vec3::new(0.0, h / 2.0, -d / 2.0 + t / 2.0),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "West",
+        Vec3::new(t, h, d - 2.0 * t),
+        Vec3::new(-w / 2.0 + t / 2.0, h / 2.0, 0.0),
+        plaster,
+    );
+    slab(
+        &mut b,
+        "East",
+        Vec3::new(t, h, d - 2.0 * t),
+        Vec3::new(w / 2.0 - t / 2.0, h / 2.0, 0.0),
+        plaster,
+    );
+    // South wall: piers between two 2.4 × 1.6 m windows (x ∈ [−3.6, −1.2] and [1.2, 3.6]).
+    let z = d / 2.0 - t / 2.0;
+    for (name, x0, x1) in [
+        ("PierW", -5.0, -3.6),
+        ("PierM", -1.2, 1.2),
+        ("PierE", 3.6, 5.0),
+    ] {
+        slab(
+            &mut b,
+            name,
+            Vec3::new(x1 - x0, h, t),
+            Vec3::new(0.5 * (x0 + x1), h / 2.0, z),
+            plaster,
+        );
+    }
+    for (i, x) in [-2.4f32, 2.4].into_iter().enumerate() {
+        slab(
+            &mut b,
+            &format!("Sill{i}"),
+            Vec3::new(2.4, 0.8, t),
+            Vec3::new(x, 0.4, z),
+            plaster,
+        );
+        slab(
+            &mut b,
+            &format!("Head{i}"),
+            Vec3::new(2.4, 0.6, t),
+            Vec3::new(x, 2.7, z),
+            plaster,
+        );
+        slab(
+            &mut b,
+            &format!("Pane{i}"),
+            Vec3::new(2.4, 1.6, 0.01),
+            Vec3::new(x, 1.6, z),
+            glass,
+        );
+    }
+    b.add_node(NodeDesc::new("Origin").rotation(Quat::IDENTITY));
+    b.write_glb(path).unwrap();
+}
+
+fn recipe(dir: &Path, local_time: [f64; 2], preset: &str) -> std::path::PathBuf {
+    let path = dir.join(format!("bim_{}_{}.toml", local_time[0], local_time[1]));
+    std::fs::write(
+        &path,
+        format!(
+            r#"output = "bim.pack"
+[[scene]]
+file = "bim.glb"
+[view_space]
+kind = "segment"
+a = [-2.0, 1.6, 0.0]
+b = [2.0, 1.6, 0.0]
+[time]
+start = 0.0
+end = 14.0
+frame_rate = 30.0
+[quality]
+preset = "{preset}"
+[sun]
+latitude = 48.8566
+longitude = 2.3522
+date = "2026-06-21"
+utc_offset = 2.0
+local_time = [{}, {}]
+[sky]
+kind = "hosek-wilkie"
+turbidity = 3.0
+"#,
+            local_time[0], local_time[1]
+        ),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn a_bim_style_building_is_lit_inside_by_sun_and_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    bim_building(&dir.path().join("bim.glb"));
+    let (recipe, scene) = load_recipe(&recipe(dir.path(), [9.0, 17.0], "draft")).unwrap();
+    assert!(scene.sun.is_some() && !scene.environment.is_none());
+    let accel = SceneAccel::new(&scene).unwrap();
+    // Inside, looking north-east across the room at the back wall, floor and sun patches.
+    let camera = PinholeCamera::look_at(
+        Vec3::new(-3.0, 1.6, 2.4),
+        Vec3::new(2.0, 0.6, -3.0),
+        Vec3::Y,
+        1.1,
+        40,
+        30,
+    )
+    .unwrap();
+    for t in [2.0f32, 11.0] {
+        let placed = accel.at_time(t);
+        let field = AmbientField::build(&placed, &ambient::settings(&recipe.quality, 7)).unwrap();
+        let ms = MultiStageRenderer::new(
+            MultiStageSettings {
+                samples_per_pixel: 64,
+                shadow_samples: 2,
+                glossy_samples: 2,
+                max_specular_depth: 4,
+                seed: 3,
+            },
+            &field,
+        )
+        .render(&placed, &camera)
+        .radiance();
+        let pt: Image<Vec3> = PathTracer::new(PathTracerSettings {
+            samples_per_pixel: 512,
+            max_depth: 32,
+            rr_start_depth: 5,
+            seed: 17,
+            environment_sampling: true,
+        })
+        .render(&placed, &camera)
+        .radiance();
+        let (m, r) = (ms.mean_luminance(), pt.mean_luminance());
+        let (sun, lux) = scene.sun_at(t).unwrap();
+        println!(
+            "BIM building t = {t}: interior mean luminance MS {m:.1}, PT {r:.1}, ratio {:.4} (sun {:.1}° up, {:.0} lx)",
+            m / r,
+            sun.y.asin().to_degrees(),
+            lux.x
+        );
+        // Lit inside: a dark interior would be far below the sun's own scale.
+        assert!(r > 100.0, "PT interior mean {r}");
+        assert!((m / r - 1.0).abs() < 0.05, "t = {t}: MS/PT {:.4}", m / r);
+    }
+}
+
+#[test]
+fn a_sun_study_adds_time_keys_where_the_sun_moves() {
+    let dir = tempfile::tempdir().unwrap();
+    bim_building(&dir.path().join("bim.glb"));
+    let keys = |local: [f64; 2]| {
+        let (recipe, scene) = load_recipe(&recipe(dir.path(), local, "draft")).unwrap();
+        let accel = SceneAccel::new(&scene).unwrap();
+        let (plan, _) = decompose(&recipe, &scene, &accel);
+        plan.light_keys
+    };
+    // A whole afternoon against one minute of it, over the same 14 s: the sun's patches move
+    // far in the first and not at all in the second.
+    let day = keys([9.0, 19.0]);
+    let minute = keys([12.0, 12.0 + 1.0 / 60.0]);
+    println!(
+        "light keys: 10 h over 14 s {}, 1 min over 14 s {}",
+        day.len(),
+        minute.len()
+    );
+    println!("10 h keys at {day:?}");
+    assert!(
+        day.len() > minute.len() + 4,
+        "{} vs {}",
+        day.len(),
+        minute.len()
+    );
+    assert!(minute.len() <= 3, "{minute:?}");
+}
