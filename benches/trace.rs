@@ -9,7 +9,9 @@
 //! - the time to place the scene (top-level rebuild) at a new time;
 //! - samples per second of the reference path tracer and the multi-stage renderer on the
 //!   furnished room, on all cores (the ambient field is built once, outside the measurement,
-//!   and its build is measured separately).
+//!   and its build is measured separately);
+//! - the path tracer in a room lit by the sky through one window, with and without
+//!   environment importance sampling: time per frame, and the noise at equal time.
 //!
 //! `cargo bench --no-default-features --bench trace`
 
@@ -225,5 +227,67 @@ fn renderers(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, rays, renderers);
+/// Relative noise of a render: the luminance RMS of the difference of two independent
+/// renders, over √2 (one render's σ), over the mean.
+fn relative_noise(pt: &PathTracer, placed: &PlacedScene<'_>, cam: &PinholeCamera) -> f64 {
+    let mut a = *pt;
+    let mut b = *pt;
+    a.settings.seed = 101;
+    b.settings.seed = 202;
+    let (a, b) = (
+        a.render(placed, cam).radiance(),
+        b.render(placed, cam).radiance(),
+    );
+    let lrms = metrics::relative_lrms(&a, &b);
+    lrms / std::f64::consts::SQRT_2
+}
+
+/// The path tracer in the sky-lit room with and without environment importance sampling:
+/// time per frame measured by criterion, and the noise at equal time printed before it (noise
+/// at 64 spp times √(time per frame), the inverse square root of the estimator's
+/// efficiency).
+fn environment_sampling(c: &mut Criterion) {
+    let scene = shapes::sky_lit_room();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let placed = accel.at_time(0.0);
+    let cam = shapes::sky_room_camera(32, 24).unwrap();
+    let tracer = |on: bool, spp: u32| {
+        PathTracer::new(PathTracerSettings {
+            samples_per_pixel: spp,
+            max_depth: 16,
+            environment_sampling: on,
+            ..PathTracerSettings::default()
+        })
+    };
+    let mut efficiency = [0.0f64; 2];
+    for (i, on) in [true, false].into_iter().enumerate() {
+        let pt = tracer(on, 64);
+        let start = Instant::now();
+        let noise = relative_noise(&pt, &placed, &cam);
+        let seconds = start.elapsed().as_secs_f64() / 2.0;
+        efficiency[i] = noise * seconds.sqrt();
+        println!(
+            "sky-lit room, environment sampling {}: noise {noise:.4} at 64 spp in {seconds:.3} s per frame",
+            if on { "on" } else { "off" },
+        );
+    }
+    println!(
+        "noise at equal time, off / on: {:.3}",
+        efficiency[1] / efficiency[0]
+    );
+    let mut g = c.benchmark_group("sky_room_path_tracer_8spp");
+    g.sample_size(10);
+    for on in [true, false] {
+        let pt = tracer(on, 8);
+        let name = if on {
+            "environment_sampling"
+        } else {
+            "bsdf_sampling_only"
+        };
+        g.bench_function(name, |b| b.iter(|| black_box(pt.render(&placed, &cam))));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, rays, renderers, environment_sampling);
 criterion_main!(benches);

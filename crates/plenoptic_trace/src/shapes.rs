@@ -417,3 +417,107 @@ pub fn room_camera(width: u32, height: u32) -> crate::Result<crate::PinholeCamer
         height,
     )
 }
+
+/// A 4 × 3 × 4 m room of 0.2 m slabs with one 1.6 × 1.2 m window in the +z wall, lit only by
+/// a Hosek–Wilkie sky (model units, `scale` 1) whose sun stands 35° up behind the room: only
+/// the sky's light enters. The environment tests and the `trace` benchmark use it.
+pub fn sky_lit_room() -> Scene {
+    let mut b = SceneBuilder::default();
+    let wall = b.material(diffuse(Vec3::splat(0.7)));
+    let floor = b.material(diffuse(Vec3::new(0.5, 0.4, 0.3)));
+    let t = 0.2;
+    let mut slab = |name: &str, size: Vec3, at: Vec3, m: usize| {
+        b.object(name, cuboid(size), m, at);
+    };
+    slab(
+        "Floor",
+        Vec3::new(4.4, t, 4.4),
+        Vec3::new(0.0, -t / 2.0, 0.0),
+        floor,
+    );
+    slab(
+        "Ceiling",
+        Vec3::new(4.4, t, 4.4),
+        Vec3::new(0.0, 3.0 + t / 2.0, 0.0),
+        wall,
+    );
+    slab(
+        "Back",
+        Vec3::new(4.4, 3.0, t),
+        Vec3::new(0.0, 1.5, -2.0 - t / 2.0),
+        wall,
+    );
+    slab(
+        "Left",
+        Vec3::new(t, 3.0, 4.0),
+        Vec3::new(-2.0 - t / 2.0, 1.5, 0.0),
+        wall,
+    );
+    slab(
+        "Right",
+        Vec3::new(t, 3.0, 4.0),
+        Vec3::new(2.0 + t / 2.0, 1.5, 0.0),
+        wall,
+    );
+    // The window wall, around the opening x ∈ [−0.8, 0.8], y ∈ [1, 2.2].
+    let z = 2.0 + t / 2.0;
+    slab(
+        "FrontL",
+        Vec3::new(1.2 + t, 3.0, t),
+        Vec3::new(-1.4 - t / 2.0, 1.5, z),
+        wall,
+    );
+    slab(
+        "FrontR",
+        Vec3::new(1.2 + t, 3.0, t),
+        Vec3::new(1.4 + t / 2.0, 1.5, z),
+        wall,
+    );
+    slab("Sill", Vec3::new(1.6, 1.0, t), Vec3::new(0.0, 0.5, z), wall);
+    slab(
+        "Lintel",
+        Vec3::new(1.6, 0.8, t),
+        Vec3::new(0.0, 2.6, z),
+        wall,
+    );
+    let sun = b.node(
+        "Sun",
+        Trs {
+            rotation: Quat::IDENTITY,
+            ..Trs::default()
+        },
+    );
+    let mut scene = b.build();
+    let towards = Vec3::new(0.3, 35f32.to_radians().sin(), -1.0).normalize();
+    scene.lights.push(Light {
+        name: "Sun".into(),
+        kind: LightKind::Directional,
+        color: Vec3::ONE,
+        intensity: 0.0,
+        range: None,
+        angular_radius: 0.0,
+        node: sun,
+    });
+    scene.sun = Some(plenoptic_scene::Sun {
+        light: scene.lights.len() - 1,
+        track: Some(plenoptic_sky::SunTrack::fixed(towards, Vec3::ZERO)),
+    });
+    scene.environment = plenoptic_scene::Environment::Sky(plenoptic_sky::SkyParams {
+        scale: 1.0,
+        ..plenoptic_sky::SkyParams::default()
+    });
+    scene
+}
+
+/// A camera in [`sky_lit_room`] from the window side towards the back corner: floor, walls
+/// and the patch of sky light on the floor.
+pub fn sky_room_camera(width: u32, height: u32) -> crate::Result<crate::PinholeCamera> {
+    crate::PinholeCamera::look_at(
+        Vec3::new(1.2, 1.6, 1.6),
+        Vec3::new(-1.0, 0.6, -1.8),
+        Vec3::Y,
+        1.2,
+        width,
+        height,
+    )
+}

@@ -18,7 +18,7 @@ use plenoptic_scene::{AlphaMode, Environment, Light, LightKind, Material, Node, 
 use plenoptic_sky::{SkyParams, SunTrack};
 use plenoptic_trace::image::luminance;
 use plenoptic_trace::metrics::relative_lrms;
-use plenoptic_trace::shapes::{SceneBuilder, diffuse};
+use plenoptic_trace::shapes::{SceneBuilder, diffuse, sky_lit_room, sky_room_camera};
 use plenoptic_trace::{
     AmbientField, AmbientSettings, Image, MultiStageRenderer, MultiStageSettings, PathTracer,
     PathTracerSettings, PinholeCamera, RadianceSample, SceneAccel,
@@ -263,105 +263,12 @@ fn the_suns_disc_gives_a_penumbra_of_its_angular_size() {
     assert!((10..=18).contains(&s), "soft edge over {s} pixels");
 }
 
-/// A 4 × 3 × 4 m room of 0.2 m slabs, one 1.6 × 1.2 m window in the +z wall, lit only by the
-/// sky (the sun is behind the building: only its direction drives the sky).
-fn sky_lit_room() -> Scene {
-    let mut b = SceneBuilder::default();
-    let wall = b.material(diffuse(Vec3::splat(0.7)));
-    let floor = b.material(diffuse(Vec3::new(0.5, 0.4, 0.3)));
-    let t = 0.2;
-    let slab = |b: &mut SceneBuilder, name: &str, size: Vec3, at: Vec3, m: usize| {
-        b.object(name, cuboid(size), m, at);
-    };
-    slab(
-        &mut b,
-        "Floor",
-        Vec3::new(4.4, t, 4.4),
-        Vec3::new(0.0, -t / 2.0, 0.0),
-        floor,
-    );
-    slab(
-        &mut b,
-        "Ceiling",
-        Vec3::new(4.4, t, 4.4),
-        Vec3::new(0.0, 3.0 + t / 2.0, 0.0),
-        wall,
-    );
-    slab(
-        &mut b,
-        "Back",
-        Vec3::new(4.4, 3.0, t),
-        Vec3::new(0.0, 1.5, -2.0 - t / 2.0),
-        wall,
-    );
-    slab(
-        &mut b,
-        "Left",
-        Vec3::new(t, 3.0, 4.0),
-        Vec3::new(-2.0 - t / 2.0, 1.5, 0.0),
-        wall,
-    );
-    slab(
-        &mut b,
-        "Right",
-        Vec3::new(t, 3.0, 4.0),
-        Vec3::new(2.0 + t / 2.0, 1.5, 0.0),
-        wall,
-    );
-    // The window wall, around the opening x ∈ [−0.8, 0.8], y ∈ [1, 2.2].
-    let z = 2.0 + t / 2.0;
-    slab(
-        &mut b,
-        "FrontL",
-        Vec3::new(1.2 + t, 3.0, t),
-        Vec3::new(-1.4 - t / 2.0, 1.5, z),
-        wall,
-    );
-    slab(
-        &mut b,
-        "FrontR",
-        Vec3::new(1.2 + t, 3.0, t),
-        Vec3::new(1.4 + t / 2.0, 1.5, z),
-        wall,
-    );
-    slab(
-        &mut b,
-        "Sill",
-        Vec3::new(1.6, 1.0, t),
-        Vec3::new(0.0, 0.5, z),
-        wall,
-    );
-    slab(
-        &mut b,
-        "Lintel",
-        Vec3::new(1.6, 0.8, t),
-        Vec3::new(0.0, 2.6, z),
-        wall,
-    );
-    let mut scene = b.build();
-    // The sun 35° up behind the room's back: the window faces the bright half of the sky away
-    // from it.
-    let towards = Vec3::new(0.3, 35f32.to_radians().sin(), -1.0).normalize();
-    add_sky(&mut scene, towards, 0.0, 0.0);
-    scene
-}
-
 #[test]
 fn a_sky_lit_room_multi_stage_against_the_path_tracer() {
     let scene = sky_lit_room();
     let accel = SceneAccel::new(&scene).unwrap();
     let placed = accel.at_time(0.0);
-    // Looking from the window side towards the back corner: floor, walls, the patch of sky
-    // light on the floor.
-    let camera = PinholeCamera::look_at(
-        Vec3::new(1.2, 1.6, 1.6),
-        Vec3::new(-1.0, 0.6, -1.8),
-        Vec3::Y,
-        1.2,
-        48,
-        36,
-    )
-    .unwrap();
+    let camera = sky_room_camera(48, 36).unwrap();
     let a = pt(256, 21).render(&placed, &camera).radiance();
     let b = pt(256, 22).render(&placed, &camera).radiance();
     let reference = Image {
