@@ -22,7 +22,8 @@ pub struct RadianceSample {
 }
 
 impl RadianceSample {
-    /// A miss: no radiance (scenes have no environment), infinite distance.
+    /// A miss before the environment is added: no radiance, infinite distance (the renderers
+    /// set the environment's radiance for the ray).
     pub const MISS: Self = Self {
         radiance: Vec3::ZERO,
         distance: f32::INFINITY,
