@@ -207,6 +207,25 @@ impl PlacedEnvironment {
         matches!(self, PlacedEnvironment::None)
     }
 
+    /// Irradiance on a horizontal plane facing +Y with nothing around it: ∫ L cos θ dω over
+    /// the upper hemisphere by the midpoint rule on `steps` × 4·`steps` cells in (θ, φ). The
+    /// reference for tests of the tracers and the sampling tables.
+    pub fn horizontal_irradiance(&self, steps: usize) -> Vec3 {
+        let n = steps.max(1);
+        let (dt, dp) = (PI / 2.0 / n as f32, TAU / (4 * n) as f32);
+        let mut e = glam::DVec3::ZERO;
+        for i in 0..n {
+            let theta = (i as f32 + 0.5) * dt;
+            let (st, ct) = theta.sin_cos();
+            for j in 0..4 * n {
+                let phi = (j as f32 + 0.5) * dp;
+                let d = Vec3::new(st * phi.cos(), ct, st * phi.sin());
+                e += (self.radiance(d) * (ct * st * dt * dp)).as_dvec3();
+            }
+        }
+        e.as_vec3()
+    }
+
     /// Linear RGB radiance arriving from unit direction `dir`.
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         match self {
@@ -225,6 +244,17 @@ impl PlacedEnvironment {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_uniform_sky_gives_pi_l_on_a_plane() {
+        let e = Environment::Uniform(Vec3::new(1.0, 2.0, 0.5))
+            .at(None)
+            .horizontal_irradiance(64);
+        assert!(
+            (e / PI - Vec3::new(1.0, 2.0, 0.5)).abs().max_element() < 1e-3,
+            "{e}"
+        );
+    }
 
     #[test]
     fn equirect_mapping_round_trips_and_follows_the_convention() {

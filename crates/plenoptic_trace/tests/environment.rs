@@ -106,25 +106,11 @@ fn a_uniform_sky_gives_pi_l_over_a_plane() {
     }
 }
 
-/// The model's irradiance on a horizontal plane: midpoint rule on a 600 × 1200 grid.
+/// The model's irradiance on a horizontal plane (midpoint rule, 600 × 2400 cells).
 fn sky_irradiance(scene: &Scene) -> f64 {
-    let env = scene.environment_at(0.0);
-    let n = 600;
-    let mut e = 0.0f64;
-    for i in 0..n {
-        for j in 0..2 * n {
-            let theta = (i as f32 + 0.5) / n as f32 * PI / 2.0;
-            let phi = (j as f32 + 0.5) / (2 * n) as f32 * 2.0 * PI;
-            let d = Vec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            );
-            let dw = theta.sin() * (PI / 2.0 / n as f32) * (PI / n as f32);
-            e += f64::from(luminance(env.radiance(d)) * d.y * dw);
-        }
-    }
-    e
+    f64::from(luminance(
+        scene.environment_at(0.0).horizontal_irradiance(600),
+    ))
 }
 
 /// A sun light (no intensity: only its direction drives the sky) at `elevation_deg`.
