@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex};
 use glam::Vec3;
 use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
 
+use crate::background::{self, Coverage, PackEnvironment};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::lookup::PackedTexels;
@@ -120,6 +121,7 @@ pub struct Reconstructor {
     pack: PackReader,
     proxy: Option<ProxyGeometry>,
     proxy_missing: Vec<String>,
+    environment: PackEnvironment,
     /// Settings (may be changed between frames).
     pub settings: ReconSettings,
     cache: Mutex<Cache>,
@@ -159,11 +161,14 @@ impl Reconstructor {
     /// A reconstructor over an open pack. Reads the proxy geometry and tracks now (what cannot
     /// be read is reported with every frame).
     pub fn new(pack: PackReader, settings: ReconSettings) -> Self {
-        let (proxy, proxy_missing) = ProxyGeometry::from_pack(&pack);
+        let (proxy, mut proxy_missing) = ProxyGeometry::from_pack(&pack);
+        let (environment, env_error) = PackEnvironment::from_pack(&pack);
+        proxy_missing.extend(env_error);
         Reconstructor {
             pack,
             proxy,
             proxy_missing,
+            environment,
             settings,
             cache: Mutex::new(Cache::default()),
             bins: Mutex::new(HashMap::new()),
@@ -174,6 +179,11 @@ impl Reconstructor {
     /// The pack.
     pub fn pack(&self) -> &PackReader {
         &self.pack
+    }
+
+    /// The pack's environment and sun track.
+    pub fn environment(&self) -> &PackEnvironment {
+        &self.environment
     }
 
     /// The proxy geometry, if the pack has readable proxy meshes.
@@ -421,7 +431,7 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let frame = match mode {
+        let mut frame = match mode {
             Mode::GeometryAssisted if self.proxy.is_some() => {
                 crate::geometry::render(self, camera, t, None, &mut report)?
             }
@@ -435,6 +445,7 @@ impl Reconstructor {
             Mode::Image => self.render_image(camera, t, &mut report)?,
             Mode::Volume => crate::volume::render(self, camera, t, &mut report)?,
         };
+        background::show(self, camera, t, report.used_mode, &mut frame);
         Ok((frame, report))
     }
 
@@ -466,7 +477,9 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
+        let mut frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
+        let env = self.environment.at(t);
+        background::apply(&env, camera, Coverage::Mask(mask), &mut frame);
         Ok((frame, report))
     }
 
