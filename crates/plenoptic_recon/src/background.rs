@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 use plenoptic_pack::PackReader;
-use plenoptic_pack::plenoptic_sky::{Environment, PlacedEnvironment, SunTrack};
+pub use plenoptic_pack::plenoptic_sky::{Environment, PlacedEnvironment, SunTrack};
 use rayon::prelude::*;
 
 use crate::{Camera, Frame, GeometryMask, Mode, Reconstructor};

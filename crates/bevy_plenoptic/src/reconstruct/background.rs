@@ -1,6 +1,11 @@
-//! The environment behind the proxy geometry: pixels no proxy covers show the heaviest key's
-//! radiance cube in the pixel's viewing direction, as `plenoptic_recon` does for pixels
-//! without geometry (sky through a window, say).
+//! The environment behind the proxy geometry: pixels no proxy covers (sky through a window or
+//! a skylight, anything beyond the view space's geometry) show the pack's environment for the
+//! pixel's own viewing direction at the camera's time, as `plenoptic_recon::background` does:
+//! a uniform colour, the Hosek–Wilkie sky (its coefficients computed here on the CPU per view
+//! from the pack's sun track at the camera's time, [`EnvironmentUniform`], the formula
+//! evaluated per pixel in `background.wgsl`), or the equirectangular image (a texture, read
+//! bilinearly as on the CPU). Packs without an environment show the heaviest key's radiance
+//! cube in the pixel's direction, as before. Output is multiplied by the camera's exposure.
 //!
 //! Each GPU camera gets a child entity with a one-triangle mesh drawn by
 //! [`PlenopticBackgroundMaterial`], whose vertex shader (`background.wgsl`) takes its
@@ -20,14 +25,19 @@ use bevy::render::render_resource::{
 };
 use bevy::shader::ShaderRef;
 
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use plenoptic_recon::background::{Environment, PlacedEnvironment};
+
 use super::{KeyTextures, ResolvedBackend};
 use crate::Backend;
+use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 
 /// Adds the background material and keeps one background per GPU camera.
 pub(super) fn build(app: &mut App) {
     embedded_asset!(app, "background.wgsl");
-    app.add_plugins(MaterialPlugin::<PlenopticBackgroundMaterial>::default());
+    app.add_plugins(MaterialPlugin::<PlenopticBackgroundMaterial>::default())
+        .init_resource::<EnvironmentImages>();
 }
 
 /// Draws the environment where no geometry is (see the module doc).
@@ -43,6 +53,107 @@ pub struct PlenopticBackgroundMaterial {
     /// image mode.
     #[texture(2, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
+    /// The pack's environment at the camera's time.
+    #[uniform(3)]
+    pub environment: EnvironmentUniform,
+    /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
+    #[texture(4, sample_type = "float", filterable = false)]
+    pub environment_image: Handle<Image>,
+}
+
+/// The environment of a [`PlenopticBackgroundMaterial`] at one time (see `background.wgsl`).
+#[derive(ShaderType, Debug, Clone, Default, PartialEq)]
+pub struct EnvironmentUniform {
+    /// x: kind (0 none: show the key's cube, 1 uniform, 2 sky, 3 image), y: image
+    /// intensity, z and w: cosine and sine of the image's turn about +Y.
+    pub kind: Vec4,
+    /// Uniform colour (xyz).
+    pub colour: Vec4,
+    /// The sky's 27 Hosek–Wilkie coefficients (A–I of R, G, B), four per vector.
+    pub sky: [Vec4; 7],
+    /// The sky's radiance scale per channel (xyz).
+    pub sky_radiance: Vec4,
+    /// Unit direction towards the sun (xyz).
+    pub sun: Vec4,
+}
+
+impl EnvironmentUniform {
+    /// The uniform for `env` (an environment placed at a time).
+    pub fn new(env: &PlacedEnvironment) -> Self {
+        let mut u = EnvironmentUniform::default();
+        match env {
+            PlacedEnvironment::None => {}
+            PlacedEnvironment::Uniform(c) => {
+                u.kind.x = 1.0;
+                u.colour = c.extend(0.0);
+            }
+            PlacedEnvironment::Sky(sky) => {
+                let c = sky.coefficients();
+                u.kind.x = 2.0;
+                for (i, p) in c.params.iter().enumerate() {
+                    u.sky[i / 4][i % 4] = *p;
+                }
+                u.sky_radiance = Vec3::from_array(c.radiances).extend(0.0);
+                u.sun = c.sun.extend(0.0);
+            }
+            PlacedEnvironment::Image {
+                intensity,
+                to_image,
+                ..
+            } => {
+                // `to_image` turns about +Y only: its angle, sign from the axis.
+                let (axis, angle) = to_image.to_axis_angle();
+                let angle = angle * axis.y.signum();
+                u.kind = Vec4::new(3.0, *intensity, angle.cos(), angle.sin());
+            }
+        }
+        u
+    }
+}
+
+/// The environment image of each pack as a texture (`Rgba32Float`, row 0 at +Y), and the
+/// 1 × 1 black texture of packs without one.
+#[derive(Resource, Debug, Default)]
+pub struct EnvironmentImages {
+    images: std::collections::HashMap<AssetId<RadiancePack>, Handle<Image>>,
+}
+
+impl EnvironmentImages {
+    /// The texture of `pack`'s environment image, made on first use.
+    fn get(
+        &mut self,
+        id: AssetId<RadiancePack>,
+        pack: &RadiancePack,
+        images: &mut Assets<Image>,
+    ) -> Handle<Image> {
+        self.images
+            .entry(id)
+            .or_insert_with(|| {
+                let (w, h, texels): (u32, u32, Vec<Vec3>) = match &pack.environment.environment {
+                    Environment::Image { image, .. } => {
+                        (image.width, image.height, image.texels.clone())
+                    }
+                    _ => (1, 1, vec![Vec3::ZERO]),
+                };
+                let data = texels
+                    .iter()
+                    .flat_map(|t| [t.x, t.y, t.z, 1.0])
+                    .flat_map(f32::to_le_bytes)
+                    .collect();
+                images.add(Image::new(
+                    Extent3d {
+                        width: w,
+                        height: h,
+                        depth_or_array_layers: 1,
+                    },
+                    TextureDimension::D2,
+                    data,
+                    TextureFormat::Rgba32Float,
+                    RenderAssetUsages::RENDER_WORLD,
+                ))
+            })
+            .clone()
+    }
 }
 
 /// The uniform of a [`PlenopticBackgroundMaterial`].
@@ -98,6 +209,9 @@ pub(super) fn spawn_backgrounds(
     image_frame: Res<super::image::ImageFrame>,
     cameras: Query<(Entity, &PlenopticCamera)>,
     existing: Query<&PlenopticBackground>,
+    packs: Res<Assets<RadiancePack>>,
+    mut env_images: ResMut<EnvironmentImages>,
+    mut images: ResMut<Assets<Image>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
 ) {
@@ -108,9 +222,10 @@ pub(super) fn spawn_backgrounds(
         if existing.iter().any(|b| b.camera == entity) {
             continue;
         }
-        let Some(tex) = keys.0.get(&cam.pack.id()) else {
+        let (Some(tex), Some(pack)) = (keys.0.get(&cam.pack.id()), packs.get(cam.pack.id())) else {
             continue;
         };
+        let environment_image = env_images.get(cam.pack.id(), pack, &mut images);
         // A triangle covering the screen, its positions in clip space (used as such by the
         // vertex shader).
         let mesh = Mesh::new(
@@ -127,6 +242,8 @@ pub(super) fn spawn_backgrounds(
             cubes: tex.image.clone(),
             params: BackgroundParams::default(),
             image_frame: image_frame.0.clone(),
+            environment: EnvironmentUniform::default(),
+            environment_image,
         });
         let child = commands
             .spawn((
@@ -142,15 +259,25 @@ pub(super) fn spawn_backgrounds(
     }
 }
 
-/// Shows the heaviest key (`layer`: its first array layer) of the camera's pack, or black;
-/// or, with `image_mode`, the image-mode frame.
+/// Shows the pack's environment `env` (placed at the camera's time) or, without one, the
+/// heaviest key (`layer`: its first array layer) of the camera's pack, or black; or, with
+/// `image_mode`, the image-mode frame.
 pub(super) fn set_background(
     materials: &mut Assets<PlenopticBackgroundMaterial>,
     handle: &MeshMaterial3d<PlenopticBackgroundMaterial>,
+    env: &PlacedEnvironment,
     layer: Option<u32>,
     face: u32,
     image_mode: bool,
 ) {
+    let environment = EnvironmentUniform::new(env);
+    if materials
+        .get(&handle.0)
+        .is_some_and(|m| m.environment != environment)
+        && let Some(mut m) = materials.get_mut(&handle.0)
+    {
+        m.environment = environment;
+    }
     let mut key = match layer {
         Some(l) => Vec4::new(l as f32, face as f32, 1.0, 0.0),
         None => Vec4::ZERO,

@@ -11,5 +11,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     let size = textureDimensions(frame);
     let uv = (in.position.xy - view.viewport.xy) / view.viewport.zw;
     let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
-    return vec4<f32>(textureLoad(frame, p, 0).rgb, 1.0);
+    // Times the camera's exposure, as Bevy's own lights (see geometry.wgsl).
+    let c = textureLoad(frame, p, 0).rgb * view.exposure;
+    return vec4<f32>(min(c, vec3<f32>(65504.0)), 1.0);
 }

@@ -213,8 +213,15 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
     return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
 }
 
+// The reconstructed radiance, times the camera's exposure as Bevy's own lights are
+// (`view.exposure`, from its `Exposure`), kept inside the f16 HDR target's range.
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    let c = reconstruct(in);
+    return vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), c.a);
+}
+
+fn reconstruct(in: VertexOutput) -> vec4<f32> {
     let object = u32(params.header.y);
     let n = u32(params.header.z);
     let p = in.world_position.xyz;

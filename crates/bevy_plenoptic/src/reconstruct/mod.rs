@@ -427,6 +427,17 @@ fn update_materials(
         let layer = frame(id, cam, transform.translation())
             .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
         let image_mode = warped(cam.mode) && job.0.is_some();
-        background::set_background(&mut background_materials, handle, layer, face, image_mode);
+        let env = packs
+            .get(id)
+            .map(|p| p.environment.at(cam.time))
+            .unwrap_or_default();
+        background::set_background(
+            &mut background_materials,
+            handle,
+            &env,
+            layer,
+            face,
+            image_mode,
+        );
     }
 }
