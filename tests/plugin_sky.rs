@@ -52,7 +52,8 @@ fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
     let data = render_until(app, image.clone(), 600, |d| {
         let px = rgba16f_pixels(d);
         let shown = px.len() == (WIDTH * HEIGHT) as usize
-            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01));
+            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
+            && px.iter().any(|c| c.max_element() > 0.01);
         let stable = prev.borrow().as_deref() == Some(d);
         *prev.borrow_mut() = Some(d.to_vec());
         shown && stable
@@ -141,6 +142,8 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
         ))
         .id();
     let gpu = settle(&mut app, camera, &image);
+    // Measured on lavapipe: sky pixels mean 0.00053, all within 5 % (f16 rounding); the
+    // whole frame mean 0.00049; EV100 + 1 is exactly half (a power of two in f16).
     let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
     eprintln!(
         "GPU vs CPU sky: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"

@@ -217,11 +217,12 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // (`view.exposure`, from its `Exposure`), kept inside the f16 HDR target's range.
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
-    let c = reconstruct(in);
+    let c = radiance(in);
     return vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), c.a);
 }
 
-fn reconstruct(in: VertexOutput) -> vec4<f32> {
+// The reconstructed radiance of the fragment (linear, before exposure).
+fn radiance(in: VertexOutput) -> vec4<f32> {
     let object = u32(params.header.y);
     let n = u32(params.header.z);
     let p = in.world_position.xyz;
