@@ -61,10 +61,9 @@ fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
     rgba16f_pixels(&data)
 }
 
-#[test]
-fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sky.pack");
+/// Writes the open room with a sky (scale 1: kcd/m², a few units, beside the test shading's
+/// radiance) and a moving sun to `path`.
+fn sky_pack(path: &std::path::Path) {
     // Scale 1: the sky in kcd/m² (a few units), beside the test shading's radiance.
     let sky = Environment::Sky(SkyParams {
         scale: 1.0,
@@ -89,38 +88,18 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
         &path,
         Some((sky, Some(track))),
     );
-    let (eye, t) = (Vec3::new(0.0, 1.3, 1.0), 0.7);
-    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.3, 2.2, -1.5), Vec3::Y);
+}
 
-    // CPU reference, and which pixels see no proxy.
-    let rec = Reconstructor::open(&path).unwrap();
-    let cam = plenoptic_recon::Camera::new(
-        eye,
-        transform.rotation,
-        std::f32::consts::FRAC_PI_4,
-        WIDTH,
-        HEIGHT,
-    )
-    .unwrap();
-    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
-    let (cpu_image, _) = rec.render(&cam, t, Mode::Image).unwrap();
-    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
-    let sky_pixels: Vec<usize> = (0..mask.object.len())
-        .filter(|&j| mask.object[j] == 0)
-        .collect();
-    let all: Vec<usize> = (0..mask.object.len()).collect();
-    let fraction = sky_pixels.len() as f32 / all.len() as f32;
-    eprintln!("sky: {:.1} % of the frame", 100.0 * fraction);
-    assert!((0.2..0.8).contains(&fraction), "sky fraction {fraction}");
-    let brightest = sky_pixels
-        .iter()
-        .map(|&j| cpu.radiance[j].max_element())
-        .fold(0.0f32, f32::max);
-    assert!(brightest > 0.5, "the CPU sky is lit: {brightest}");
-
-    // GPU.
-    let mut app = headless_app_in(dir.path());
-    app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+/// A headless app on `backend` with a camera into an Rgba16Float target (no MSAA, no
+/// tonemapping, exposure multiplier 1) on `sky.pack` in `dir`: (app, camera, target).
+fn sky_app(
+    dir: &std::path::Path,
+    backend: Backend,
+    transform: Transform,
+    t: f32,
+) -> (App, Entity, Handle<Image>) {
+    let mut app = headless_app_in(dir);
+    app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("sky.pack");
     let image = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
@@ -141,6 +120,56 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
             },
         ))
         .id();
+    (app, camera, image)
+}
+
+/// The eye and time of the tests, looking up through the opening.
+fn view() -> (Vec3, Transform, f32) {
+    let eye = Vec3::new(0.0, 1.3, 1.0);
+    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.3, 2.2, -1.5), Vec3::Y);
+    (eye, transform, 0.7)
+}
+
+/// The CPU camera of `view`.
+fn cpu_camera(eye: Vec3, transform: &Transform) -> plenoptic_recon::Camera {
+    plenoptic_recon::Camera::new(
+        eye,
+        transform.rotation,
+        std::f32::consts::FRAC_PI_4,
+        WIDTH,
+        HEIGHT,
+    )
+    .unwrap()
+}
+
+#[test]
+fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+
+    // CPU reference, and which pixels see no proxy.
+    let rec = Reconstructor::open(&path).unwrap();
+    let cam = cpu_camera(eye, &transform);
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let (cpu_image, _) = rec.render(&cam, t, Mode::Image).unwrap();
+    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+    let sky_pixels: Vec<usize> = (0..mask.object.len())
+        .filter(|&j| mask.object[j] == 0)
+        .collect();
+    let all: Vec<usize> = (0..mask.object.len()).collect();
+    let fraction = sky_pixels.len() as f32 / all.len() as f32;
+    eprintln!("sky: {:.1} % of the frame", 100.0 * fraction);
+    assert!((0.2..0.8).contains(&fraction), "sky fraction {fraction}");
+    let brightest = sky_pixels
+        .iter()
+        .map(|&j| cpu.radiance[j].max_element())
+        .fold(0.0f32, f32::max);
+    assert!(brightest > 0.5, "the CPU sky is lit: {brightest}");
+
+    // GPU.
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
     let gpu = settle(&mut app, camera, &image);
     // Measured on lavapipe: sky pixels mean 0.00053, all within 5 % (f16 rounding); the
     // whole frame mean 0.00049; EV100 + 1 is exactly half (a power of two in f16).
@@ -193,4 +222,42 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
         mean < 0.003 && f5 > 0.995 && f20 > 0.999,
         "image-mode sky: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
     );
+}
+
+/// The CPU backend shows `plenoptic_recon`'s frame where no proxy is too (a full-screen
+/// background behind the proxies), so its sky is on screen.
+#[test]
+fn cpu_backend_shows_the_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+    let rec = Reconstructor::open(&path).unwrap();
+    let cam = cpu_camera(eye, &transform);
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+    let sky_pixels: Vec<usize> = (0..mask.object.len())
+        .filter(|&j| mask.object[j] == 0)
+        .collect();
+    assert!(
+        sky_pixels.len() * 5 > mask.object.len(),
+        "{}",
+        sky_pixels.len()
+    );
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Cpu, transform, t);
+    let shown = settle(&mut app, camera, &image);
+    let within = sky_pixels
+        .iter()
+        .filter(|&&j| {
+            let (g, c) = (shown[j], cpu.radiance[j]);
+            ((g - c).abs() / (c.abs() + Vec3::splat(0.02))).max_element() < 0.01
+        })
+        .count() as f32
+        / sky_pixels.len() as f32;
+    eprintln!(
+        "CPU backend sky vs CPU frame: {:.1} % within 1 %",
+        100.0 * within
+    );
+    // As `cpu_backend_shows_the_cpu_frame` (plugin_scene_render.rs).
+    assert!(within > 0.97, "{within}");
 }

@@ -25,7 +25,9 @@ use bevy::render::render_resource::{
 };
 use bevy::shader::ShaderRef;
 
-use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy::render::render_resource::{
+    Extent3d, TextureDimension, TextureFormat, TextureViewDescriptor, TextureViewDimension,
+};
 use plenoptic_recon::background::{Environment, PlacedEnvironment};
 
 use super::{KeyTextures, ResolvedBackend};
@@ -197,6 +199,106 @@ impl Material for PlenopticBackgroundMaterial {
 pub struct PlenopticBackground {
     /// The camera it is drawn for.
     pub camera: Entity,
+    /// Drawn for the CPU backend: it shows the CPU frame (whose pixels without geometry
+    /// `plenoptic_recon` filled with the environment) and is not updated by the GPU path.
+    pub cpu: bool,
+}
+
+/// A full-screen triangle at depth 0 drawn with `material` for `camera`, as its child.
+fn spawn_background(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    camera: Entity,
+    cpu: bool,
+    material: Handle<PlenopticBackgroundMaterial>,
+) {
+    // A triangle covering the screen, its positions in clip space (used as such by the
+    // vertex shader).
+    let mesh = Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::RENDER_WORLD,
+    )
+    .with_inserted_attribute(
+        Mesh::ATTRIBUTE_POSITION,
+        vec![[-1.0f32, -1.0, 0.0], [3.0, -1.0, 0.0], [-1.0, 3.0, 0.0]],
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 0.0, 1.0]; 3])
+    .with_inserted_indices(Indices::U32(vec![0, 1, 2]));
+    let child = commands
+        .spawn((
+            Name::new("plenoptic background"),
+            PlenopticBackground { camera, cpu },
+            Mesh3d(meshes.add(mesh)),
+            MeshMaterial3d(material),
+            NoFrustumCulling,
+            Transform::IDENTITY,
+        ))
+        .id();
+    commands.entity(camera).add_child(child);
+}
+
+/// Spawns a background child for each camera on the CPU backend whose pack has an
+/// environment: it shows the CPU frame (`frame`: the pack's displayed CPU frame, if any)
+/// where no proxy is, so that the sky `plenoptic_recon` put there is seen.
+pub(super) fn spawn_cpu_backgrounds(
+    mut commands: Commands,
+    backend: Res<ResolvedBackend>,
+    frames: Res<super::cpu::CpuFrames>,
+    cameras: Query<(Entity, &PlenopticCamera)>,
+    existing: Query<&PlenopticBackground>,
+    packs: Res<Assets<RadiancePack>>,
+    mut images: ResMut<Assets<Image>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
+) {
+    if backend.0 != Backend::Cpu {
+        return;
+    }
+    for (entity, cam) in &cameras {
+        if existing.iter().any(|b| b.camera == entity) {
+            continue;
+        }
+        let (Some(pack), Some(frame)) = (packs.get(cam.pack.id()), frames.image(cam.pack.id()))
+        else {
+            continue;
+        };
+        if pack.environment.is_none() {
+            continue;
+        }
+        // The shader's key texture binding needs a 2D array; the CPU path has no keys.
+        let mut cubes = Image::new_fill(
+            Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 6,
+            },
+            TextureDimension::D2,
+            &[0; 16],
+            TextureFormat::Rgba32Uint,
+            RenderAssetUsages::RENDER_WORLD,
+        );
+        cubes.texture_view_descriptor = Some(TextureViewDescriptor {
+            dimension: Some(TextureViewDimension::D2Array),
+            ..default()
+        });
+        let black = Image::new_fill(
+            Extent3d::default(),
+            TextureDimension::D2,
+            &[0; 16],
+            TextureFormat::Rgba32Float,
+            RenderAssetUsages::RENDER_WORLD,
+        );
+        let material = materials.add(PlenopticBackgroundMaterial {
+            cubes: images.add(cubes),
+            params: BackgroundParams {
+                key: Vec4::new(0.0, 1.0, 0.0, 1.0),
+            },
+            image_frame: frame,
+            environment: EnvironmentUniform::default(),
+            environment_image: images.add(black),
+        });
+        spawn_background(&mut commands, &mut meshes, entity, true, material);
+    }
 }
 
 /// Spawns a background child for each camera on the GPU backend whose pack's key texture
@@ -226,18 +328,6 @@ pub(super) fn spawn_backgrounds(
             continue;
         };
         let environment_image = env_images.get(cam.pack.id(), pack, &mut images);
-        // A triangle covering the screen, its positions in clip space (used as such by the
-        // vertex shader).
-        let mesh = Mesh::new(
-            PrimitiveTopology::TriangleList,
-            RenderAssetUsages::RENDER_WORLD,
-        )
-        .with_inserted_attribute(
-            Mesh::ATTRIBUTE_POSITION,
-            vec![[-1.0f32, -1.0, 0.0], [3.0, -1.0, 0.0], [-1.0, 3.0, 0.0]],
-        )
-        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 0.0, 1.0]; 3])
-        .with_inserted_indices(Indices::U32(vec![0, 1, 2]));
         let material = materials.add(PlenopticBackgroundMaterial {
             cubes: tex.image.clone(),
             params: BackgroundParams::default(),
@@ -245,17 +335,7 @@ pub(super) fn spawn_backgrounds(
             environment: EnvironmentUniform::default(),
             environment_image,
         });
-        let child = commands
-            .spawn((
-                Name::new("plenoptic background"),
-                PlenopticBackground { camera: entity },
-                Mesh3d(meshes.add(mesh)),
-                MeshMaterial3d(material),
-                NoFrustumCulling,
-                Transform::IDENTITY,
-            ))
-            .id();
-        commands.entity(entity).add_child(child);
+        spawn_background(&mut commands, &mut meshes, entity, false, material);
     }
 }
 

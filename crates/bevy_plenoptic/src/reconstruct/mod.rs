@@ -422,6 +422,9 @@ fn update_materials(
         let Ok((cam, transform)) = cameras.get(bg.camera) else {
             continue;
         };
+        if bg.cpu {
+            continue;
+        }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
         let layer = frame(id, cam, transform.translation())
