@@ -240,6 +240,7 @@ fn spawn_background(
 /// Spawns a background child for each camera on the CPU backend whose pack has an
 /// environment: it shows the CPU frame (`frame`: the pack's displayed CPU frame, if any)
 /// where no proxy is, so that the sky `plenoptic_recon` put there is seen.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 pub(super) fn spawn_cpu_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
