@@ -261,3 +261,53 @@ fn cpu_backend_shows_the_sky() {
     // As `cpu_backend_shows_the_cpu_frame` (plugin_scene_render.rs).
     assert!(within > 0.97, "{within}");
 }
+
+/// A camera without an HDR target is tonemapped in the reconstruction's shaders, as Bevy's
+/// PBR does: the bright sky (about 10 in the blue) saturates an 8-bit target without a
+/// tonemapping curve, and stays below white with one.
+#[test]
+fn ldr_cameras_get_the_tonemapping_curve() {
+    use bevy::core_pipeline::tonemapping::Tonemapping;
+    let dir = tempfile::tempdir().unwrap();
+    sky_pack(&dir.path().join("sky.pack"));
+    let (_, transform, t) = view();
+    let mut blue = Vec::new();
+    for tonemapping in [Tonemapping::None, Tonemapping::Reinhard] {
+        let mut app = headless_app_in(dir.path());
+        app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+        let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("sky.pack");
+        let image = target_image(&mut app.world_mut().resource_mut::<Assets<Image>>());
+        let camera = app
+            .world_mut()
+            .spawn((
+                camera_into(image.clone(), transform),
+                Msaa::Off,
+                PlenopticCamera {
+                    playback: Playback::Manual,
+                    time: t,
+                    ..PlenopticCamera::new(handle)
+                },
+            ))
+            .id();
+        app.world_mut().entity_mut(camera).insert(tonemapping);
+        for _ in 0..300 {
+            app.update();
+            if app.world().get::<StreamState>(camera).unwrap().complete {
+                break;
+            }
+        }
+        // The top row is sky; ready once it is drawn (not the red clear colour).
+        let data = render_until(&mut app, image, 600, |d| {
+            d.len() == (WIDTH * HEIGHT * 4) as usize
+                && (0..WIDTH).all(|x| pixel(d, x, 0)[1] > 0 && pixel(d, x, HEIGHT - 1)[1] > 0)
+        });
+        blue.push((0..WIDTH).map(|x| pixel(&data, x, 0)[2]).min().unwrap());
+    }
+    eprintln!("top row blue, no tonemapping vs Reinhard: {blue:?}");
+    assert_eq!(blue[0], 255, "without a curve the sky saturates");
+    assert!(
+        (60..250).contains(&blue[1]),
+        "Reinhard keeps it below white: {}",
+        blue[1]
+    );
+}

@@ -7,6 +7,9 @@
 // or in image mode the image-mode frame. Output is times the camera's exposure.
 
 #import bevy_pbr::mesh_view_bindings::view
+#ifdef TONEMAP_IN_SHADER
+#import bevy_core_pipeline::tonemapping::tone_mapping
+#endif
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel}
 
@@ -146,9 +149,14 @@ fn background(position: vec2<f32>) -> vec3<f32> {
     return rgb9e5_decode(texel.x);
 }
 
-// Times the camera's exposure, as Bevy's own lights (geometry.wgsl), inside f16's range.
+// Times the camera's exposure, as Bevy's own lights, inside f16's range; tonemapped here for
+// cameras without an HDR target (geometry.wgsl).
 @fragment
 fn fragment(in: Out) -> @location(0) vec4<f32> {
     let c = background(in.position.xy) * view.exposure;
-    return vec4<f32>(min(c, vec3<f32>(65504.0)), 1.0);
+    var out = vec4<f32>(min(c, vec3<f32>(65504.0)), 1.0);
+#ifdef TONEMAP_IN_SHADER
+    out = tone_mapping(out, view.color_grading);
+#endif
+    return out;
 }
