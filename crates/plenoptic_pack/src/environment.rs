@@ -233,11 +233,22 @@ pub(crate) fn environment_image_header(bytes: &[u8]) -> Result<(u32, u32, u64)> 
 /// Decodes an environment-image chunk.
 pub fn decode_environment_image(bytes: &[u8]) -> Result<EquirectImage> {
     let (width, height, len) = environment_image_header(bytes)?;
-    let raw = zstd_decompress_exact(
-        &bytes[ENVIRONMENT_IMAGE_HEADER_LEN..],
-        len as usize,
-        PackError::payload,
-    )?;
+    let frame = &bytes[ENVIRONMENT_IMAGE_HEADER_LEN..];
+    // The frame must declare the size the header implies before anything is allocated.
+    match zstd::zstd_safe::get_frame_content_size(frame) {
+        Ok(Some(n)) if n == len => {}
+        Ok(Some(n)) => {
+            return Err(PackError::payload(format!(
+                "zstd frame declares {n} bytes, {width} × {height} texels need {len}"
+            )));
+        }
+        _ => {
+            return Err(PackError::payload(
+                "zstd frame is truncated or does not declare its size",
+            ));
+        }
+    }
+    let raw = zstd_decompress_exact(frame, len as usize, PackError::payload)?;
     let texels: Vec<Vec3> = raw
         .chunks_exact(6)
         .map(|c| {
