@@ -85,7 +85,7 @@ fn sky_pack(path: &std::path::Path) {
     write_pack_with(
         &open_room(),
         &PackSpec::segment(2, vec![0.0, 2.0], 16),
-        &path,
+        path,
         Some((sky, Some(track))),
     );
 }
