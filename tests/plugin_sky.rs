@@ -64,11 +64,15 @@ fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
 /// Writes the open room with a sky (scale 1: kcd/m², a few units, beside the test shading's
 /// radiance) and a moving sun to `path`.
 fn sky_pack(path: &std::path::Path) {
-    // Scale 1: the sky in kcd/m² (a few units), beside the test shading's radiance.
     let sky = Environment::Sky(SkyParams {
         scale: 1.0,
         ..SkyParams::default()
     });
+    env_pack(path, sky);
+}
+
+/// Writes the open room with `env` and a moving sun to `path`.
+fn env_pack(path: &std::path::Path, env: Environment) {
     let track = SunTrack::new(vec![
         SunTrackSample {
             time: 0.0,
@@ -86,7 +90,7 @@ fn sky_pack(path: &std::path::Path) {
         &open_room(),
         &PackSpec::segment(2, vec![0.0, 2.0], 16),
         path,
-        Some((sky, Some(track))),
+        Some((env, Some(track))),
     );
 }
 
@@ -310,4 +314,51 @@ fn ldr_cameras_get_the_tonemapping_curve() {
         "Reinhard keeps it below white: {}",
         blue[1]
     );
+}
+
+/// The other two kinds on the GPU: an equirectangular image (turned 30° about +Y, read
+/// bilinearly from its texture) and a uniform colour, against the CPU's background.
+#[test]
+fn gpu_image_and_uniform_environments_match_cpu() {
+    use plenoptic_pack::plenoptic_sky::EquirectImage;
+    use std::sync::Arc;
+    let (w, h) = (32u32, 16u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            Vec3::new(0.2 + 2.0 * x, 0.5 + y, 1.0 + (x * 12.0).sin().abs())
+        })
+        .collect();
+    let image = Environment::Image {
+        image: Arc::new(EquirectImage::new(w, h, texels).unwrap()),
+        intensity: 1.5,
+        rotation_deg: 30.0,
+    };
+    for env in [image, Environment::Uniform(Vec3::new(0.7, 1.1, 2.3))] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sky.pack");
+        env_pack(&path, env.clone());
+        let (eye, transform, t) = view();
+        let rec = Reconstructor::open(&path).unwrap();
+        let cam = cpu_camera(eye, &transform);
+        let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+        let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+        let sky_pixels: Vec<usize> = (0..mask.object.len())
+            .filter(|&j| mask.object[j] == 0)
+            .collect();
+        assert!(sky_pixels.len() * 5 > mask.object.len());
+        let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+        let gpu = settle(&mut app, camera, &image);
+        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
+        let kind = if matches!(env, Environment::Image { .. }) {
+            "image"
+        } else {
+            "uniform"
+        };
+        eprintln!("GPU vs CPU {kind}: mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %");
+        assert!(
+            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+            "{kind}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+        );
+    }
 }
