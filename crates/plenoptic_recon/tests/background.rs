@@ -55,6 +55,7 @@ fn pixels_without_geometry_show_the_sky_at_the_cameras_time_in_every_mode() {
         .filter(|&j| mask.object[j] == 0)
         .collect();
     let fraction = sky_pixels.len() as f32 / mask.object.len() as f32;
+    eprintln!("sky: {:.1} % of the frame", 100.0 * fraction);
     assert!((0.2..0.8).contains(&fraction), "sky fraction {fraction}");
     let basis = camera.basis();
     let direction = |j: usize| basis.direction((j % 64) as f32 + 0.5, (j / 64) as f32 + 0.5);
