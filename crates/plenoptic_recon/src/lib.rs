@@ -76,6 +76,7 @@
 //! ```
 
 pub mod background;
+mod cache;
 pub mod camera;
 pub mod delaunay3;
 pub mod frame;

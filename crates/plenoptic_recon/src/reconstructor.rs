@@ -14,6 +14,7 @@ use glam::Vec3;
 use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
 
 use crate::background::{self, Coverage, PackEnvironment};
+use crate::cache::{Cache, Cached};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::lookup::PackedTexels;
@@ -82,38 +83,6 @@ impl Default for ReconSettings {
             cube_filter: CubeFilter::Nearest,
         }
     }
-}
-
-#[derive(Clone)]
-pub(crate) enum Cached {
-    Radiance(Arc<CubeImage<Vec3>>),
-    Distance(Arc<CubeImage<f32>>),
-    Ids(Arc<CubeImage<u32>>),
-    Normal(Arc<CubeImage<Vec3>>),
-    Volume(Arc<VolumeBlock>),
-    Connectivity(Arc<Vec<[u32; 4]>>),
-    Failed(String),
-}
-
-impl Cached {
-    fn bytes(&self) -> usize {
-        match self {
-            Cached::Radiance(c) => c.texels.len() * 12,
-            Cached::Distance(c) => c.texels.len() * 4,
-            Cached::Ids(c) => c.texels.len() * 4,
-            Cached::Normal(c) => c.texels.len() * 12,
-            Cached::Volume(b) => b.samples.len() * 64,
-            Cached::Connectivity(t) => t.len() * 16,
-            Cached::Failed(s) => s.len(),
-        }
-    }
-}
-
-#[derive(Default)]
-struct Cache {
-    map: HashMap<(ChunkKind, u32, u32), (Cached, u64)>,
-    tick: u64,
-    bytes: usize,
 }
 
 /// Reconstructs frames from one pack.
