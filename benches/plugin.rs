@@ -114,6 +114,9 @@ fn first_frame_once(assets: &std::path::Path) -> Duration {
             },
             RenderTarget::Image(image.clone().into()),
             Tonemapping::None,
+            bevy::camera::Exposure {
+                ev100: bevy_plenoptic::camera::EV100_UNIT,
+            },
             Transform::from_xyz(0.3, 1.3, 1.0).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
             PlenopticCamera {
                 playback: Playback::Manual,

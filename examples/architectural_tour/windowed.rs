@@ -12,15 +12,18 @@
 //! moment, waits until the plugin has streamed what the frame needs and the pipelines are
 //! compiled, saves the window to FILE and quits: how the README's window picture was taken.
 //!
-//! Exposure: the reconstruction writes linear radiance into the HDR target; the example sets
-//! the camera's colour-grading exposure from the CPU reconstruction's automatic exposure at
-//! the start of the path and tonemaps with ACES, the same curve as the headless frames.
+//! Exposure: the reconstruction writes linear radiance times the camera's physical exposure
+//! into the HDR target, as Bevy's lights do. The tour is lit far below daylight (a sun of
+//! about 6 lux), so its camera's `Exposure` is [`EV100_UNIT`] (multiplier 1, the radiance as
+//! baked); on top of that the example sets the colour-grading exposure from the CPU
+//! reconstruction's automatic exposure at the start of the path and tonemaps with ACES, the
+//! same curve as the headless frames.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use bevy::camera::Hdr;
+use bevy::camera::{Exposure, Hdr};
 use bevy::camera_controller::free_camera::{FreeCamera, FreeCameraPlugin, FreeCameraState};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore, FrameTimeDiagnosticsPlugin};
@@ -28,6 +31,7 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{Capturing, Screenshot, save_to_disk};
 use bevy::render::view::{ColorGrading, ColorGradingGlobal};
 use bevy::window::WindowResolution;
+use bevy_plenoptic::camera::EV100_UNIT;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::RESIDENT_BYTES;
 use plenoptic_recon::CameraPath;
@@ -127,6 +131,7 @@ pub fn run(
             commands.spawn((
                 camera,
                 Hdr,
+                Exposure { ev100: EV100_UNIT },
                 Tonemapping::AcesFitted,
                 ColorGrading {
                     global: ColorGradingGlobal {

@@ -18,8 +18,10 @@
 //!   and decode time.
 //! - [`reconstruct`]: the reconstruction in WGSL. Geometry-assisted: a material on the proxy
 //!   meshes that does `plenoptic_recon`'s geometry-mode lookups per fragment (with its
-//!   volume, hole-fill and background fallbacks) and writes linear radiance, unlit, into the
-//!   camera's HDR target. Image mode: compute passes (splats, key and view blends, background
+//!   volume, hole-fill and background fallbacks) and writes linear radiance times the camera's
+//!   `Exposure`, unlit, into the camera's HDR target (tonemapped by the camera's
+//!   `Tonemapping`, in the shader for cameras without an HDR target, as Bevy's PBR). Pixels
+//!   no proxy covers show the pack's environment (sky, image, colour) at the camera's time. Image mode: compute passes (splats, key and view blends, background
 //!   fill) whose frame the proxies show; volume mode: the same passes over cubes interpolated
 //!   from the temporal volumes. [`cpu`] is the fallback backend ([`Backend`]) that runs
 //!   `plenoptic_recon` itself on a worker thread, and the reference the GPU path is tested

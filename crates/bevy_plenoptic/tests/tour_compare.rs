@@ -68,6 +68,10 @@ fn tour_gpu_against_cpu() {
                 },
                 RenderTarget::Image(image.clone().into()),
                 Tonemapping::None,
+                // Exposure multiplier 1: the frame is the pack's radiance.
+                bevy::camera::Exposure {
+                    ev100: bevy_plenoptic::camera::EV100_UNIT,
+                },
                 Hdr,
                 Msaa::Off,
                 Projection::Perspective(PerspectiveProjection {

@@ -21,10 +21,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use plenoptic_pack::{
-    Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, Interpolation, Light,
-    LightKind, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter, ProxyMesh, RangeImage,
-    TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block, encode_connectivity,
-    encode_distance, encode_normal, encode_object_id, encode_radiance, encode_volume_block,
+    Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, EnvironmentEntry,
+    Interpolation, Light, LightKind, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter,
+    ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block,
+    encode_connectivity, encode_distance, encode_normal, encode_object_id, encode_radiance,
+    encode_volume_block,
 };
 use plenoptic_scene::Scene;
 use plenoptic_trace::SceneAccel;
@@ -338,7 +339,20 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
             .unwrap_or(0),
         extra,
     };
+    m.environment = environment_entry(plan.start, plan.end, scene);
     m
+}
+
+/// Sun-track samples the pack stores for a moving sun that has no sun study (the runtime
+/// interpolates linearly between them).
+pub const SUN_TRACK_SAMPLES: usize = 256;
+
+/// The scene's environment and sun track over `[start, end]` as the pack stores them: `None`
+/// when the scene has neither.
+fn environment_entry(start: f32, end: f32, scene: &Scene) -> Option<EnvironmentEntry> {
+    let sun = scene.sun_track(start, end, SUN_TRACK_SAMPLES);
+    (!scene.environment.is_none() || sun.is_some())
+        .then(|| EnvironmentEntry::new(&scene.environment, sun))
 }
 
 fn stat_name(kind: ChunkKind) -> &'static str {
@@ -351,6 +365,7 @@ fn stat_name(kind: ChunkKind) -> &'static str {
         ChunkKind::VolumeConnectivity => "connectivity",
         ChunkKind::ProxyMesh => "proxy",
         ChunkKind::AnimationTracks => "tracks",
+        ChunkKind::EnvironmentImage => "environment",
         ChunkKind::Unknown(_) => "other",
     }
 }
@@ -415,6 +430,11 @@ pub fn assemble(
     let before = writer.bytes_written();
     writer.add_tracks(&animation_tracks(scene, plan))?;
     *bytes.entry("tracks".into()).or_default() += writer.bytes_written() - before;
+    if let plenoptic_scene::Environment::Image { image, .. } = &scene.environment {
+        let before = writer.bytes_written();
+        writer.add_environment_image(image)?;
+        *bytes.entry("environment".into()).or_default() += writer.bytes_written() - before;
+    }
 
     let cost = plan.cost(0.0);
     let s = &mut manifest.stats;
@@ -450,4 +470,53 @@ pub fn timings_path(output: &Path) -> PathBuf {
     let mut name = output.as_os_str().to_owned();
     name.push(".timings.json");
     PathBuf::from(name)
+}
+
+#[cfg(test)]
+mod environment_tests {
+    use super::*;
+    use plenoptic_pack::EnvironmentSource;
+    use plenoptic_pack::plenoptic_sky::SkyParams;
+    use plenoptic_scene::{Environment, Sun, SunTrack, SunTrackSample};
+
+    #[test]
+    fn the_manifest_carries_the_scenes_environment_and_sun_track() {
+        assert_eq!(environment_entry(0.0, 1.0, &Scene::default()), None);
+        let track = SunTrack::new(vec![
+            SunTrackSample {
+                time: 0.0,
+                direction: glam::Vec3::X,
+                illuminance: glam::Vec3::splat(1e5),
+            },
+            SunTrackSample {
+                time: 1.0,
+                direction: glam::Vec3::Y,
+                illuminance: glam::Vec3::splat(1e5),
+            },
+        ])
+        .unwrap();
+        let scene = Scene {
+            environment: Environment::Sky(SkyParams::default()),
+            sun: Some(Sun {
+                light: 0,
+                track: Some(track.clone()),
+            }),
+            ..Scene::default()
+        };
+        let entry = environment_entry(0.0, 1.0, &scene).unwrap();
+        assert_eq!(
+            entry.source,
+            EnvironmentSource::Sky {
+                params: SkyParams::default()
+            }
+        );
+        assert_eq!(entry.sun, Some(track));
+        let uniform = Scene {
+            environment: Environment::Uniform(glam::Vec3::ONE),
+            ..Scene::default()
+        };
+        let entry = environment_entry(0.0, 1.0, &uniform).unwrap();
+        assert_eq!(entry.sun, None);
+        assert!(matches!(entry.source, EnvironmentSource::Uniform { .. }));
+    }
 }

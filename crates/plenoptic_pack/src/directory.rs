@@ -30,6 +30,9 @@ pub enum ChunkKind {
     ProxyMesh,
     /// Animation tracks of all objects (code 8). Base view: [`NO_BASE_VIEW`]. Key: 0.
     AnimationTracks,
+    /// The environment's equirectangular image (code 9, since version 1.1). Base view:
+    /// [`NO_BASE_VIEW`]. Key: 0.
+    EnvironmentImage,
     /// A kind written by a newer minor version. It is validated like every other chunk and its
     /// raw bytes can be read, but it cannot be decoded.
     Unknown(u32),
@@ -47,6 +50,7 @@ impl ChunkKind {
             ChunkKind::VolumeConnectivity => 6,
             ChunkKind::ProxyMesh => 7,
             ChunkKind::AnimationTracks => 8,
+            ChunkKind::EnvironmentImage => 9,
             ChunkKind::Unknown(c) => c,
         }
     }
@@ -62,6 +66,7 @@ impl ChunkKind {
             6 => ChunkKind::VolumeConnectivity,
             7 => ChunkKind::ProxyMesh,
             8 => ChunkKind::AnimationTracks,
+            9 => ChunkKind::EnvironmentImage,
             c => ChunkKind::Unknown(c),
         }
     }

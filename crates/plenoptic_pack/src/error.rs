@@ -253,6 +253,14 @@ pub enum PackError {
         /// The chunk's own value.
         actual: u64,
     },
+    /// The pack's environment (manifest entry or image chunk) is not valid.
+    #[error("environment of {}: {reason}", path.display())]
+    InvalidEnvironment {
+        /// The pack (empty for in-memory sources).
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
     /// The caller handed the writer or an encoder something it cannot store.
     #[error("invalid input: {reason}")]
     InvalidInput {

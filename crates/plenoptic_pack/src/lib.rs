@@ -47,6 +47,7 @@
 mod bytes;
 pub mod cube;
 pub mod directory;
+pub mod environment;
 mod error;
 pub mod header;
 pub mod ktx;
@@ -59,9 +60,14 @@ pub mod writer;
 
 /// The glam this crate's types use (the workspace's one glam).
 pub use glam;
+/// The environment model whose parameters the pack stores.
+pub use plenoptic_sky;
 
 pub use cube::{direction_to_face_uv, face_uv_to_direction};
 pub use directory::{ChunkEntry, ChunkKind, NO_BASE_VIEW};
+pub use environment::{
+    EnvironmentEntry, EnvironmentSource, decode_environment_image, encode_environment_image,
+};
 pub use error::{ChunkRef, PackError, Result, Section};
 pub use header::{HEADER_LEN, Header, MAGIC, VERSION_MAJOR, VERSION_MINOR};
 pub use manifest::{

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::environment::EnvironmentEntry;
 use crate::error::{PackError, Result};
 
 /// Largest manifest the reader accepts, in bytes.
@@ -35,6 +36,10 @@ pub struct Manifest {
     pub bake: BakeSettings,
     /// What the bake measured.
     pub stats: BakeStatistics,
+    /// The environment rays that leave the scene see, and the sun's track (version 1.1;
+    /// absent in older packs and in packs without an environment).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<EnvironmentEntry>,
 }
 
 impl Manifest {
@@ -55,6 +60,7 @@ impl Manifest {
             lights: Vec::new(),
             bake: BakeSettings::default(),
             stats: BakeStatistics::default(),
+            environment: None,
         }
     }
 

@@ -9,6 +9,7 @@ use std::sync::Mutex;
 
 use crate::bytes::{ByteReader, checksum};
 use crate::directory::{ChunkEntry, ChunkKind, DIRECTORY_ROW_LEN, NO_BASE_VIEW};
+use crate::environment::{decode_environment_image, environment_image_header};
 use crate::error::{ChunkRef, PackError, Result, Section};
 use crate::header::{HEADER_LEN, Header};
 use crate::ktx::inspect_cube;
@@ -25,6 +26,7 @@ use crate::volume::{
     VolumeBlock, block_header, connectivity_header, decode_connectivity, decode_volume_block,
 };
 use crate::writer::{MAX_CHUNK_LENGTH, MAX_CHUNKS};
+use plenoptic_sky::EquirectImage;
 
 /// Positional reads from a shared source.
 trait Source: Send + Sync {
@@ -86,6 +88,8 @@ pub enum Chunk {
     ProxyMesh(ProxyMesh),
     /// The animation tracks.
     Tracks(AnimationTracks),
+    /// The environment's image.
+    EnvironmentImage(EquirectImage),
 }
 
 /// The uncompressed length a chunk's own header declares (validating that header).
@@ -99,6 +103,7 @@ pub(crate) fn declared_uncompressed_length(kind: ChunkKind, bytes: &[u8]) -> Res
         ChunkKind::VolumeConnectivity => connectivity_header(bytes)?.2,
         ChunkKind::ProxyMesh => proxy_header(bytes)?.4,
         ChunkKind::AnimationTracks => tracks_header(bytes)?.1,
+        ChunkKind::EnvironmentImage => environment_image_header(bytes)?.2,
         ChunkKind::Unknown(_) => {
             return Err(PackError::input(
                 "unknown chunk kinds must be added with add_raw_chunk",
@@ -153,6 +158,11 @@ impl PackReader {
             len,
             PathBuf::new(),
         )
+    }
+
+    /// The path the pack was opened from (empty for other sources).
+    pub fn path(&self) -> &Path {
+        &self.path
     }
 
     fn read_at(&self, offset: u64, len: u64) -> Result<Vec<u8>> {
@@ -238,6 +248,13 @@ impl PackReader {
             });
         }
         let manifest = Manifest::from_json(&manifest_bytes)?;
+        if let Some(env) = &manifest.environment {
+            env.validate()
+                .map_err(|reason| PackError::InvalidEnvironment {
+                    path: path.clone(),
+                    reason,
+                })?;
+        }
 
         let mut r = ByteReader::new(&directory_bytes, |reason| PackError::InvalidManifest {
             reason,
@@ -341,12 +358,15 @@ impl PackReader {
             }
             ChunkKind::ProxyMesh => decode_proxy_mesh(&bytes).map(Chunk::ProxyMesh),
             ChunkKind::AnimationTracks => decode_tracks(&bytes).map(Chunk::Tracks),
+            ChunkKind::EnvironmentImage => {
+                decode_environment_image(&bytes).map(Chunk::EnvironmentImage)
+            }
             ChunkKind::Unknown(_) => return Err(PackError::UnknownChunkKind { chunk }),
         };
         decoded.map_err(|err| err.in_chunk(chunk))
     }
 
-    fn get(&self, kind: ChunkKind, base_view: u32, key: u32) -> Result<Chunk> {
+    pub(crate) fn get(&self, kind: ChunkKind, base_view: u32, key: u32) -> Result<Chunk> {
         let i = self
             .find(kind, base_view, key)
             .ok_or(PackError::ChunkNotFound {

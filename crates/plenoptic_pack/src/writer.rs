@@ -263,11 +263,30 @@ impl PackWriter {
         )
     }
 
+    /// Encodes and adds the environment's equirectangular image (key 0); the manifest's
+    /// [`crate::EnvironmentEntry`] gives its intensity and rotation. Texels above
+    /// [`crate::environment::ENVIRONMENT_TEXEL_MAX`] are clamped.
+    pub fn add_environment_image(&mut self, image: &plenoptic_sky::EquirectImage) -> Result<usize> {
+        let (bytes, len) = crate::environment::encode_environment_image(image)?;
+        self.add_raw_chunk(
+            ChunkKind::EnvironmentImage,
+            NO_BASE_VIEW,
+            0,
+            &bytes,
+            len,
+            None,
+        )
+    }
+
     /// Writes the manifest and directory, then the header, fsyncs and renames the file to the
     /// target path. Fails (leaving the target untouched) if a chunk names a base view the
     /// manifest does not have.
     pub fn finish(mut self, manifest: &Manifest) -> Result<PathBuf> {
         manifest.validate()?;
+        if let Some(env) = &manifest.environment {
+            env.validate()
+                .map_err(|reason| PackError::input(format!("environment: {reason}")))?;
+        }
         for (i, e) in self.entries.iter().enumerate() {
             if e.base_view != NO_BASE_VIEW && e.base_view as usize >= manifest.base_views.len() {
                 return Err(PackError::UnknownBaseView {

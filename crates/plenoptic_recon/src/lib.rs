@@ -22,6 +22,9 @@
 //!   the improvement the thesis proposes in §8.2.3; [`motion`]: the objects' tracks
 //!   evaluated at any time.
 //!
+//! - [`background`]: the pack's environment (sky, image, colour) per pixel where no proxy
+//!   is, at the camera's time.
+//!
 //! [`Reconstructor::render`] runs one of the three [`Mode`]s and returns a [`Frame`]
 //! (radiance, depth, object id) and a [`Report`] (fallback fractions, missing chunks). A
 //! damaged pack degrades the frame instead of failing it. [`path`] is the camera-path file
@@ -72,6 +75,8 @@
 //! assert!(frame.radiance[12 * 32 + 16].abs_diff_eq(Vec3::new(0.0, 0.0, 1.0), 0.1));
 //! ```
 
+pub mod background;
+mod cache;
 pub mod camera;
 pub mod delaunay3;
 pub mod frame;

@@ -13,6 +13,8 @@ use std::sync::{Arc, Mutex};
 use glam::Vec3;
 use plenoptic_pack::{ChunkKind, CubeImage, PackReader, VolumeBlock};
 
+use crate::background::{self, Coverage, PackEnvironment};
+use crate::cache::{Cache, Cached};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::lookup::PackedTexels;
@@ -83,43 +85,12 @@ impl Default for ReconSettings {
     }
 }
 
-#[derive(Clone)]
-pub(crate) enum Cached {
-    Radiance(Arc<CubeImage<Vec3>>),
-    Distance(Arc<CubeImage<f32>>),
-    Ids(Arc<CubeImage<u32>>),
-    Normal(Arc<CubeImage<Vec3>>),
-    Volume(Arc<VolumeBlock>),
-    Connectivity(Arc<Vec<[u32; 4]>>),
-    Failed(String),
-}
-
-impl Cached {
-    fn bytes(&self) -> usize {
-        match self {
-            Cached::Radiance(c) => c.texels.len() * 12,
-            Cached::Distance(c) => c.texels.len() * 4,
-            Cached::Ids(c) => c.texels.len() * 4,
-            Cached::Normal(c) => c.texels.len() * 12,
-            Cached::Volume(b) => b.samples.len() * 64,
-            Cached::Connectivity(t) => t.len() * 16,
-            Cached::Failed(s) => s.len(),
-        }
-    }
-}
-
-#[derive(Default)]
-struct Cache {
-    map: HashMap<(ChunkKind, u32, u32), (Cached, u64)>,
-    tick: u64,
-    bytes: usize,
-}
-
 /// Reconstructs frames from one pack.
 pub struct Reconstructor {
     pack: PackReader,
     proxy: Option<ProxyGeometry>,
     proxy_missing: Vec<String>,
+    environment: PackEnvironment,
     /// Settings (may be changed between frames).
     pub settings: ReconSettings,
     cache: Mutex<Cache>,
@@ -159,11 +130,14 @@ impl Reconstructor {
     /// A reconstructor over an open pack. Reads the proxy geometry and tracks now (what cannot
     /// be read is reported with every frame).
     pub fn new(pack: PackReader, settings: ReconSettings) -> Self {
-        let (proxy, proxy_missing) = ProxyGeometry::from_pack(&pack);
+        let (proxy, mut proxy_missing) = ProxyGeometry::from_pack(&pack);
+        let (environment, env_error) = PackEnvironment::from_pack(&pack);
+        proxy_missing.extend(env_error);
         Reconstructor {
             pack,
             proxy,
             proxy_missing,
+            environment,
             settings,
             cache: Mutex::new(Cache::default()),
             bins: Mutex::new(HashMap::new()),
@@ -174,6 +148,11 @@ impl Reconstructor {
     /// The pack.
     pub fn pack(&self) -> &PackReader {
         &self.pack
+    }
+
+    /// The pack's environment and sun track.
+    pub fn environment(&self) -> &PackEnvironment {
+        &self.environment
     }
 
     /// The proxy geometry, if the pack has readable proxy meshes.
@@ -421,7 +400,7 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let frame = match mode {
+        let mut frame = match mode {
             Mode::GeometryAssisted if self.proxy.is_some() => {
                 crate::geometry::render(self, camera, t, None, &mut report)?
             }
@@ -435,6 +414,7 @@ impl Reconstructor {
             Mode::Image => self.render_image(camera, t, &mut report)?,
             Mode::Volume => crate::volume::render(self, camera, t, &mut report)?,
         };
+        background::show(self, camera, t, report.used_mode, &mut frame);
         Ok((frame, report))
     }
 
@@ -466,7 +446,9 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
+        let mut frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
+        let env = self.environment.at(t);
+        background::apply(&env, camera, Coverage::Mask(mask), &mut frame);
         Ok((frame, report))
     }
 

@@ -79,7 +79,11 @@ impl AssetLoader for RadiancePackLoader {
             source,
         })?;
 
-        let (read, failed) = plenoptic_recon::proxy::read_proxies(&pack);
+        let (read, mut failed) = plenoptic_recon::proxy::read_proxies(&pack);
+        // The environment (its image chunk, if any, is read now: every frame needs it).
+        let (environment, env_error) =
+            plenoptic_recon::background::PackEnvironment::from_pack(&pack);
+        failed.extend(env_error.map(|e| ("environment".to_string(), e)));
         let mut proxies = Vec::new();
         for proxy in read {
             let mesh = proxy_to_mesh(&proxy.mesh);
@@ -98,6 +102,7 @@ impl AssetLoader for RadiancePackLoader {
             failed,
             file,
             usable_views,
+            environment,
         })
     }
 

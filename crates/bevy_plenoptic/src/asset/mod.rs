@@ -38,6 +38,9 @@ pub struct RadiancePack {
     /// Per base view: whether the directory has a radiance cube of it at some time key. Views
     /// without one get no view-space weight, as in `plenoptic_recon`.
     pub usable_views: Vec<bool>,
+    /// The environment behind the proxies (sky, image, colour) and the sun's track; none when
+    /// the pack has none or it could not be read (then in [`RadiancePack::failed`]).
+    pub environment: plenoptic_recon::background::PackEnvironment,
 }
 
 /// Per base view of `pack`: whether the directory has a radiance cube of it at some time key

@@ -17,11 +17,23 @@ impl Plugin for PlenopticCameraPlugin {
     }
 }
 
+/// The EV100 at which Bevy's exposure multiplier (`2^−EV100 / 1.2`) is 1: a camera with
+/// `Exposure { ev100: EV100_UNIT }` shows a pack's radiance as it is stored. For packs
+/// baked with non-physical light levels (a sun of a few lux, like the tour's); a pack lit by
+/// a real sun (about 100,000 lux) wants a daylight exposure such as
+/// `Exposure::SUNLIGHT` (EV100 15).
+pub const EV100_UNIT: f32 = -0.263_034_4;
+
 /// A camera that shows a radiance pack: which pack, at which time, reconstructed how.
 ///
 /// Requires a [`Camera3d`] (the proxy geometry is rasterised by it) with a
 /// [`DepthPrepass`] (the GPU reconstruction's hole fill reads the depth of neighbouring
 /// pixels), and carries the per-camera streaming state.
+///
+/// The reconstructed radiance honours the camera's `Exposure` (EV100) as Bevy's own lights
+/// do: it is multiplied by `2^−EV100 / 1.2` before it reaches the HDR target, and the
+/// camera's `Tonemapping` then applies as to any other mesh. Bevy's default exposure (EV100
+/// 9.7, "Blender") suits physical light levels; see [`EV100_UNIT`] for packs without them.
 #[derive(Component, Debug, Clone)]
 #[require(Camera3d, DepthPrepass, StreamState)]
 pub struct PlenopticCamera {

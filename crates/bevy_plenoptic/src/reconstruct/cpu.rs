@@ -31,7 +31,11 @@ impl Plugin for PlenopticCpuPlugin {
             .init_resource::<CpuFrames>()
             .add_systems(
                 Update,
-                (attach_cpu_materials, run_cpu_frames)
+                (
+                    attach_cpu_materials,
+                    super::background::spawn_cpu_backgrounds,
+                    run_cpu_frames,
+                )
                     .chain()
                     .after(PlenopticSystems::Streaming),
             );
@@ -67,6 +71,11 @@ struct CpuFrame {
 }
 
 impl CpuFrames {
+    /// The image showing `pack`'s latest CPU frame, once the backend has one for it.
+    pub fn image(&self, pack: AssetId<RadiancePack>) -> Option<Handle<Image>> {
+        self.0.get(&pack).map(|f| f.image.clone())
+    }
+
     /// Frames the CPU backend has completed for `pack`.
     pub fn frames_done(&self, pack: AssetId<RadiancePack>) -> u64 {
         self.0.get(&pack).map_or(0, |f| f.done)
@@ -141,6 +150,7 @@ fn run_cpu_frames(
     cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
     mut images: ResMut<Assets<Image>>,
     mut materials: ResMut<Assets<CpuFrameMaterial>>,
+    mut backgrounds: ResMut<Assets<super::background::PlenopticBackgroundMaterial>>,
     mut events: MessageWriter<PlenopticEvent>,
 ) {
     for (id, f) in frames.0.iter_mut() {
@@ -179,6 +189,16 @@ fn run_cpu_frames(
                     for m in users {
                         if let Some(mut m) = materials.get_mut(m) {
                             m.frame = f.image.clone();
+                        }
+                    }
+                    let users: Vec<_> = backgrounds
+                        .iter()
+                        .filter(|(_, m)| m.image_frame == f.image)
+                        .map(|(id, _)| id)
+                        .collect();
+                    for m in users {
+                        if let Some(mut m) = backgrounds.get_mut(m) {
+                            m.image_frame = f.image.clone();
                         }
                     }
                     f.done += 1;

@@ -4,6 +4,9 @@
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
+#ifdef TONEMAP_IN_SHADER
+#import bevy_core_pipeline::tonemapping::tone_mapping
+#endif
 #import bevy_pbr::prepass_utils
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction}
@@ -213,8 +216,22 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
     return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
 }
 
+// The reconstructed radiance, times the camera's exposure as Bevy's own lights are
+// (`view.exposure`, from its `Exposure`), kept inside the f16 HDR target's range; tonemapped
+// here for cameras without an HDR target, as Bevy's PBR does (HDR cameras are tonemapped by
+// Bevy's post-process pass).
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    let c = radiance(in);
+    var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), c.a);
+#ifdef TONEMAP_IN_SHADER
+    out = tone_mapping(out, view.color_grading);
+#endif
+    return out;
+}
+
+// The reconstructed radiance of the fragment (linear, before exposure).
+fn radiance(in: VertexOutput) -> vec4<f32> {
     let object = u32(params.header.y);
     let n = u32(params.header.z);
     let p = in.world_position.xyz;

@@ -8,8 +8,9 @@
 //! for each resident (base view, bracketing time key) the fragment's point is carried along
 //! its object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, looked up (nearest texel) in that key's
 //! cube, accepted if the cube saw the same object at the same distance, and blended with
-//! weight `w_view · w_time · ((1 + cos θ)/2)^p`. The result is written unlit into the camera's
-//! HDR target; depth comes from the rasterised proxy mesh.
+//! weight `w_view · w_time · ((1 + cos θ)/2)^p`. The result, times the camera's exposure
+//! (`view.exposure`, as Bevy's lights), is written unlit into the camera's HDR target; depth
+//! comes from the rasterised proxy mesh.
 //!
 //! Where no lookup is accepted, the same fallbacks as `plenoptic_recon`, in its order:
 //! 1. the temporal volumes ([`volume`]): samples of the object near the point's direction
@@ -24,8 +25,9 @@
 //!    planar faces only;
 //! 3. the heaviest key's texel in the point's direction ("background").
 //!
-//! Pixels no proxy covers show the heaviest key's cube in the viewing direction
-//! ([`background`], a full-screen triangle behind all geometry), as on the CPU. The
+//! Pixels no proxy covers show the pack's environment for their viewing direction at the
+//! camera's time, or without one the heaviest key's cube in that direction ([`background`],
+//! a full-screen triangle behind all geometry), as on the CPU. The
 //! background is drawn by every camera of the app: give other cameras other `RenderLayers`.
 //!
 //! Resident keys live in one `Rgba32Uint` 2D-array texture per pack: texel = (radiance as
@@ -422,11 +424,25 @@ fn update_materials(
         let Ok((cam, transform)) = cameras.get(bg.camera) else {
             continue;
         };
+        if bg.cpu {
+            continue;
+        }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
         let layer = frame(id, cam, transform.translation())
             .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
         let image_mode = warped(cam.mode) && job.0.is_some();
-        background::set_background(&mut background_materials, handle, layer, face, image_mode);
+        let env = packs
+            .get(id)
+            .map(|p| p.environment.at(cam.time))
+            .unwrap_or_default();
+        background::set_background(
+            &mut background_materials,
+            handle,
+            &env,
+            layer,
+            face,
+            image_mode,
+        );
     }
 }

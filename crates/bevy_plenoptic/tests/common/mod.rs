@@ -74,11 +74,14 @@ pub fn target_image(images: &mut Assets<Image>) -> Handle<Image> {
     images.add(image)
 }
 
-/// A 3D camera that renders into `image` with no tonemapping, so colours reach the target
-/// unchanged.
+/// A 3D camera that renders into `image` with no tonemapping and an exposure multiplier of
+/// 1 ([`bevy_plenoptic::camera::EV100_UNIT`]), so colours reach the target unchanged.
 pub fn camera_into(image: Handle<Image>, transform: Transform) -> impl Bundle {
     (
         Camera3d::default(),
+        bevy::camera::Exposure {
+            ev100: bevy_plenoptic::camera::EV100_UNIT,
+        },
         Camera {
             clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
             ..default()

@@ -20,6 +20,15 @@ pub const LIGHT: Vec3 = Vec3::new(0.3, 2.3, 0.2);
 /// A closed room 4 × 2.6 × 5 m with a static box and (optionally) a box sliding along x from
 /// t = 0 to t = 2. Scene object i has pack id i + 1.
 pub fn room(moving: bool) -> Scene {
+    room_with(moving, true)
+}
+
+/// The room of [`room`] without its ceiling: a skylight 4 × 5 m open to the environment.
+pub fn open_room() -> Scene {
+    room_with(false, false)
+}
+
+fn room_with(moving: bool, ceiling: bool) -> Scene {
     let mut b = shapes::SceneBuilder::default();
     let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
     let wall = |b: &mut shapes::SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3| {
@@ -40,13 +49,15 @@ pub fn room(moving: bool) -> Scene {
         );
     };
     wall(&mut b, "floor", Vec2::new(4.0, 5.0), Vec3::ZERO, Vec3::Y);
-    wall(
-        &mut b,
-        "ceiling",
-        Vec2::new(4.0, 5.0),
-        Vec3::new(0.0, 2.6, 0.0),
-        -Vec3::Y,
-    );
+    if ceiling {
+        wall(
+            &mut b,
+            "ceiling",
+            Vec2::new(4.0, 5.0),
+            Vec3::new(0.0, 2.6, 0.0),
+            -Vec3::Y,
+        );
+    }
     wall(
         &mut b,
         "back",
@@ -255,6 +266,19 @@ impl Lcg {
 
 /// Writes a pack of `scene` per `spec` to `path`.
 pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
+    write_pack_with(scene, spec, path, None);
+}
+
+/// [`write_pack`] with an environment entry (its image, if any, is written too).
+pub fn write_pack_with(
+    scene: &Scene,
+    spec: &PackSpec,
+    path: &Path,
+    environment: Option<(
+        plenoptic_pack::plenoptic_sky::Environment,
+        Option<plenoptic_pack::plenoptic_sky::SunTrack>,
+    )>,
+) {
     let accel = SceneAccel::new(scene).unwrap();
     let mut w = PackWriter::create(path).unwrap();
     let placed: Vec<PlacedScene<'_>> = spec.keys.iter().map(|&t| accel.at_time(t)).collect();
@@ -380,6 +404,12 @@ pub fn write_pack(scene: &Scene, spec: &PackSpec, path: &Path) {
         })
         .collect();
     manifest.bake.cube_face_size = spec.face;
+    if let Some((env, sun)) = environment {
+        if let plenoptic_pack::plenoptic_sky::Environment::Image { image, .. } = &env {
+            w.add_environment_image(image).unwrap();
+        }
+        manifest.environment = Some(plenoptic_pack::EnvironmentEntry::new(&env, sun));
+    }
     w.finish(&manifest).unwrap();
 }
 

@@ -1,0 +1,364 @@
+//! The sky on the GPU: looking up through the open ceiling of the test room, the pixels no
+//! proxy covers show the pack's Hosek–Wilkie sky at the camera's time, evaluated per pixel in
+//! WGSL from coefficients computed on the CPU, equal to `plenoptic_recon`'s background within
+//! the GPU-versus-CPU bounds of `plugin_scene_render.rs`; and the frame honours the camera's
+//! `Exposure`: one EV100 more halves the linear output.
+
+#[path = "../crates/bevy_plenoptic/tests/common/mod.rs"]
+mod common;
+/// The reconstruction crate's test pack builder, shared with the CPU tests.
+#[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
+mod pack;
+
+use std::cell::RefCell;
+
+use bevy::camera::{Exposure, Hdr};
+use bevy::prelude::*;
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
+use bevy_plenoptic::camera::EV100_UNIT;
+use bevy_plenoptic::prelude::*;
+use bevy_plenoptic::streaming::StreamState;
+use common::*;
+use pack::{PackSpec, open_room, write_pack_with};
+use plenoptic_pack::plenoptic_sky::{Environment, SkyParams, SunTrack, SunTrackSample};
+use plenoptic_recon::{Mode, Reconstructor};
+
+/// Compares `gpu` with `cpu` over the pixels `which`, as `plugin_scene_render.rs` does: per
+/// pixel the largest channel's |gpu − cpu| / (cpu + 0.02). Returns (mean, fraction within
+/// 5 %, within 20 %).
+fn compare(gpu: &[Vec3], cpu: &[Vec3], which: &[usize]) -> (f32, f32, f32) {
+    let err =
+        |j: usize| ((gpu[j] - cpu[j]).abs() / (cpu[j].abs() + Vec3::splat(0.02))).max_element();
+    let n = which.len().max(1) as f32;
+    let mean = which.iter().map(|&j| err(j)).sum::<f32>() / n;
+    let frac = |limit: f32| which.iter().filter(|&&j| err(j) < limit).count() as f32 / n;
+    (mean, frac(0.05), frac(0.2))
+}
+
+/// Renders until the camera's keys are resident and two read-backs agree.
+fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
+    let mut complete = 0;
+    for _ in 0..500 {
+        app.update();
+        if app.world().get::<StreamState>(camera).unwrap().complete {
+            complete += 1;
+            if complete == 3 {
+                break;
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
+    let data = render_until(app, image.clone(), 600, |d| {
+        let px = rgba16f_pixels(d);
+        let shown = px.len() == (WIDTH * HEIGHT) as usize
+            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
+            && px.iter().any(|c| c.max_element() > 0.01);
+        let stable = prev.borrow().as_deref() == Some(d);
+        *prev.borrow_mut() = Some(d.to_vec());
+        shown && stable
+    });
+    rgba16f_pixels(&data)
+}
+
+/// Writes the open room with a sky (scale 1: kcd/m², a few units, beside the test shading's
+/// radiance) and a moving sun to `path`.
+fn sky_pack(path: &std::path::Path) {
+    let sky = Environment::Sky(SkyParams {
+        scale: 1.0,
+        ..SkyParams::default()
+    });
+    env_pack(path, sky);
+}
+
+/// Writes the open room with `env` and a moving sun to `path`.
+fn env_pack(path: &std::path::Path, env: Environment) {
+    let track = SunTrack::new(vec![
+        SunTrackSample {
+            time: 0.0,
+            direction: Vec3::new(1.0, 0.15, 0.2).normalize(),
+            illuminance: Vec3::splat(20_000.0),
+        },
+        SunTrackSample {
+            time: 2.0,
+            direction: Vec3::new(-0.3, 1.0, -0.4).normalize(),
+            illuminance: Vec3::splat(100_000.0),
+        },
+    ])
+    .unwrap();
+    write_pack_with(
+        &open_room(),
+        &PackSpec::segment(2, vec![0.0, 2.0], 16),
+        path,
+        Some((env, Some(track))),
+    );
+}
+
+/// A headless app on `backend` with a camera into an Rgba16Float target (no MSAA, no
+/// tonemapping, exposure multiplier 1) on `sky.pack` in `dir`: (app, camera, target).
+fn sky_app(
+    dir: &std::path::Path,
+    backend: Backend,
+    transform: Transform,
+    t: f32,
+) -> (App, Entity, Handle<Image>) {
+    let mut app = headless_app_in(dir);
+    app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
+    let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("sky.pack");
+    let image = {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
+        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        images.add(img)
+    };
+    let camera = app
+        .world_mut()
+        .spawn((
+            camera_into(image.clone(), transform),
+            Hdr,
+            Msaa::Off,
+            PlenopticCamera {
+                playback: Playback::Manual,
+                time: t,
+                ..PlenopticCamera::new(handle)
+            },
+        ))
+        .id();
+    (app, camera, image)
+}
+
+/// The eye and time of the tests, looking up through the opening.
+fn view() -> (Vec3, Transform, f32) {
+    let eye = Vec3::new(0.0, 1.3, 1.0);
+    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.3, 2.2, -1.5), Vec3::Y);
+    (eye, transform, 0.7)
+}
+
+/// The CPU camera of `view`.
+fn cpu_camera(eye: Vec3, transform: &Transform) -> plenoptic_recon::Camera {
+    plenoptic_recon::Camera::new(
+        eye,
+        transform.rotation,
+        std::f32::consts::FRAC_PI_4,
+        WIDTH,
+        HEIGHT,
+    )
+    .unwrap()
+}
+
+#[test]
+fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+
+    // CPU reference, and which pixels see no proxy.
+    let rec = Reconstructor::open(&path).unwrap();
+    let cam = cpu_camera(eye, &transform);
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let (cpu_image, _) = rec.render(&cam, t, Mode::Image).unwrap();
+    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+    let sky_pixels: Vec<usize> = (0..mask.object.len())
+        .filter(|&j| mask.object[j] == 0)
+        .collect();
+    let all: Vec<usize> = (0..mask.object.len()).collect();
+    let fraction = sky_pixels.len() as f32 / all.len() as f32;
+    eprintln!("sky: {:.1} % of the frame", 100.0 * fraction);
+    assert!((0.2..0.8).contains(&fraction), "sky fraction {fraction}");
+    let brightest = sky_pixels
+        .iter()
+        .map(|&j| cpu.radiance[j].max_element())
+        .fold(0.0f32, f32::max);
+    assert!(brightest > 0.5, "the CPU sky is lit: {brightest}");
+
+    // GPU.
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+    let gpu = settle(&mut app, camera, &image);
+    // Measured on lavapipe: sky pixels mean 0.00053, all within 5 % (f16 rounding); the
+    // whole frame mean 0.00049; EV100 + 1 is exactly half (a power of two in f16).
+    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
+    eprintln!(
+        "GPU vs CPU sky: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
+    );
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "sky: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &all);
+    eprintln!(
+        "GPU vs CPU frame: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
+    );
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "frame: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+
+    // One EV100 more: half the light, everywhere (linear output, no tonemapping).
+    app.world_mut().get_mut::<Exposure>(camera).unwrap().ev100 = EV100_UNIT + 1.0;
+    let darker = settle(&mut app, camera, &image);
+    let lit: Vec<usize> = all
+        .iter()
+        .copied()
+        .filter(|&j| gpu[j].max_element() > 0.05)
+        .collect();
+    assert!(lit.len() > all.len() / 2, "{} lit pixels", lit.len());
+    let worst = lit
+        .iter()
+        .map(|&j| ((gpu[j] * 0.5 - darker[j]).abs() / (gpu[j] * 0.5)).max_element())
+        .fold(0.0f32, f32::max);
+    eprintln!("EV100 +1: largest relative deviation from half {worst:.5}");
+    // Two f16 roundings of 2⁻¹¹ each.
+    assert!(worst < 2e-3, "EV100 + 1 is not half the light: {worst}");
+
+    // Image mode: the sky is the same per-pixel environment.
+    {
+        let mut e = app.world_mut().entity_mut(camera);
+        e.get_mut::<Exposure>().unwrap().ev100 = EV100_UNIT;
+        e.get_mut::<PlenopticCamera>().unwrap().mode = ReconMode::Image;
+    }
+    let gpu_image = settle(&mut app, camera, &image);
+    let (mean, f5, f20) = compare(&gpu_image, &cpu_image.radiance, &sky_pixels);
+    eprintln!(
+        "GPU vs CPU sky, image mode: mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
+    );
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "image-mode sky: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
+/// The CPU backend shows `plenoptic_recon`'s frame where no proxy is too (a full-screen
+/// background behind the proxies), so its sky is on screen.
+#[test]
+fn cpu_backend_shows_the_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+    let rec = Reconstructor::open(&path).unwrap();
+    let cam = cpu_camera(eye, &transform);
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+    let sky_pixels: Vec<usize> = (0..mask.object.len())
+        .filter(|&j| mask.object[j] == 0)
+        .collect();
+    assert!(
+        sky_pixels.len() * 5 > mask.object.len(),
+        "{}",
+        sky_pixels.len()
+    );
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Cpu, transform, t);
+    let shown = settle(&mut app, camera, &image);
+    let within = sky_pixels
+        .iter()
+        .filter(|&&j| {
+            let (g, c) = (shown[j], cpu.radiance[j]);
+            ((g - c).abs() / (c.abs() + Vec3::splat(0.02))).max_element() < 0.01
+        })
+        .count() as f32
+        / sky_pixels.len() as f32;
+    eprintln!(
+        "CPU backend sky vs CPU frame: {:.1} % within 1 %",
+        100.0 * within
+    );
+    // As `cpu_backend_shows_the_cpu_frame` (plugin_scene_render.rs).
+    assert!(within > 0.97, "{within}");
+}
+
+/// A camera without an HDR target is tonemapped in the reconstruction's shaders, as Bevy's
+/// PBR does: the bright sky (about 10 in the blue) saturates an 8-bit target without a
+/// tonemapping curve, and stays below white with one.
+#[test]
+fn ldr_cameras_get_the_tonemapping_curve() {
+    use bevy::core_pipeline::tonemapping::Tonemapping;
+    let dir = tempfile::tempdir().unwrap();
+    sky_pack(&dir.path().join("sky.pack"));
+    let (_, transform, t) = view();
+    let mut blue = Vec::new();
+    for tonemapping in [Tonemapping::None, Tonemapping::Reinhard] {
+        let mut app = headless_app_in(dir.path());
+        app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+        let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("sky.pack");
+        let image = target_image(&mut app.world_mut().resource_mut::<Assets<Image>>());
+        let camera = app
+            .world_mut()
+            .spawn((
+                camera_into(image.clone(), transform),
+                Msaa::Off,
+                PlenopticCamera {
+                    playback: Playback::Manual,
+                    time: t,
+                    ..PlenopticCamera::new(handle)
+                },
+            ))
+            .id();
+        app.world_mut().entity_mut(camera).insert(tonemapping);
+        for _ in 0..300 {
+            app.update();
+            if app.world().get::<StreamState>(camera).unwrap().complete {
+                break;
+            }
+        }
+        // The top row is sky; ready once it is drawn (not the red clear colour).
+        let data = render_until(&mut app, image, 600, |d| {
+            d.len() == (WIDTH * HEIGHT * 4) as usize
+                && (0..WIDTH).all(|x| pixel(d, x, 0)[1] > 0 && pixel(d, x, HEIGHT - 1)[1] > 0)
+        });
+        blue.push((0..WIDTH).map(|x| pixel(&data, x, 0)[2]).min().unwrap());
+    }
+    eprintln!("top row blue, no tonemapping vs Reinhard: {blue:?}");
+    assert_eq!(blue[0], 255, "without a curve the sky saturates");
+    assert!(
+        (60..250).contains(&blue[1]),
+        "Reinhard keeps it below white: {}",
+        blue[1]
+    );
+}
+
+/// The other two kinds on the GPU: an equirectangular image (turned 30° about +Y, read
+/// bilinearly from its texture) and a uniform colour, against the CPU's background.
+#[test]
+fn gpu_image_and_uniform_environments_match_cpu() {
+    use plenoptic_pack::plenoptic_sky::EquirectImage;
+    use std::sync::Arc;
+    let (w, h) = (32u32, 16u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            Vec3::new(0.2 + 2.0 * x, 0.5 + y, 1.0 + (x * 12.0).sin().abs())
+        })
+        .collect();
+    let image = Environment::Image {
+        image: Arc::new(EquirectImage::new(w, h, texels).unwrap()),
+        intensity: 1.5,
+        rotation_deg: 30.0,
+    };
+    for env in [image, Environment::Uniform(Vec3::new(0.7, 1.1, 2.3))] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sky.pack");
+        env_pack(&path, env.clone());
+        let (eye, transform, t) = view();
+        let rec = Reconstructor::open(&path).unwrap();
+        let cam = cpu_camera(eye, &transform);
+        let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+        let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+        let sky_pixels: Vec<usize> = (0..mask.object.len())
+            .filter(|&j| mask.object[j] == 0)
+            .collect();
+        assert!(sky_pixels.len() * 5 > mask.object.len());
+        let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+        let gpu = settle(&mut app, camera, &image);
+        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
+        let kind = if matches!(env, Environment::Image { .. }) {
+            "image"
+        } else {
+            "uniform"
+        };
+        eprintln!("GPU vs CPU {kind}: mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %");
+        assert!(
+            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+            "{kind}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+        );
+    }
+}
