@@ -146,6 +146,11 @@ fn cpu_camera(eye: Vec3, transform: &Transform) -> plenoptic_recon::Camera {
     .unwrap()
 }
 
+/// The pixels that see no proxy geometry (object id 0 in the mask): where the sky shows.
+fn no_proxy_pixels(object: &[u32]) -> Vec<usize> {
+    (0..object.len()).filter(|&j| object[j] == 0).collect()
+}
+
 #[test]
 fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
     let dir = tempfile::tempdir().unwrap();
@@ -159,9 +164,7 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
     let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     let (cpu_image, _) = rec.render(&cam, t, Mode::Image).unwrap();
     let mask = rec.proxy().unwrap().mask_raster(&cam, t);
-    let sky_pixels: Vec<usize> = (0..mask.object.len())
-        .filter(|&j| mask.object[j] == 0)
-        .collect();
+    let sky_pixels = no_proxy_pixels(&mask.object);
     let all: Vec<usize> = (0..mask.object.len()).collect();
     let fraction = sky_pixels.len() as f32 / all.len() as f32;
     eprintln!("sky: {:.1} % of the frame", 100.0 * fraction);
@@ -240,9 +243,7 @@ fn cpu_backend_shows_the_sky() {
     let cam = cpu_camera(eye, &transform);
     let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     let mask = rec.proxy().unwrap().mask_raster(&cam, t);
-    let sky_pixels: Vec<usize> = (0..mask.object.len())
-        .filter(|&j| mask.object[j] == 0)
-        .collect();
+    let sky_pixels = no_proxy_pixels(&mask.object);
     assert!(
         sky_pixels.len() * 5 > mask.object.len(),
         "{}",
@@ -343,9 +344,7 @@ fn gpu_image_and_uniform_environments_match_cpu() {
         let cam = cpu_camera(eye, &transform);
         let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
         let mask = rec.proxy().unwrap().mask_raster(&cam, t);
-        let sky_pixels: Vec<usize> = (0..mask.object.len())
-            .filter(|&j| mask.object[j] == 0)
-            .collect();
+        let sky_pixels = no_proxy_pixels(&mask.object);
         assert!(sky_pixels.len() * 5 > mask.object.len());
         let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
         let gpu = settle(&mut app, camera, &image);
