@@ -142,6 +142,31 @@ pub fn complex_chunk(block: &[u8]) -> Result<Option<(Vec<u8>, u64)>> {
     }
 }
 
+/// The coverage of object `index` for the pack (see [`ObjectEntry::coverage`]): for a
+/// `BLEND` material, the tracers' expected coverage at each triangle's centroid, weighted by
+/// the triangle's area; `None` for opaque and cut-out materials, and where it rounds to 1.
+pub fn object_coverage(scene: &Scene, index: usize) -> Option<f32> {
+    let object = scene.objects.get(index)?;
+    let material = scene.materials.get(object.material)?;
+    if material.alpha_mode != plenoptic_scene::AlphaMode::Blend {
+        return None;
+    }
+    let mesh = scene.meshes.get(object.mesh)?;
+    let (mut sum, mut area) = (0.0f64, 0.0f64);
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let [Some(a), Some(b), Some(c)] = tri.map(|i| mesh.positions.get(i as usize)) else {
+            continue;
+        };
+        let da = f64::from((*b - *a).cross(*c - *a).length());
+        let bary = glam::Vec2::splat(1.0 / 3.0);
+        let cov = plenoptic_trace::alpha::coverage(scene, material, mesh, t as u32, bary);
+        sum += f64::from(cov) * da;
+        area += da;
+    }
+    let mean = if area > 0.0 { sum / area } else { 1.0 } as f32;
+    (mean < 0.999).then_some(mean.max(1e-3))
+}
+
 /// The proxy mesh of every object with triangles (object-space positions, indices, normals).
 pub fn proxy_meshes(scene: &Scene) -> Vec<ProxyMesh> {
     scene
@@ -292,6 +317,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
                     Motion::Static
                 },
                 proxy_mesh: has_mesh.then_some(id),
+                coverage: object_coverage(scene, i),
             }
         })
         .collect();

@@ -125,6 +125,16 @@ impl Manifest {
                 return bad(format!("base view {i} has a non-finite time key"));
             }
         }
+        for o in &self.objects {
+            if let Some(c) = o.coverage
+                && !(c > 0.0 && c < 1.0)
+            {
+                return bad(format!(
+                    "object {} ({:?}) has coverage {c}, outside (0, 1)",
+                    o.id, o.name
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -228,6 +238,12 @@ pub struct ObjectEntry {
     /// Key of this object's [`crate::ChunkKind::ProxyMesh`] chunk (by convention the object id),
     /// if it has one.
     pub proxy_mesh: Option<u32>,
+    /// Coverage of a see-through surface (glTF `alphaMode: BLEND`, e.g. glass exported that
+    /// way): the mean fraction of rays that stop at it, in (0, 1). A runtime composites the
+    /// object over what lies behind it with this weight, so the sky shows through glazing at
+    /// full resolution. `None` (absent, and in packs before version 1.1's readers): opaque.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<f32>,
 }
 
 /// The shape of a light.

@@ -125,6 +125,10 @@ pub struct Report {
     /// (the others were triangulated per cube face at t, or came from range images).
     #[serde(default)]
     pub volume_complex_blocks: usize,
+    /// Geometry-assisted mode: pixels where see-through glazing was composited over what
+    /// lies behind it (`plenoptic_recon`'s glazing module).
+    #[serde(default)]
+    pub glazing_pixels: usize,
     /// Wall-clock milliseconds of the stages of the reconstruction (diagnostics).
     pub stage_ms: Vec<(String, f64)>,
 }

@@ -52,12 +52,25 @@ const VOLUME: u8 = 2;
 const HOLE: u8 = 0;
 const NONE: u8 = 4;
 
-/// Renders one frame in geometry-assisted mode.
+/// Which proxies a rasterized mask holds (see [`crate::glazing`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Layer<'a> {
+    /// Every proxy.
+    All,
+    /// The proxies except these pack ids (what lies behind glazing).
+    Without(&'a [u32]),
+    /// Only these pack ids (the glazing).
+    Only(&'a [u32]),
+}
+
+/// Renders one frame in geometry-assisted mode, from the proxies of `layer` (a given `mask`
+/// is used whole).
 pub(crate) fn render(
     rec: &Reconstructor,
     camera: &Camera,
     t: f32,
     mask: Option<&GeometryMask>,
+    layer: Layer<'_>,
     report: &mut Report,
 ) -> Result<Frame> {
     let start = Instant::now();
@@ -138,7 +151,11 @@ pub(crate) fn render(
     // The mask: rasterized band by band inside the pixel loop, or given (computed
     // beforehand, e.g. ray cast by plenoptic_eval).
     let source = match mask {
-        None => MaskSource::Raster(proxy.project(camera, t)),
+        None => MaskSource::Raster(match layer {
+            Layer::All => proxy.project(camera, t),
+            Layer::Without(ids) => proxy.project_only(camera, t, |o| !ids.contains(&o)),
+            Layer::Only(ids) => proxy.project_only(camera, t, |o| ids.contains(&o)),
+        }),
         Some(m) => MaskSource::Mask(m),
     };
     report.stage_ms.push(("mask_setup".into(), ms(start)));

@@ -206,6 +206,18 @@ impl ProxyGeometry {
         crate::raster::project(camera, &self.placed_meshes(t))
     }
 
+    /// [`Self::project`] of the objects whose pack id `keep` accepts.
+    pub(crate) fn project_only(
+        &self,
+        camera: &Camera,
+        t: f32,
+        keep: impl Fn(u32) -> bool,
+    ) -> crate::raster::Projected {
+        let mut placed = self.placed_meshes(t);
+        placed.retain(|o| keep(o.0));
+        crate::raster::project(camera, &placed)
+    }
+
     /// (pack id, object-to-world transform at `t`, mesh) of every object.
     pub fn placed_meshes(&self, t: f32) -> Vec<(u32, Affine3A, &TriangleMesh)> {
         (0..self.pack_ids.len())

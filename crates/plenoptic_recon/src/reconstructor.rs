@@ -17,6 +17,7 @@ use crate::background::{self, Coverage, PackEnvironment};
 use crate::cache::{Cache, Cached};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
+use crate::geometry::Layer;
 use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
 use crate::temporal::{bezier_weights, nearest_key};
@@ -400,9 +401,15 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
+        let glazing = crate::glazing::glazing_objects(self);
         let mut frame = match mode {
+            Mode::GeometryAssisted if self.proxy.is_some() && !glazing.is_empty() => {
+                // The environment is shown behind the glazing already.
+                let frame = crate::glazing::render(self, camera, t, &glazing, &mut report)?;
+                return Ok((frame, report));
+            }
             Mode::GeometryAssisted if self.proxy.is_some() => {
-                crate::geometry::render(self, camera, t, None, &mut report)?
+                crate::geometry::render(self, camera, t, None, Layer::All, &mut report)?
             }
             Mode::GeometryAssisted => {
                 report
@@ -446,7 +453,8 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let mut frame = crate::geometry::render(self, camera, t, Some(mask), &mut report)?;
+        let mut frame =
+            crate::geometry::render(self, camera, t, Some(mask), Layer::All, &mut report)?;
         let env = self.environment.at(t);
         background::apply(&env, camera, Coverage::Mask(mask), &mut frame);
         Ok((frame, report))

@@ -68,6 +68,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             node_path: "/Scene/Room/Walls".into(),
             motion: Motion::Static,
             proxy_mesh: Some(1),
+            coverage: None,
         },
         ObjectEntry {
             id: 2,
@@ -75,6 +76,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             node_path: "/Scene/Room/Chair".into(),
             motion: Motion::Animated,
             proxy_mesh: Some(2),
+            coverage: None,
         },
     ];
     m.lights = vec![

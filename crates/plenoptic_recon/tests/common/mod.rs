@@ -28,7 +28,51 @@ pub fn open_room() -> Scene {
     room_with(false, false)
 }
 
+/// The window of [`windowed_room`] in the front wall (z = 2.5): x from −0.8 to 0.8, y from
+/// 0.8 to 2.0.
+pub const WINDOW: (Vec2, Vec2) = (Vec2::new(-0.8, 0.8), Vec2::new(0.8, 2.0));
+
+/// The closed room of [`room`] (static) whose front wall has a [`WINDOW`] open to the
+/// environment; with `glazing`, the window holds a pane of that base-colour alpha exported as
+/// `alphaMode: BLEND`, as CAD/BIM tools write glass. The pane is the last object.
+pub fn windowed_room(glazing: Option<f32>) -> Scene {
+    let mut b = room_builder(false, true, false);
+    let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
+    let (lo, hi) = WINDOW;
+    let front = Quat::from_rotation_arc(Vec3::Y, Vec3::NEG_Z);
+    let piece = |b: &mut shapes::SceneBuilder, name: &str, x: (f32, f32), y: (f32, f32), m| {
+        b.object_trs(
+            name,
+            shapes::quad(Vec2::new(x.1 - x.0, y.1 - y.0)),
+            m,
+            plenoptic_scene::Trs {
+                translation: Vec3::new(0.5 * (x.0 + x.1), 0.5 * (y.0 + y.1), 2.5),
+                rotation: front,
+                scale: Vec3::ONE,
+            },
+        );
+    };
+    piece(&mut b, "front left", (-2.0, lo.x), (0.0, 2.6), m);
+    piece(&mut b, "front right", (hi.x, 2.0), (0.0, 2.6), m);
+    piece(&mut b, "sill", (lo.x, hi.x), (0.0, lo.y), m);
+    piece(&mut b, "lintel", (lo.x, hi.x), (hi.y, 2.6), m);
+    if let Some(alpha) = glazing {
+        let mut glass = shapes::diffuse(Vec3::new(0.6, 0.75, 0.7));
+        glass.base_color.w = alpha;
+        glass.alpha_mode = plenoptic_scene::AlphaMode::Blend;
+        let g = b.material(glass);
+        piece(&mut b, "pane", (lo.x, hi.x), (lo.y, hi.y), g);
+    }
+    b.build()
+}
+
 fn room_with(moving: bool, ceiling: bool) -> Scene {
+    room_builder(moving, ceiling, true).build()
+}
+
+/// The room's builder: floor, walls (the front one if `front`), ceiling if `ceiling`, box,
+/// pillar, the slider if `moving`, and the light.
+fn room_builder(moving: bool, ceiling: bool, front: bool) -> shapes::SceneBuilder {
     let mut b = shapes::SceneBuilder::default();
     let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
     let wall = |b: &mut shapes::SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3| {
@@ -65,13 +109,15 @@ fn room_with(moving: bool, ceiling: bool) -> Scene {
         Vec3::new(0.0, 1.3, -2.5),
         Vec3::Z,
     );
-    wall(
-        &mut b,
-        "front",
-        Vec2::new(4.0, 2.6),
-        Vec3::new(0.0, 1.3, 2.5),
-        -Vec3::Z,
-    );
+    if front {
+        wall(
+            &mut b,
+            "front",
+            Vec2::new(4.0, 2.6),
+            Vec3::new(0.0, 1.3, 2.5),
+            -Vec3::Z,
+        );
+    }
     wall(
         &mut b,
         "left",
@@ -115,7 +161,7 @@ fn room_with(moving: bool, ceiling: bool) -> Scene {
     }
     // A light so that the reference path tracer (benchmark) sees the room lit like `shade`.
     b.point_light(LIGHT, Vec3::ONE, 3.0);
-    b.build()
+    b
 }
 
 fn object_colour(id: u32) -> Vec3 {
@@ -218,6 +264,9 @@ pub struct PackSpec {
     pub bucket: f32,
     /// (view, key) pairs to leave out.
     pub skip: Vec<(usize, usize)>,
+    /// Whether `BLEND` objects are written with their coverage (see-through at runtime, as
+    /// the baker writes them) or without it (opaque proxies showing their baked texels).
+    pub glazing: bool,
 }
 
 impl PackSpec {
@@ -244,6 +293,7 @@ impl PackSpec {
             time: (0.0, 2.0),
             bucket: 0.25,
             skip: Vec::new(),
+            glazing: true,
         }
     }
 }
@@ -388,6 +438,12 @@ pub fn write_pack_with(
                 Motion::Static
             },
             proxy_mesh: Some(id),
+            // BLEND objects of the test scenes are untextured: their coverage is the factor's.
+            coverage: {
+                let m = &scene.materials[obj.material];
+                (spec.glazing && m.alpha_mode == plenoptic_scene::AlphaMode::Blend)
+                    .then_some(m.base_color.w)
+            },
         });
     }
     w.add_tracks(&tracks).unwrap();

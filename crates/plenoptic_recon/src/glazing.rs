@@ -1,0 +1,130 @@
+//! See-through surfaces in geometry-assisted mode (docs/architecture.md, "Daylight"): glass
+//! exported as glTF `alphaMode: BLEND` is traced as *coverage*, a ray stopping at it with
+//! probability c (the pack's [`plenoptic_pack::ObjectEntry::coverage`]). Drawn as an opaque
+//! proxy, a window would show its cube texels: the pane where the bake's rays stopped at it,
+//! and elsewhere the sky behind, clamped and at cube resolution.
+//!
+//! Here the frame is reconstructed in two layers instead, as a rasterizer draws transparent
+//! surfaces after opaque ones:
+//! 1. *behind*: every proxy except the glazing, with the environment evaluated per pixel where
+//!    nothing is (the sky through the window at full resolution);
+//! 2. *glazing*: the glazing proxies alone. Their lookups accept only the texels whose rays
+//!    stopped at the pane, so they give the pane's own radiance (its reflection and tint).
+//!
+//! Where a glazing surface is nearer than what lies behind it, the pixel is
+//! `c · L_glazing + (1 − c) · L_behind`, with the glazing's depth and object id; this is the
+//! mean over the coverage the path tracer samples. One pane is composited (the nearest);
+//! panes behind panes see the far one as opaque. Image and volume modes warp the range
+//! images whole and keep showing the baked texels (the thesis's baselines).
+
+use glam::Vec3;
+
+use crate::background::{self, Coverage};
+use crate::frame::{Frame, Report};
+use crate::geometry::{self, Layer};
+use crate::{Camera, Reconstructor, Result};
+
+/// The pack ids and coverages of the pack's see-through objects.
+pub(crate) fn glazing_objects(rec: &Reconstructor) -> Vec<(u32, f32)> {
+    rec.pack()
+        .manifest()
+        .objects
+        .iter()
+        .filter_map(|o| o.coverage.map(|c| (o.id, c.clamp(0.0, 1.0))))
+        .collect()
+}
+
+/// Renders a geometry-assisted frame of a pack with `glazing` (see the module doc); the
+/// environment is already shown where nothing is.
+pub(crate) fn render(
+    rec: &Reconstructor,
+    camera: &Camera,
+    t: f32,
+    glazing: &[(u32, f32)],
+    report: &mut Report,
+) -> Result<Frame> {
+    let ids: Vec<u32> = glazing.iter().map(|g| g.0).collect();
+    let mut behind = geometry::render(rec, camera, t, None, Layer::Without(&ids), report)?;
+    background::apply(
+        &rec.environment().at(t),
+        camera,
+        Coverage::FrameObjects,
+        &mut behind,
+    );
+    let start = std::time::Instant::now();
+    let mut front_report = Report::default();
+    let front = geometry::render(rec, camera, t, None, Layer::Only(&ids), &mut front_report)?;
+    let covered = composite(&mut behind, &front, glazing);
+    report
+        .stage_ms
+        .push(("glazing".into(), start.elapsed().as_secs_f64() * 1e3));
+    for m in front_report.missing {
+        if !report.missing.contains(&m) {
+            report.missing.push(m);
+        }
+    }
+    report.glazing_pixels = covered;
+    Ok(behind)
+}
+
+/// Composites the glazing layer `front` over `behind` in place: where a glazing object is
+/// nearer, `c · front + (1 − c) · behind`, with the glazing's depth and id. Returns how many
+/// pixels were covered.
+fn composite(behind: &mut Frame, front: &Frame, glazing: &[(u32, f32)]) -> usize {
+    let coverage = |o: u32| glazing.iter().find(|g| g.0 == o).map(|g| g.1);
+    let mut covered = 0;
+    for j in 0..behind.radiance.len() {
+        let o = front.object[j];
+        let Some(c) = (o != 0).then(|| coverage(o)).flatten() else {
+            continue;
+        };
+        if front.depth[j] >= behind.depth[j] {
+            continue;
+        }
+        let back: Vec3 = behind.radiance[j];
+        behind.radiance[j] = front.radiance[j] * c + back * (1.0 - c);
+        behind.depth[j] = front.depth[j];
+        behind.object[j] = o;
+        covered += 1;
+    }
+    covered
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(radiance: Vec<Vec3>, depth: Vec<f32>, object: Vec<u32>) -> Frame {
+        Frame {
+            width: radiance.len() as u32,
+            height: 1,
+            radiance,
+            depth,
+            object,
+        }
+    }
+
+    #[test]
+    fn nearer_glazing_is_blended_by_its_coverage_and_farther_glazing_is_hidden() {
+        let mut behind = frame(
+            vec![Vec3::splat(4.0), Vec3::splat(4.0), Vec3::splat(4.0)],
+            vec![f32::INFINITY, 1.0, 5.0],
+            vec![0, 1, 1],
+        );
+        let front = frame(
+            vec![Vec3::splat(0.8), Vec3::splat(0.8), Vec3::ZERO],
+            vec![3.0, 3.0, f32::INFINITY],
+            vec![7, 7, 0],
+        );
+        let n = composite(&mut behind, &front, &[(7, 0.25)]);
+        assert_eq!(n, 1);
+        // Sky behind the pane: 0.25 · 0.8 + 0.75 · 4.
+        assert!((behind.radiance[0].x - 3.2).abs() < 1e-6);
+        assert_eq!((behind.depth[0], behind.object[0]), (3.0, 7));
+        // The wall in front of the pane hides it.
+        assert_eq!(behind.radiance[1], Vec3::splat(4.0));
+        assert_eq!(behind.object[1], 1);
+        // No pane there.
+        assert_eq!(behind.radiance[2], Vec3::splat(4.0));
+    }
+}
