@@ -223,7 +223,11 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     let c = radiance(in);
-    var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), c.a);
+    // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
+    // geometry-assisted mode; the image-mode frame already holds what is behind.
+    let glazing = params.fill.w > 0.0 && params.fill.w < 1.0 && params.fill.z != 1.0;
+    let alpha = select(c.a, params.fill.w, glazing);
+    var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), alpha);
 #ifdef TONEMAP_IN_SHADER
     out = tone_mapping(out, view.color_grading);
 #endif
@@ -265,7 +269,14 @@ fn radiance(in: VertexOutput) -> vec4<f32> {
                 if any(c < view.viewport.xy) || any(c >= view.viewport.xy + view.viewport.zw) {
                     continue;
                 }
-                let q = neighbour_point(c, p, nrm);
+                // Glazing is not in the depth prepass (Bevy's transparent pass): its ring
+                // pixels are found on its plane, panes being flat.
+                var q: vec4<f32>;
+                if params.fill.w > 0.0 && params.fill.w < 1.0 {
+                    q = pixel_on_plane(c, p, nrm);
+                } else {
+                    q = neighbour_point(c, p, nrm);
+                }
                 if q.w == 0.0 {
                     continue;
                 }

@@ -25,6 +25,11 @@
 //!    planar faces only;
 //! 3. the heaviest key's texel in the point's direction ("background").
 //!
+//! See-through glazing (objects with a pack coverage c < 1: glass exported as `alphaMode:
+//! BLEND`) is drawn in Bevy's transparent pass with alpha c over what lies behind it, the
+//! environment included, as `plenoptic_recon`'s glazing module composites it; its hole fill
+//! finds ring pixels on its plane (it is not in the depth prepass).
+//!
 //! Pixels no proxy covers show the pack's environment for their viewing direction at the
 //! camera's time, or without one the heaviest key's cube in that direction ([`background`],
 //! a full-screen triangle behind all geometry), as on the CPU. The
@@ -163,11 +168,24 @@ pub struct PlenopticMaterial {
     /// camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
+    /// The object's coverage when it is see-through glazing (the pack's
+    /// [`plenoptic_pack::ObjectEntry::coverage`]), else 1. Glazing is drawn in Bevy's
+    /// transparent pass, blended over what lies behind it with this alpha in
+    /// geometry-assisted mode, as `plenoptic_recon`'s glazing module composites it.
+    pub coverage: f32,
 }
 
 impl Material for PlenopticMaterial {
     fn fragment_shader() -> ShaderRef {
         "embedded://bevy_plenoptic/reconstruct/geometry.wgsl".into()
+    }
+
+    fn alpha_mode(&self) -> AlphaMode {
+        if self.coverage < 1.0 {
+            AlphaMode::Blend
+        } else {
+            AlphaMode::Opaque
+        }
     }
 }
 
@@ -180,7 +198,8 @@ pub struct ReconParams {
     pub tuning: Vec4,
     /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
     /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
-    /// image-mode passes' frame instead (image and volume modes).
+    /// image-mode passes' frame instead (image and volume modes), w: the glazing's coverage
+    /// (its output alpha in geometry-assisted mode; 1 or 0 for opaque objects).
     pub fill: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
@@ -221,6 +240,7 @@ fn attach_materials(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
     image_frame: Res<image::ImageFrame>,
+    packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
@@ -228,13 +248,14 @@ fn attach_materials(
     if backend.0 != Backend::Gpu {
         return;
     }
-    for (entity, parent, _) in &proxies {
+    for (entity, parent, of) in &proxies {
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let (Some(tex), Some(vol)) = (
+        let (Some(tex), Some(vol), Some(pack)) = (
             keys.0.get(&scene.pack.id()),
             volumes.0.get(&scene.pack.id()),
+            packs.get(scene.pack.id()),
         ) else {
             continue;
         };
@@ -244,12 +265,25 @@ fn attach_materials(
             volume_samples: vol.samples.clone(),
             volume_bins: vol.bins.clone(),
             image_frame: image_frame.0.clone(),
+            coverage: object_coverage(pack, of.id),
         });
         commands
             .entity(entity)
             .remove::<MeshMaterial3d<StandardMaterial>>()
             .insert(MeshMaterial3d(m));
     }
+}
+
+/// The coverage of the pack's object `id`: its manifest coverage if it is see-through
+/// glazing, else 1 (opaque).
+fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
+    pack.reader
+        .manifest()
+        .objects
+        .iter()
+        .find(|o| o.id == id)
+        .and_then(|o| o.coverage)
+        .map_or(1.0, |c| c.clamp(1e-3, 1.0))
 }
 
 /// One lookup of a frame: a resident, uploaded (base view, time key).
@@ -396,7 +430,7 @@ fn update_materials(
                 HOLE_FILL_RADIUS as f32,
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
                 if image_mode { 1.0 } else { 0.0 },
-                0.0,
+                object_coverage(pack, of.id),
             ),
             ..default()
         };
