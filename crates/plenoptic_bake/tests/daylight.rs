@@ -13,7 +13,7 @@ mod scene;
 use glam::Vec3;
 use plenoptic_bake::daylight::read_equirect;
 use plenoptic_bake::input::load_recipe;
-use plenoptic_bake::plan::{ambient, decompose};
+use plenoptic_bake::plan::{ambient, decompose, sunlit};
 use plenoptic_trace::{
     AmbientField, Image, MultiStageRenderer, MultiStageSettings, PathTracer, PathTracerSettings,
     PinholeCamera, SceneAccel,
@@ -99,7 +99,22 @@ fn bim_building(path: &Path) {
 }
 
 fn recipe(dir: &Path, local_time: [f64; 2], preset: &str) -> std::path::PathBuf {
-    let path = dir.join(format!("bim_{}_{}.toml", local_time[0], local_time[1]));
+    recipe_with(dir, local_time, preset, "")
+}
+
+/// [`recipe`] with `quality` added to its `[quality]` section.
+fn recipe_with(
+    dir: &Path,
+    local_time: [f64; 2],
+    preset: &str,
+    quality: &str,
+) -> std::path::PathBuf {
+    let path = dir.join(format!(
+        "bim_{}_{}_{}.toml",
+        local_time[0],
+        local_time[1],
+        quality.len()
+    ));
     std::fs::write(
         &path,
         format!(
@@ -116,6 +131,7 @@ end = 14.0
 frame_rate = 30.0
 [quality]
 preset = "{preset}"
+{quality}
 [sun]
 latitude = 48.8566
 longitude = 2.3522
@@ -215,4 +231,81 @@ fn a_sun_study_adds_time_keys_where_the_sun_moves() {
         minute.len()
     );
     assert!(minute.len() <= 3, "{minute:?}");
+}
+
+#[test]
+fn a_day_long_sun_study_gets_more_keys_where_the_sun_patches_move_fast() {
+    let dir = tempfile::tempdir().unwrap();
+    bim_building(&dir.path().join("bim.glb"));
+    // 6:00 to 21:30 in Paris on 21 June over 14 s, on a lattice fine enough (2^7 steps) that
+    // the keys do not saturate it.
+    let path = recipe_with(dir.path(), [6.0, 21.5], "draft", "max_time_depth = 7");
+    let (recipe, scene) = load_recipe(&path).unwrap();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let (plan, _) = decompose(&recipe, &scene, &accel);
+    // The base view nearest the windows' patches, with the most keys.
+    let view = plan
+        .base_views
+        .iter()
+        .max_by_key(|v| v.time_keys.len())
+        .unwrap();
+    let keys = &view.time_keys;
+    println!(
+        "light keys {}, base views' keys {:?}",
+        plan.light_keys.len(),
+        plan.base_views
+            .iter()
+            .map(|v| v.time_keys.len())
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        keys.len() < 129,
+        "the lattice is not saturated: {}",
+        keys.len()
+    );
+
+    // How fast the patches move, measured apart from the plan's decision: the share of the
+    // sunlit surface this view sees that changes from one lattice step to the next (1 − the
+    // overlap of its sunlit masks), at twice the plan's resolution.
+    let clear = sunlit::visibility_scene(&scene);
+    let patches = sunlit::SunPatches::new(&scene, &clear).unwrap();
+    let steps = 128;
+    let time = |i: usize| 14.0 * i as f32 / steps as f32;
+    let size = 2 * recipe.quality.id_image_size;
+    let lit: Vec<Vec<bool>> = (0..=steps)
+        .map(|i| patches.sunlit(&accel.at_time(time(i)), view.position, size))
+        .collect();
+    // Per lattice step: its patch speed, and the length of the plan's interval holding it.
+    let mut steps_by_speed: Vec<(f64, f32)> = (0..steps)
+        .map(|i| {
+            let moved = 1.0 - sunlit::overlap(&lit[i], &lit[i + 1]);
+            let mid = 0.5 * (time(i) + time(i + 1));
+            let after = keys.iter().position(|&k| k > mid).unwrap_or(keys.len() - 1);
+            (moved, keys[after] - keys[after.saturating_sub(1)])
+        })
+        .collect();
+    steps_by_speed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let quarter = steps / 4;
+    let mean = |s: &[(f64, f32)]| {
+        (
+            s.iter().map(|x| x.0).sum::<f64>() / s.len() as f64,
+            s.iter().map(|x| x.1).sum::<f32>() / s.len() as f32,
+        )
+    };
+    let (slow_speed, slow_interval) = mean(&steps_by_speed[..quarter]);
+    let (fast_speed, fast_interval) = mean(&steps_by_speed[steps - quarter..]);
+    println!(
+        "sun study, {} keys at the busiest view: the fastest quarter of the day ({:.1} % of the \
+         sunlit surface moves per step) lies in key intervals of {fast_interval:.3} s on \
+         average, the slowest quarter ({:.1} %) in {slow_interval:.3} s",
+        keys.len(),
+        100.0 * fast_speed,
+        100.0 * slow_speed
+    );
+    println!("keys at {keys:?}");
+    assert!(fast_speed > 2.0 * slow_speed, "the patches do move");
+    assert!(
+        fast_interval * 1.5 < slow_interval,
+        "keys are denser where the patches move fast: {fast_interval} vs {slow_interval}"
+    );
 }

@@ -10,6 +10,7 @@
 pub mod ambient;
 pub mod ids;
 pub mod space;
+pub mod sunlit;
 pub mod time;
 
 use glam::Vec3;
@@ -269,16 +270,35 @@ pub fn decompose(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> 
         );
         rays += lv.values().flatten().map(|v| v.len() as u64).sum::<u64>();
         counters.time_intervals_tested += tested;
+        // A moving sun: each view also follows where the sun falls (see `sunlit`).
+        let clear = scene
+            .sun_is_animated()
+            .then(|| sunlit::visibility_scene(scene));
+        let patches = clear
+            .as_ref()
+            .and_then(|c| sunlit::SunPatches::new(scene, c));
         let per_view = space
             .views
             .iter()
             .map(|&(_, pos)| {
                 let (keys, tested, values) = time::subdivide(
                     &lk,
-                    |k| ids::cube_ids(&accel.at_time(tt(k)), pos, id_size),
-                    |a, b| ids::fitness(&[a, b]) >= f64::from(q.q),
+                    |k| {
+                        let placed = accel.at_time(tt(k));
+                        let ids = ids::cube_ids(&placed, pos, id_size);
+                        let lit = patches.as_ref().map(|p| p.sunlit(&placed, pos, id_size));
+                        (ids, lit)
+                    },
+                    |a, b| {
+                        ids::fitness(&[&a.0, &b.0]) >= f64::from(q.q)
+                            && match (&a.1, &b.1) {
+                                (Some(x), Some(y)) => sunlit::overlap(x, y) >= f64::from(q.q),
+                                _ => true,
+                            }
+                    },
                 );
-                rays += values.len() as u64 * cube_rays;
+                let per_key = if patches.is_some() { 3 } else { 1 };
+                rays += values.len() as u64 * cube_rays * per_key;
                 counters.time_intervals_tested += tested;
                 keys
             })
