@@ -314,3 +314,23 @@ fn bad_manifest() {
         PackError::InvalidManifest { .. }
     ));
 }
+
+#[test]
+fn glazing_coverage_outside_zero_to_one_is_refused_and_named() {
+    for bad in [0.0f32, 1.0, 1.5, -0.2, f32::NAN] {
+        let mut m = manifest(1);
+        m.objects[0].coverage = Some(bad);
+        let err = m.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("coverage") && err.contains("walls"),
+            "{bad}: {err}"
+        );
+    }
+    let mut m = manifest(1);
+    m.objects[0].coverage = Some(0.12);
+    m.validate().unwrap();
+    // It survives the JSON round trip; absent reads as opaque.
+    let back = Manifest::from_json(&m.to_json().unwrap()).unwrap();
+    assert_eq!(back.objects[0].coverage, Some(0.12));
+    assert_eq!(back.objects[1].coverage, None);
+}
