@@ -120,11 +120,9 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
     // One key (4 cubes of 8² × 6 texels, 4 bytes each) is 6 KiB; the pack holds 15 keys.
     let key_bytes = 4 * 6 * 64 * 4;
     let budget = 3 * key_bytes + key_bytes / 2;
-    {
-        let mut s = app.world_mut().resource_mut::<PlenopticSettings>();
-        s.memory_budget_bytes = budget;
-        s.max_views = 1;
-    }
+    app.world_mut()
+        .resource_mut::<PlenopticSettings>()
+        .memory_budget_bytes = budget;
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
     let image = target_image(&mut app.world_mut().resource_mut::<Assets<Image>>());
     let camera = app
@@ -133,6 +131,10 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
             camera_into(image.clone(), Transform::from_xyz(-1.0, 1.3, 1.0)),
             PlenopticCamera {
                 playback: Playback::Manual,
+                settings: ReconSettings {
+                    max_views: 1,
+                    ..ReconSettings::default()
+                },
                 ..PlenopticCamera::new(handle.clone())
             },
         ))

@@ -418,3 +418,54 @@ fn gpu_window_open_or_glazed_matches_cpu() {
         );
     }
 }
+
+/// One `ReconSettings` field, changed on the camera, changes the GPU frame and the CPU frame
+/// alike: the tunables reach WGSL from the camera's settings, not from constants.
+#[test]
+fn a_recon_settings_change_moves_gpu_and_cpu_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+    let cam = cpu_camera(eye, &transform);
+    let mut rec = Reconstructor::open(&path).unwrap();
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+    let mut frames = Vec::new();
+    // Base views blended: both of the pack's, then only the nearest (the streaming working
+    // set follows the same field).
+    for views in [4, 1] {
+        rec.settings.max_views = views;
+        let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+        app.world_mut()
+            .get_mut::<PlenopticCamera>(camera)
+            .unwrap()
+            .settings
+            .max_views = views;
+        let gpu = settle(&mut app, camera, &image);
+        let all: Vec<usize> = (0..gpu.len()).collect();
+        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &all);
+        eprintln!(
+            "max_views {views}: GPU vs CPU mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} \
+             within 20 %"
+        );
+        assert!(
+            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+            "max_views {views}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+        );
+        frames.push((gpu, cpu.radiance));
+    }
+    // The change is visible, on both backends alike.
+    let all: Vec<usize> = (0..frames[0].0.len()).collect();
+    let (_, gpu_same, _) = compare(&frames[1].0, &frames[0].0, &all);
+    let (_, cpu_same, _) = compare(&frames[1].1, &frames[0].1, &all);
+    eprintln!(
+        "max_views 4 → 1: {:.1} % of GPU pixels and {:.1} % of CPU pixels change by 5 % or more",
+        100.0 * (1.0 - gpu_same),
+        100.0 * (1.0 - cpu_same)
+    );
+    assert!(gpu_same < 0.95 && cpu_same < 0.95, "{gpu_same} {cpu_same}");
+    assert!(
+        (gpu_same - cpu_same).abs() < 0.02,
+        "{gpu_same} vs {cpu_same}"
+    );
+}

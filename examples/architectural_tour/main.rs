@@ -526,8 +526,9 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
     const MIB: f64 = 1024.0 * 1024.0;
     let reader = plenoptic_pack::PackReader::open(pack)?;
     let settings = PlenopticSettings::default();
+    let recon = bevy_plenoptic::ReconSettings::default();
     let look = Lookahead {
-        views: settings.max_views,
+        settings: &recon,
         seconds: settings.prefetch_seconds,
     };
     let usable = bevy_plenoptic::asset::usable_views(&reader);
@@ -590,7 +591,7 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
          prefetch, along all {} frames of the tour): needed per frame {:.1} MiB mean, {:.1} MiB \
          at most; with prefetch {:.1} MiB at most — of {:.1} MiB for the whole pack decoded \
          ({:.1} % resident at the peak).",
-        look.views,
+        recon.max_views,
         look.seconds,
         frames.len(),
         needed_sum as f64 / frames.len().max(1) as f64 / MIB,

@@ -65,14 +65,14 @@ use bevy::asset::io::file::FileAssetReader;
 use bevy::prelude::*;
 
 pub use asset::{RadiancePack, RadiancePackLoader};
-pub use camera::{Playback, PlenopticCamera, ReconMode};
+pub use camera::{Playback, PlenopticCamera, ReconMode, ReconSettings};
 pub use reconstruct::cpu;
 
 /// The usual imports.
 pub mod prelude {
     pub use crate::{
         Backend, Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin, PlenopticSettings,
-        PlenopticSystems, RadiancePack, ReconMode,
+        PlenopticSystems, RadiancePack, ReconMode, ReconSettings,
     };
 }
 
@@ -111,9 +111,6 @@ pub struct PlenopticSettings {
     /// Upper bound, in bytes, on decoded pack data kept resident (including reads in flight).
     /// Larger budgets keep more base views and time keys around the camera and stall less.
     pub memory_budget_bytes: u64,
-    /// Base views blended per frame (and kept resident per camera). Each adds its cubes at two
-    /// time keys to the working set and a lookup per pixel.
-    pub max_views: usize,
     /// How far ahead, in seconds, to prefetch along the camera's velocity and the playback
     /// direction. Longer hides more latency but spends budget on data that may not be used.
     pub prefetch_seconds: f32,
@@ -147,7 +144,6 @@ impl Default for PlenopticSettings {
     fn default() -> Self {
         Self {
             memory_budget_bytes: 256 * 1024 * 1024,
-            max_views: 4,
             prefetch_seconds: 0.5,
             backend: Backend::Auto,
         }

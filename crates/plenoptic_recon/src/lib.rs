@@ -89,6 +89,7 @@ pub mod proxy;
 mod raster;
 pub mod reconstructor;
 mod sample;
+pub mod settings;
 pub mod temporal;
 pub mod viewspace;
 pub mod volume;
@@ -99,7 +100,8 @@ pub use frame::{FallbackReport, Frame, Mode, Report};
 pub use motion::ObjectMotion;
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
-pub use reconstructor::{CubeFilter, ReconSettings, Reconstructor};
+pub use reconstructor::Reconstructor;
+pub use settings::{CubeFilter, ReconSettings};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -20,71 +20,11 @@ use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::geometry::Layer;
 use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
+pub use crate::settings::{CubeFilter, ReconSettings};
 use crate::temporal::{bezier_weights, nearest_key};
-use crate::viewspace::ViewWeights;
 use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
 use crate::{Error, Result};
-
-/// Reconstruction settings; each field's cost/quality trade-off is documented.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ReconSettings {
-    /// Most base views blended per frame (more: smoother transitions, linear cost).
-    pub max_views: usize,
-    /// Relative distance tolerance of a geometry-assisted lookup (|d_cube − d| < tol·d, where
-    /// d_cube is the distance to the plane of the texel's surface along the lookup direction
-    /// when normals are available). Too small rejects valid lookups; too large lets occluders
-    /// through. Also the relative depth window of blending in image and volume modes.
-    pub depth_tolerance: f32,
-    /// Exponent of the angular-closeness weight `((1 + cos θ)/2)^p` between a base view's
-    /// direction to a point and the camera's (0 disables it).
-    pub angular_power: f32,
-    /// Half-width tε of the temporal filter window, seconds (`None`: half the bucket span).
-    pub time_epsilon: Option<f32>,
-    /// Face size of cubes reconstructed from temporal volumes (cost grows with its square).
-    pub volume_face_size: u32,
-    /// Radius, pixels, of the same-object hole fill search (cost grows with its square in the
-    /// worst case; only holes pay it).
-    pub hole_fill_radius: u32,
-    /// Passes of the background fill in image and volume modes (each extends by a pixel).
-    pub background_passes: u32,
-    /// Bytes of decoded chunks kept in the cache.
-    pub cache_bytes: usize,
-    /// How the geometry-assisted mode reads radiance from the cubes.
-    pub cube_filter: CubeFilter,
-}
-
-/// How radiance is read from a base view's cube in the geometry-assisted mode.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CubeFilter {
-    /// The texel the direction falls in (what the GPU passes of `bevy_plenoptic` do; the
-    /// fastest).
-    #[default]
-    Nearest,
-    /// Seamless bilinear filtering: the four texels around the direction, taken across face
-    /// seams from the neighbouring face ([`plenoptic_pack::cube`] convention), restricted to
-    /// the texels that show the same object at the same distance (so that edges stay sharp).
-    /// The lookup is still accepted or rejected by its nearest texel. Lowers the error against
-    /// the path tracer (by about an eighth on the test room) and takes about twice the time
-    /// per frame of `Nearest` (benches/recon.rs).
-    Bilinear,
-}
-
-impl Default for ReconSettings {
-    fn default() -> Self {
-        ReconSettings {
-            max_views: 4,
-            depth_tolerance: 0.03,
-            angular_power: 8.0,
-            time_epsilon: None,
-            volume_face_size: 48,
-            hole_fill_radius: 12,
-            background_passes: 24,
-            cache_bytes: 512 << 20,
-            cube_filter: CubeFilter::Nearest,
-        }
-    }
-}
 
 /// Reconstructs frames from one pack.
 pub struct Reconstructor {
@@ -163,10 +103,7 @@ impl Reconstructor {
 
     /// The temporal filter half-width in use.
     pub fn time_epsilon(&self) -> f32 {
-        self.settings
-            .time_epsilon
-            .unwrap_or(self.pack.manifest().bucket_span * 0.5)
-            .max(1e-6)
+        self.settings.time_epsilon_on(self.pack.manifest())
     }
 
     pub(crate) fn cached(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
@@ -381,15 +318,7 @@ impl Reconstructor {
                 })
             })
             .collect();
-        let mut w = ViewWeights::new(&m.view_space, &m.base_views, &usable).weights(position);
-        w.truncate(self.settings.max_views.max(1));
-        let s: f32 = w.iter().map(|x| x.1).sum();
-        if s > 0.0 {
-            for x in &mut w {
-                x.1 /= s;
-            }
-        }
-        w
+        self.settings.view_weights(m, &usable, position)
     }
 
     /// Reconstructs the frame `camera` sees at time `t` in `mode`.
@@ -493,7 +422,10 @@ impl Reconstructor {
                         distance: &c.1.distance,
                         object: &c.1.ids,
                     };
-                    (warp_view(&view, &basis, camera.width, camera.height), *w)
+                    (
+                        warp_view(&view, &basis, camera.width, camera.height, &self.settings),
+                        *w,
+                    )
                 })
                 .collect()
         };

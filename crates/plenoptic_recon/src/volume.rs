@@ -555,7 +555,10 @@ pub(crate) fn render(
                 distance: d,
                 object: o,
             };
-            (warp_view(&view, &basis, camera.width, camera.height), *w)
+            (
+                warp_view(&view, &basis, camera.width, camera.height, &rec.settings),
+                *w,
+            )
         })
         .collect();
     Ok(rec.finish_warped(camera, &warped, report, true))

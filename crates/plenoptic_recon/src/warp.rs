@@ -6,8 +6,8 @@
 //! texel spans `2/n` in face coordinates, so at distance `d` along a direction whose largest
 //! component is `m` it covers about `2 d m / n` metres across (surface slant is ignored),
 //! i.e. `2 d m f / (n z)` pixels at camera depth `z` with focal length `f` pixels. Splats are
-//! capped at [`MAX_SPLAT_PX`] pixels. A splat in front (by more than [`SAME_SURFACE`], relative)
-//! wins; among splats of the same surface the one whose centre is nearer the pixel wins.
+//! capped at [`ReconSettings::max_splat_px`] pixels. A splat in front (by more than
+//! [`ReconSettings::same_surface`], relative) wins; among splats of the same surface the one whose centre is nearer the pixel wins.
 //!
 //! Warped views are blended per pixel over the views whose depth is within a relative
 //! tolerance of the nearest ([`blend_warped`]), and the remaining holes are filled from the
@@ -18,13 +18,8 @@ use glam::Vec3;
 use plenoptic_pack::{CubeImage, cube};
 use rayon::prelude::*;
 
+use crate::ReconSettings;
 use crate::camera::CameraBasis;
-
-/// Relative depth difference under which two splats count as the same surface.
-pub const SAME_SURFACE: f32 = 0.03;
-
-/// Largest splat edge, pixels.
-pub const MAX_SPLAT_PX: f32 = 8.0;
 
 /// One base view warped into the camera.
 #[derive(Clone, Debug)]
@@ -50,8 +45,15 @@ pub struct ViewCubes<'a> {
     pub object: &'a CubeImage<u32>,
 }
 
-/// Warps one view's cubes into a `width × height` camera.
-pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u32) -> Warped {
+/// Warps one view's cubes into a `width × height` camera, with the splats of `settings`.
+pub fn warp_view(
+    view: &ViewCubes<'_>,
+    cam: &CameraBasis,
+    width: u32,
+    height: u32,
+    settings: &ReconSettings,
+) -> Warped {
+    let (same_surface, max_splat_px) = (settings.same_surface, settings.max_splat_px);
     let (w, h) = (width as usize, height as usize);
     let mut out = Warped {
         radiance: vec![Vec3::ZERO; w * h],
@@ -80,7 +82,7 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
             continue;
         };
         let m = dir.abs().max_element();
-        let size = (2.0 * d * m * cam.focal_px / (n as f32 * z)).min(MAX_SPLAT_PX);
+        let size = (2.0 * d * m * cam.focal_px / (n as f32 * z)).min(max_splat_px);
         let half = (size * 0.5).max(0.5);
         let (x0, x1) = (
             (px - half).floor().max(0.0),
@@ -103,8 +105,8 @@ pub fn warp_view(view: &ViewCubes<'_>, cam: &CameraBasis, width: u32, height: u3
                 let cur = out.z[j];
                 // Clearly in front: wins. Same surface (within the tolerance): the nearer
                 // splat centre wins. Behind: loses.
-                if z < cur * (1.0 - SAME_SURFACE)
-                    || (z <= cur * (1.0 + SAME_SURFACE) && r2 < key[j])
+                if z < cur * (1.0 - same_surface)
+                    || (z <= cur * (1.0 + same_surface) && r2 < key[j])
                 {
                     key[j] = r2;
                     out.z[j] = z;

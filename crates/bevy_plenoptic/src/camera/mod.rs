@@ -2,6 +2,7 @@
 
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::prelude::*;
+pub use plenoptic_recon::ReconSettings;
 
 use crate::PlenopticSystems;
 use crate::asset::RadiancePack;
@@ -45,6 +46,10 @@ pub struct PlenopticCamera {
     pub mode: ReconMode,
     /// How `time` advances.
     pub playback: Playback,
+    /// How this camera's frames are reconstructed: the one definition of every tunable, read
+    /// by the GPU passes (as uniforms) and the CPU backend alike, and by streaming (which
+    /// base views the camera blends, `max_views` of them, must be resident).
+    pub settings: ReconSettings,
 }
 
 impl PlenopticCamera {
@@ -58,6 +63,7 @@ impl PlenopticCamera {
                 speed: 1.0,
                 looping: true,
             },
+            settings: ReconSettings::default(),
         }
     }
 

@@ -214,10 +214,18 @@ fn run_cpu_frames(
         if f.task.is_some() {
             continue;
         }
-        let (Some(rec), Some((cam, camera, projection, transform))) = (
-            f.rec.clone(),
-            cameras.iter().find(|(c, ..)| c.pack.id() == *id),
-        ) else {
+        let Some((cam, camera, projection, transform)) =
+            cameras.iter().find(|(c, ..)| c.pack.id() == *id)
+        else {
+            continue;
+        };
+        // The camera's settings, applied while no frame task shares the reconstructor.
+        if let Some(r) = f.rec.as_mut().and_then(Arc::get_mut)
+            && r.settings != cam.settings
+        {
+            r.settings = cam.settings.clone();
+        }
+        let Some(rec) = f.rec.clone() else {
             continue;
         };
         let Some(size) = camera.physical_viewport_size() else {

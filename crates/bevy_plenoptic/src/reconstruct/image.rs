@@ -2,11 +2,11 @@
 //! passes (`image.wgsl`, beside this file), dispatched before the cameras render.
 //!
 //! Per weighted base view (the view-space weights of the nearest
-//! [`PlenopticSettings::max_views`] views, at most [`MAX_IMAGE_VIEWS`]), every texel of the
+//! `ReconSettings::max_views` views, at most [`MAX_IMAGE_VIEWS`]), every texel of the
 //! view's nearest resident key with a finite distance is splatted into the camera as
-//! `plenoptic_recon::warp` does (square splats of the texel's footprint, at most 8 pixels),
-//! through a per-view z-buffer: the nearest surface (splats within 3 % of the nearest depth)
-//! wins, and among its splats the one whose centre is nearest the pixel. The CPU resolves
+//! `plenoptic_recon::warp` does (square splats of the texel's footprint, at most
+//! `ReconSettings::max_splat_px` pixels), through a per-view z-buffer: the nearest surface
+//! (splats within `ReconSettings::same_surface` of the nearest depth) wins, and among its splats the one whose centre is nearest the pixel. The CPU resolves
 //! splats in texel order ("clearly in front, or same surface and nearer centre"); the GPU's
 //! three atomic passes (nearest depth, nearest centre within the surface, winning texel) are
 //! order-independent, so the two can differ where surfaces meet. A texel's radiance is the
@@ -14,7 +14,8 @@
 //! resident, otherwise with inverse time-distance weights over the resident ones (the CPU's
 //! fallback for unreadable keys). The views are then blended per pixel over those within
 //! the depth tolerance of the nearest, and holes are filled from the farthest covered
-//! neighbour, [`FILL_PASSES`] times.
+//! neighbour, `ReconSettings::background_passes` times. Every tunable comes from the
+//! camera's `ReconSettings`, in [`ImageParams`].
 //!
 //! The frame is written to [`ImageFrame`]'s `Rgba32Float` storage texture, which the proxy
 //! materials and the background show in screen space while the camera is in image mode.
@@ -44,22 +45,17 @@ use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use plenoptic_recon::temporal::bezier_weights;
 
 use super::background::PlenopticBackgroundMaterial;
-use super::volume_mode::{VOLUME_FACE_SIZE, VolumeCubes};
+use super::volume_mode::VolumeCubes;
 use super::{KeyTextures, ResolvedBackend};
+use crate::Backend;
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::streaming::StreamCache;
-use crate::streaming::schedule::view_weights;
-use crate::{Backend, PlenopticSettings};
 
 /// Most base views warped per frame.
 pub const MAX_IMAGE_VIEWS: usize = 8;
 /// Most keys blended per view (the Bézier segment's four).
 pub const KEYS_PER_VIEW: usize = 4;
-/// Background-fill passes (`plenoptic_recon`'s default).
-pub const FILL_PASSES: u32 = 24;
-/// Relative depth window of the blend (`plenoptic_recon`'s default).
-const DEPTH_TOLERANCE: f32 = 0.03;
 
 /// The uniform of the image-mode passes.
 #[derive(ShaderType, Debug, Clone, Default)]
@@ -76,6 +72,9 @@ pub struct ImageParams {
     pub size: UVec4,
     /// x: background-fill passes.
     pub misc: UVec4,
+    /// x: relative depth under which two splats are the same surface, y: largest splat edge
+    /// in pixels.
+    pub splat: Vec4,
     /// Per view: position (xyz), view weight (w).
     pub views: [Vec4; MAX_IMAGE_VIEWS],
     /// Per view: first array layer of each key blended.
@@ -150,7 +149,6 @@ pub(super) fn prepare_job(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     cache: Res<StreamCache>,
-    settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
     volume: Res<VolumeCubes>,
     frame: Res<ImageFrame>,
@@ -182,15 +180,21 @@ pub(super) fn prepare_job(
             eye: basis.position.extend(basis.focal_px),
             right: basis.right.extend(basis.tan_x),
             up: basis.up.extend(basis.tan_y),
-            forward: basis.forward.extend(DEPTH_TOLERANCE),
+            forward: basis.forward.extend(cam.settings.depth_tolerance),
             size: UVec4::new(size.x, size.y, tex.face, 0),
-            misc: UVec4::new(FILL_PASSES, 0, 0, 0),
+            misc: UVec4::new(cam.settings.background_passes, 0, 0, 0),
+            splat: Vec4::new(
+                cam.settings.same_surface,
+                cam.settings.max_splat_px,
+                0.0,
+                0.0,
+            ),
             ..default()
         };
         if volume_mode {
             // Each view's cube at t is its single key.
             let image = volume.image.clone()?;
-            params.size.z = VOLUME_FACE_SIZE;
+            params.size.z = volume.face;
             for (n, &(v, w)) in volume.views.iter().enumerate() {
                 let layer = 6 * n as u32;
                 params.views[n] = pack.reader.manifest().base_views[v].position.extend(w);
@@ -207,7 +211,7 @@ pub(super) fn prepare_job(
         }
         let m = pack.reader.manifest();
         let t = cam.time;
-        let views = view_weights(m, &pack.usable_views, position, settings.max_views);
+        let views = cam.settings.view_weights(m, &pack.usable_views, position);
         let mut n = 0;
         for (v, w) in views {
             if n == MAX_IMAGE_VIEWS {

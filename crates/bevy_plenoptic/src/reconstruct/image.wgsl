@@ -7,9 +7,6 @@
 
 const MAX_VIEWS: u32 = 8u;
 const EMPTY: u32 = 0xffffffffu;
-// plenoptic_recon::warp::MAX_SPLAT_PX and SAME_SURFACE.
-const MAX_SPLAT_PX: f32 = 8.0;
-const SAME_SURFACE: f32 = 0.03;
 
 struct ImageParams {
     // Eye (xyz), focal length in pixels (w).
@@ -24,6 +21,9 @@ struct ImageParams {
     size: vec4<u32>,
     // x: background-fill passes.
     misc: vec4<u32>,
+    // x: relative depth under which two splats are the same surface, y: largest splat edge in
+    // pixels (ReconSettings::same_surface and max_splat_px).
+    splat: vec4<f32>,
     // Per view: position (xyz), view weight (w).
     views: array<vec4<f32>, 8>,
     // Per view: first array layer of each key blended.
@@ -89,7 +89,7 @@ fn splat_of(v: u32, i: u32) -> Splat {
     let sy = dot(rel, params.up.xyz) / (z * params.up.w);
     s.px = vec2<f32>((sx + 1.0) * 0.5 * f32(params.size.x), (1.0 - sy) * 0.5 * f32(params.size.y));
     let m = max(abs(dir.x), max(abs(dir.y), abs(dir.z)));
-    let size = min(2.0 * d * m * params.eye.w / (f32(n) * z), MAX_SPLAT_PX);
+    let size = min(2.0 * d * m * params.eye.w / (f32(n) * z), params.splat.y);
     s.half = max(size * 0.5, 0.5);
     s.z = z;
     s.ok = true;
@@ -150,7 +150,7 @@ fn splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Pass 2: among the splats of the nearest surface (within SAME_SURFACE), the nearest centre.
+// Pass 2: among the splats of the nearest surface (within params.splat.x), the nearest centre.
 @compute @workgroup_size(64)
 fn splat_centre(@builtin(global_invocation_id) id: vec3<u32>) {
     let v = id.y;
@@ -167,7 +167,7 @@ fn splat_centre(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = b.x; x <= b.z; x++) {
             let j = base + u32(y) * params.size.x + u32(x);
             let zmin = bitcast<f32>(atomicLoad(&splat_keys[2u * j]));
-            if s.z <= zmin * (1.0 + SAME_SURFACE) {
+            if s.z <= zmin * (1.0 + params.splat.x) {
                 atomicMin(&splat_keys[2u * j + 1u], centre_key(s, x, y));
             }
         }
@@ -191,7 +191,7 @@ fn splat_texel(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = b.x; x <= b.z; x++) {
             let j = base + u32(y) * params.size.x + u32(x);
             let zmin = bitcast<f32>(atomicLoad(&splat_keys[2u * j]));
-            if s.z <= zmin * (1.0 + SAME_SURFACE)
+            if s.z <= zmin * (1.0 + params.splat.x)
                 && atomicLoad(&splat_keys[2u * j + 1u]) == centre_key(s, x, y) {
                 splat_texels[j] = id.x;
             }

@@ -16,7 +16,7 @@
 //! 1. the temporal volumes ([`volume`]): samples of the object near the point's direction
 //!    from each base view, within `t ± tε`;
 //! 2. the same-object hole fill: the nearest ring of pixels (radius up to
-//!    [`HOLE_FILL_RADIUS`]) whose points have a direct or volume lookup of this object, their
+//!    [`ReconSettings::hole_fill_radius`]) whose points have a direct or volume lookup of this object, their
 //!    mean. A fragment cannot read its neighbours' results, so it recomputes them at the
 //!    points the neighbouring pixels show, read from the depth prepass
 //!    ([`PlenopticCamera`] requires one); a lookup accepted there means the neighbour shows
@@ -57,16 +57,13 @@ use bevy::shader::ShaderRef;
 use plenoptic_recon::temporal::bracketing;
 
 use crate::asset::RadiancePack;
-use crate::camera::{PlenopticCamera, ReconMode};
+use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::streaming::StreamCache;
-use crate::streaming::schedule::{time_epsilon, view_weights, volume_buckets};
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
-/// Radius, pixels, of the same-object hole fill (`plenoptic_recon`'s default).
-pub const HOLE_FILL_RADIUS: u32 = 12;
 /// Most array layers of the key texture (a common device limit is 2048).
 const MAX_LAYERS: u32 = 2046;
 
@@ -309,19 +306,19 @@ struct FrameLookups {
 
 /// The lookups of a camera at `position` and time `t` on pack `id`, as `plenoptic_recon`'s
 /// geometry mode chooses them: the view-space weights of the nearest
-/// [`PlenopticSettings::max_views`] views, each at its bracketing keys with linear time
+/// [`ReconSettings::max_views`] views, each at its bracketing keys with linear time
 /// weights, over the keys that are resident and uploaded.
 fn frame_lookups(
     id: AssetId<RadiancePack>,
     pack: &RadiancePack,
     tex: &KeyTexture,
     cache: &StreamCache,
-    max_views: usize,
+    settings: &ReconSettings,
     position: Vec3,
     t: f32,
 ) -> FrameLookups {
     let m = pack.reader.manifest();
-    let views = view_weights(m, &pack.usable_views, position, max_views);
+    let views = settings.view_weights(m, &pack.usable_views, position);
     let mut out = FrameLookups::default();
     // Weight of the heaviest lookup.
     let mut heaviest = f32::NEG_INFINITY;
@@ -378,7 +375,6 @@ fn update_materials(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
     cache: Res<StreamCache>,
-    settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
     job: Res<image::ImageJob>,
     cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
@@ -398,7 +394,7 @@ fn update_materials(
             frames
                 .entry(id)
                 .or_insert_with(|| {
-                    frame_lookups(id, pack, tex, &cache, settings.max_views, at, cam.time)
+                    frame_lookups(id, pack, tex, &cache, &cam.settings, at, cam.time)
                 })
                 .clone(),
         )
@@ -425,9 +421,14 @@ fn update_materials(
         });
         let mut params = ReconParams {
             header: Vec4::new(f.lookups.len() as f32, of.id as f32, tex.face as f32, 0.0),
-            tuning: Vec4::new(0.03, 8.0, 0.0, 0.0),
+            tuning: Vec4::new(
+                cam.settings.depth_tolerance,
+                cam.settings.angular_power,
+                0.0,
+                0.0,
+            ),
             fill: Vec4::new(
-                HOLE_FILL_RADIUS as f32,
+                cam.settings.hole_fill_radius as f32,
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
                 if image_mode { 1.0 } else { 0.0 },
                 object_coverage(pack, of.id),
@@ -440,9 +441,9 @@ fn update_materials(
             volumes.0.get(&id),
             &f.views,
             &positions,
-            volume_buckets(m, cam.time),
+            cam.settings.volume_buckets(m, cam.time),
             cam.time,
-            time_epsilon(m),
+            cam.settings.time_epsilon_on(m),
         );
         for (n, l) in f.lookups.iter().enumerate() {
             params.base[n] = l.base.extend((l.slot * 6) as f32);

@@ -2,8 +2,8 @@
 //! on the GPU.
 //!
 //! Per weighted base view (the view-space weights of the nearest
-//! [`PlenopticSettings::max_views`] views, at most [`MAX_IMAGE_VIEWS`]), a cube of face size
-//! [`VOLUME_FACE_SIZE`] at the camera's time t is interpolated on the CPU from the view's
+//! `ReconSettings::max_views` views, at most [`MAX_IMAGE_VIEWS`]), a cube of face size
+//! `ReconSettings::volume_face_size` at the camera's time t is interpolated on the CPU from the view's
 //! temporal-volume samples, exactly as `plenoptic_recon` does: sliced from the baked
 //! (x, y, t) complex of the block of `bucket_of(t)` when the pack has its connectivity
 //! ([`plenoptic_recon::volume::slice_to_cube`]), otherwise triangulated per face from the
@@ -33,21 +33,19 @@ use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
 
 use super::ResolvedBackend;
 use super::image::MAX_IMAGE_VIEWS;
+use crate::Backend;
 use crate::asset::RadiancePack;
+use crate::camera::ReconSettings;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::streaming::StreamCache;
-use crate::streaming::schedule::{time_epsilon, view_weights, volume_buckets};
-use crate::{Backend, PlenopticSettings};
-
-/// Face size of the cubes interpolated from the temporal volumes (`plenoptic_recon`'s
-/// default `volume_face_size`).
-pub const VOLUME_FACE_SIZE: u32 = 48;
 
 /// The volume-mode cubes of the first volume-mode camera, six layers per view.
 #[derive(Resource, Default)]
 pub struct VolumeCubes {
-    /// The texture (`Rgba32Uint`, [`VOLUME_FACE_SIZE`]² per layer), once built.
+    /// The texture (`Rgba32Uint`, [`VolumeCubes::face`]² per layer), once built.
     pub image: Option<Handle<Image>>,
+    /// Face size of its cubes: the camera's `ReconSettings::volume_face_size`.
+    pub face: u32,
     /// (base view, normalised view weight) of each view in the texture, in layer order.
     pub views: Vec<(usize, f32)>,
     /// What they were built for: pack, time bits, (view, weight bits) of the weighted views.
@@ -70,12 +68,14 @@ impl std::fmt::Debug for VolumeCubes {
 /// A finished rebuild: the texels of the cubes, and (view, weight) of each.
 type Rebuilt = (Vec<u8>, Vec<(usize, f32)>);
 
-/// Pack, time bits, and (view, weight bits) of the weighted views.
-type BuiltFor = (AssetId<RadiancePack>, u32, Vec<(usize, u32)>);
+/// Pack, time bits, face size, and (view, weight bits) of the weighted views.
+type BuiltFor = (AssetId<RadiancePack>, u32, u32, Vec<(usize, u32)>);
 
 /// The cube of base view `view` at time `t`, as `plenoptic_recon`'s volume mode builds it;
 /// `None` when the view has no usable volume near t.
-pub fn view_cube(r: &PackReader, view: usize, t: f32) -> Option<Cubes> {
+/// `settings` give the face size, tε and the buckets.
+pub fn view_cube(r: &PackReader, view: usize, t: f32, settings: &ReconSettings) -> Option<Cubes> {
+    let face = settings.volume_face_size.max(1);
     let m = r.manifest();
     let v = view as u32;
     // The baked complex of the block of bucket_of(t), if any.
@@ -83,14 +83,14 @@ pub fn view_cube(r: &PackReader, view: usize, t: f32) -> Option<Cubes> {
     if r.find(ChunkKind::VolumeConnectivity, v, bucket).is_some()
         && r.find(ChunkKind::VolumeBlock, v, bucket).is_some()
         && let (Ok(block), Ok(tets)) = (r.volume_block(v, bucket), r.connectivity(v, bucket))
-        && let Ok(Some(c)) = slice_to_cube(&block, &tets, t, VOLUME_FACE_SIZE)
+        && let Ok(Some(c)) = slice_to_cube(&block, &tets, t, face)
     {
         return Some(c);
     }
     // The samples within t ± tε, tent-weighted.
-    let eps = time_epsilon(m);
+    let eps = settings.time_epsilon_on(m);
     let mut samples = Vec::new();
-    for b in volume_buckets(m, t) {
+    for b in settings.volume_buckets(m, t) {
         if r.find(ChunkKind::VolumeBlock, v, b).is_none() {
             continue;
         }
@@ -104,7 +104,7 @@ pub fn view_cube(r: &PackReader, view: usize, t: f32) -> Option<Cubes> {
             }
         }
     }
-    (samples.len() >= 3).then(|| samples_to_cube(&samples, VOLUME_FACE_SIZE))
+    (samples.len() >= 3).then(|| samples_to_cube(&samples, face))
 }
 
 /// A cube's texels in the image-mode passes' key layout: (radiance RGB9E5, distance f32 bits,
@@ -130,7 +130,6 @@ fn texels((radiance, distance, ids): &Cubes) -> Vec<u8> {
 pub(super) fn prepare_cubes(
     backend: Res<ResolvedBackend>,
     cache: Res<StreamCache>,
-    settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
     cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
     mut images: ResMut<Assets<Image>>,
@@ -157,18 +156,20 @@ pub(super) fn prepare_cubes(
     };
     let m = pack.reader.manifest();
     let (t, position) = (cam.time, transform.translation());
-    let mut views = view_weights(m, &pack.usable_views, position, settings.max_views);
+    let settings = cam.settings.clone();
+    let mut views = settings.view_weights(m, &pack.usable_views, position);
     views.truncate(MAX_IMAGE_VIEWS);
     let key = (
         id,
         t.to_bits(),
+        settings.volume_face_size.max(1),
         views.iter().map(|&(v, w)| (v, w.to_bits())).collect(),
     );
     if cubes.built_for.as_ref() == Some(&key) {
         return;
     }
     let resident = views.iter().all(|&(v, _)| {
-        volume_buckets(m, t).all(|b| {
+        settings.volume_buckets(m, t).all(|b| {
             pack.reader
                 .find(ChunkKind::VolumeBlock, v as u32, b)
                 .is_none()
@@ -185,7 +186,7 @@ pub(super) fn prepare_cubes(
             let mut data = Vec::new();
             let mut built = Vec::new();
             for (v, w) in views {
-                if let Some(c) = view_cube(&reader, v, t) {
+                if let Some(c) = view_cube(&reader, v, t, &settings) {
                     data.extend_from_slice(&texels(&c));
                     built.push((v, w));
                 }
@@ -202,16 +203,18 @@ fn apply(
     key: BuiltFor,
     (data, built): Rebuilt,
 ) {
+    let face = key.2;
     cubes.built_for = Some(key);
     cubes.views = built;
+    cubes.face = face;
     if cubes.views.is_empty() {
         cubes.image = None;
         return;
     }
     let image = Image::new(
         Extent3d {
-            width: VOLUME_FACE_SIZE,
-            height: VOLUME_FACE_SIZE,
+            width: face,
+            height: face,
             depth_or_array_layers: 6 * cubes.views.len() as u32,
         },
         TextureDimension::D2,

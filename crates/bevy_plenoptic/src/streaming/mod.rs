@@ -2,7 +2,7 @@
 //!
 //! Every frame, per [`PlenopticCamera`]: the working set ([`schedule::working_set`]) is the
 //! base views the reconstruction blends (the view-space weights,
-//! [`schedule::view_weights`]) × the time keys bracketing t (in image mode the up to four keys
+//! [`plenoptic_recon::ReconSettings::view_weights`]) × the time keys bracketing t (in image mode the up to four keys
 //! of its Bézier segment) ("needed"), plus the same around where
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
@@ -475,10 +475,6 @@ fn schedule_reads(
     let frame = cache.frame;
     let budget = settings.memory_budget_bytes;
     let (mut hits, mut misses, mut stalled) = (0u64, 0u64, false);
-    let look = Lookahead {
-        views: settings.max_views.max(1),
-        seconds: settings.prefetch_seconds,
-    };
     let mut wanted: Vec<(AssetId<RadiancePack>, Arc<PackReader>, Unit, bool)> = Vec::new();
     for (cam, mut state, transform) in &mut cameras {
         let Some(pack) = packs.get(&cam.pack) else {
@@ -503,7 +499,10 @@ fn schedule_reads(
             velocity,
             cam.time,
             speed,
-            look,
+            Lookahead {
+                settings: &cam.settings,
+                seconds: settings.prefetch_seconds,
+            },
         );
         if cam.mode == crate::camera::ReconMode::Image {
             // Image mode blends each view's keys with Bézier weights over up to four keys

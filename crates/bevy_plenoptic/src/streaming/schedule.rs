@@ -3,7 +3,7 @@
 
 use bevy::math::Vec3;
 use plenoptic_pack::Manifest;
-use plenoptic_recon::viewspace::ViewWeights;
+use plenoptic_recon::ReconSettings;
 
 /// One streamable unit: the cubes (radiance, distance, object id, normal) of base view
 /// `view` (index into the manifest's base views) at time key `key`.
@@ -11,45 +11,6 @@ pub type KeyRef = (u32, u32);
 
 /// One temporal-volume block: (base view, time bucket).
 pub type BlockRef = (u32, u32);
-
-/// The buckets whose samples can fall in the temporal filter window `t ± tε`, with
-/// `plenoptic_recon`'s default `tε` (half the bucket span, [`time_epsilon`]).
-pub fn volume_buckets(manifest: &Manifest, t: f32) -> std::ops::RangeInclusive<u32> {
-    let eps = time_epsilon(manifest);
-    let b0 = manifest.bucket_of(t - eps);
-    let b1 = manifest.bucket_of(t + eps);
-    b0..=b1.min(b0.saturating_add(64))
-}
-
-/// Half-width tε of the temporal filter window: half the bucket span, as in
-/// `plenoptic_recon`'s default settings.
-pub fn time_epsilon(manifest: &Manifest) -> f32 {
-    (manifest.bucket_span * 0.5).max(1e-6)
-}
-
-/// The base views the reconstruction blends for a camera at `position`, with their weights
-/// normalised to sum 1: the pack's view-space weights over the `usable` views
-/// (`plenoptic_recon::viewspace::ViewWeights`), heaviest first, at most `count`, as
-/// `plenoptic_recon` chooses them. These, not merely the nearest views, must be resident: a
-/// plane view space weights the corners of the triangle around the camera, which need not be
-/// the nearest views.
-pub fn view_weights(
-    manifest: &Manifest,
-    usable: &[bool],
-    position: Vec3,
-    count: usize,
-) -> Vec<(usize, f32)> {
-    let mut w =
-        ViewWeights::new(&manifest.view_space, &manifest.base_views, usable).weights(position);
-    w.truncate(count.max(1));
-    let s: f32 = w.iter().map(|x| x.1).sum();
-    if s > 0.0 {
-        for x in &mut w {
-            x.1 /= s;
-        }
-    }
-    w
-}
 
 /// Indices of the `count` base views nearest `position`, nearest first.
 pub fn nearest_views(manifest: &Manifest, position: Vec3, count: usize) -> Vec<u32> {
@@ -99,9 +60,11 @@ pub struct WorkingSet {
 
 /// Parameters of [`working_set`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lookahead {
-    /// Base views blended per frame.
-    pub views: usize,
+pub struct Lookahead<'a> {
+    /// The camera's reconstruction settings: which base views it blends
+    /// ([`ReconSettings::view_weights`]) and which volume buckets its window t ± tε reaches
+    /// ([`ReconSettings::volume_buckets`]), as the reconstruction itself chooses them.
+    pub settings: &'a ReconSettings,
     /// Seconds ahead to prefetch.
     pub seconds: f32,
 }
@@ -115,26 +78,27 @@ pub fn working_set(
     velocity: Vec3,
     t: f32,
     direction: f32,
-    look: Lookahead,
+    look: Lookahead<'_>,
 ) -> WorkingSet {
+    let rs = look.settings;
     let mut set = WorkingSet::default();
     let push = |list: &mut Vec<KeyRef>, others: &[KeyRef], k: KeyRef| {
         if !list.contains(&k) && !others.contains(&k) {
             list.push(k);
         }
     };
-    for (v, _) in view_weights(manifest, usable, position, look.views) {
+    for (v, _) in rs.view_weights(manifest, usable, position) {
         let v = v as u32;
         for k in bracketing_keys(&manifest.base_views[v as usize].time_keys, t) {
             push(&mut set.needed, &[], (v, k));
         }
-        for b in volume_buckets(manifest, t) {
+        for b in rs.volume_buckets(manifest, t) {
             set.volumes.push((v, b));
         }
     }
     let future_pos = position + velocity * look.seconds;
     let future_t = t + direction * look.seconds;
-    for (v, _) in view_weights(manifest, usable, future_pos, look.views) {
+    for (v, _) in rs.view_weights(manifest, usable, future_pos) {
         let v = v as u32;
         let keys = &manifest.base_views[v as usize].time_keys;
         let mut ks = bracketing_keys(keys, t);
@@ -143,7 +107,10 @@ pub fn working_set(
             let needed = set.needed.clone();
             push(&mut set.prefetch, &needed, (v, k));
         }
-        for b in volume_buckets(manifest, t).chain(volume_buckets(manifest, future_t)) {
+        for b in rs
+            .volume_buckets(manifest, t)
+            .chain(rs.volume_buckets(manifest, future_t))
+        {
             let volumes = set.volumes.clone();
             push(&mut set.volume_prefetch, &volumes, (v, b));
         }
@@ -186,8 +153,12 @@ mod tests {
     #[test]
     fn needed_and_prefetch() {
         let m = manifest();
+        let settings = ReconSettings {
+            max_views: 2,
+            ..ReconSettings::default()
+        };
         let look = Lookahead {
-            views: 2,
+            settings: &settings,
             seconds: 1.0,
         };
         let usable = [true; 5];
@@ -209,7 +180,7 @@ mod tests {
         // At x = 3.1 and t = 1.5 (buckets 2 and 3) for views 3 and 4, and their buckets at t.
         assert!(s.volume_prefetch.contains(&(3, 3)) && s.volume_prefetch.contains(&(4, 0)));
         assert!(s.volume_prefetch.iter().all(|b| !s.volumes.contains(b)));
-        assert_eq!(volume_buckets(&m, 0.2), 0..=0);
-        assert_eq!(volume_buckets(&m, 0.8), 1..=2);
+        assert_eq!(settings.volume_buckets(&m, 0.2), 0..=0);
+        assert_eq!(settings.volume_buckets(&m, 0.8), 1..=2);
     }
 }

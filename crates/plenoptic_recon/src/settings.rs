@@ -1,0 +1,122 @@
+//! The reconstruction's tunables in one place (docs/architecture.md, "Reconstruction"):
+//! [`ReconSettings`], and the choices both backends derive from them and the pack's manifest
+//! (the view-space blend of base views, the temporal window tε, the temporal-volume buckets
+//! around t). `plenoptic_recon`'s modes and `bevy_plenoptic`'s GPU passes call these; the
+//! plugin hands the values to WGSL in uniforms, so no tunable is written twice.
+
+use std::ops::RangeInclusive;
+
+use glam::Vec3;
+use plenoptic_pack::Manifest;
+
+use crate::viewspace::ViewWeights;
+
+/// Reconstruction settings; each field's cost/quality trade-off is documented.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReconSettings {
+    /// Most base views blended per frame (more: smoother transitions, linear cost).
+    pub max_views: usize,
+    /// Relative distance tolerance of a geometry-assisted lookup (|d_cube − d| < tol·d, where
+    /// d_cube is the distance to the plane of the texel's surface along the lookup direction
+    /// when normals are available). Too small rejects valid lookups; too large lets occluders
+    /// through. Also the relative depth window of blending in image and volume modes.
+    pub depth_tolerance: f32,
+    /// Exponent of the angular-closeness weight `((1 + cos θ)/2)^p` between a base view's
+    /// direction to a point and the camera's (0 disables it).
+    pub angular_power: f32,
+    /// Half-width tε of the temporal filter window, seconds (`None`: half the bucket span).
+    pub time_epsilon: Option<f32>,
+    /// Face size of cubes reconstructed from temporal volumes (cost grows with its square).
+    pub volume_face_size: u32,
+    /// Radius, pixels, of the same-object hole fill search (cost grows with its square in the
+    /// worst case; only holes pay it).
+    pub hole_fill_radius: u32,
+    /// Passes of the background fill in image and volume modes (each extends by a pixel).
+    pub background_passes: u32,
+    /// Bytes of decoded chunks kept in the cache.
+    pub cache_bytes: usize,
+    /// How the geometry-assisted mode reads radiance from the cubes.
+    pub cube_filter: CubeFilter,
+    /// Image and volume modes: relative depth difference under which two splats of warped
+    /// texels count as the same surface (the nearer centre wins) rather than one occluding
+    /// the other.
+    pub same_surface: f32,
+    /// Image and volume modes: largest splat edge, pixels (a texel's footprint is capped at
+    /// it; larger closes more gaps near the camera and blurs more).
+    pub max_splat_px: f32,
+}
+
+/// How radiance is read from a base view's cube in the geometry-assisted mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CubeFilter {
+    /// The texel the direction falls in (what the GPU passes of `bevy_plenoptic` do; the
+    /// fastest).
+    #[default]
+    Nearest,
+    /// Seamless bilinear filtering: the four texels around the direction, taken across face
+    /// seams from the neighbouring face ([`plenoptic_pack::cube`] convention), restricted to
+    /// the texels that show the same object at the same distance (so that edges stay sharp).
+    /// The lookup is still accepted or rejected by its nearest texel. Lowers the error against
+    /// the path tracer (by about an eighth on the test room) and takes about twice the time
+    /// per frame of `Nearest` (benches/recon.rs).
+    Bilinear,
+}
+
+impl Default for ReconSettings {
+    fn default() -> Self {
+        ReconSettings {
+            max_views: 4,
+            depth_tolerance: 0.03,
+            angular_power: 8.0,
+            time_epsilon: None,
+            volume_face_size: 48,
+            hole_fill_radius: 12,
+            background_passes: 24,
+            cache_bytes: 512 << 20,
+            cube_filter: CubeFilter::Nearest,
+            same_surface: 0.03,
+            max_splat_px: 8.0,
+        }
+    }
+}
+
+impl ReconSettings {
+    /// The half-width tε of the temporal filter window on `manifest`'s pack:
+    /// [`ReconSettings::time_epsilon`], or half the bucket span.
+    pub fn time_epsilon_on(&self, manifest: &Manifest) -> f32 {
+        self.time_epsilon
+            .unwrap_or(manifest.bucket_span * 0.5)
+            .max(1e-6)
+    }
+
+    /// The base views blended for a camera at `position`, with their weights normalised to
+    /// sum 1: the pack's view-space weights over the `usable` views
+    /// ([`crate::viewspace::ViewWeights`]), heaviest first, at most
+    /// [`ReconSettings::max_views`].
+    pub fn view_weights(
+        &self,
+        manifest: &Manifest,
+        usable: &[bool],
+        position: Vec3,
+    ) -> Vec<(usize, f32)> {
+        let mut w =
+            ViewWeights::new(&manifest.view_space, &manifest.base_views, usable).weights(position);
+        w.truncate(self.max_views.max(1));
+        let s: f32 = w.iter().map(|x| x.1).sum();
+        if s > 0.0 {
+            for x in &mut w {
+                x.1 /= s;
+            }
+        }
+        w
+    }
+
+    /// The temporal-volume buckets whose samples can fall in the filter window t ± tε (at
+    /// most 65).
+    pub fn volume_buckets(&self, manifest: &Manifest, t: f32) -> RangeInclusive<u32> {
+        let eps = self.time_epsilon_on(manifest);
+        let b0 = manifest.bucket_of(t - eps);
+        let b1 = manifest.bucket_of(t + eps);
+        b0..=b1.min(b0.saturating_add(64))
+    }
+}
