@@ -469,3 +469,40 @@ fn a_recon_settings_change_moves_gpu_and_cpu_alike() {
         "{gpu_same} vs {cpu_same}"
     );
 }
+
+/// `CubeFilter::Bilinear` on the camera: the GPU's lookups filter seamlessly over the texels
+/// of the same object and distance, as the CPU's do.
+#[test]
+fn gpu_bilinear_lookups_match_cpu() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+    let cam = cpu_camera(eye, &transform);
+    let mut rec = Reconstructor::open(&path).unwrap();
+    let (nearest, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    rec.settings.cube_filter = plenoptic_recon::CubeFilter::Bilinear;
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+    app.world_mut()
+        .get_mut::<PlenopticCamera>(camera)
+        .unwrap()
+        .settings
+        .cube_filter = plenoptic_recon::CubeFilter::Bilinear;
+    let gpu = settle(&mut app, camera, &image);
+    let room: Vec<usize> = (0..cpu.object.len())
+        .filter(|&j| cpu.object[j] != 0)
+        .collect();
+    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &room);
+    let (_, unchanged, _) = compare(&cpu.radiance, &nearest.radiance, &room);
+    eprintln!(
+        "bilinear: GPU vs CPU on the room's pixels mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} \
+         within 20 %; {:.1} % of them differ from nearest by 5 % or more",
+        100.0 * (1.0 - unchanged)
+    );
+    assert!(unchanged < 0.97, "bilinear changes the frame: {unchanged}");
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "bilinear: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}

@@ -49,8 +49,7 @@ pub struct ReconSettings {
 /// How radiance is read from a base view's cube in the geometry-assisted mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum CubeFilter {
-    /// The texel the direction falls in (what the GPU passes of `bevy_plenoptic` do; the
-    /// fastest).
+    /// The texel the direction falls in (the fastest).
     #[default]
     Nearest,
     /// Seamless bilinear filtering: the four texels around the direction, taken across face
@@ -58,7 +57,8 @@ pub enum CubeFilter {
     /// the texels that show the same object at the same distance (so that edges stay sharp).
     /// The lookup is still accepted or rejected by its nearest texel. Lowers the error against
     /// the path tracer (by about an eighth on the test room) and takes about twice the time
-    /// per frame of `Nearest` (benches/recon.rs).
+    /// per frame of `Nearest` (benches/recon.rs). `bevy_plenoptic`'s GPU lookups filter the
+    /// same way when a camera's settings ask for it.
     Bilinear,
 }
 

@@ -47,3 +47,62 @@ fn texel_direction(t: vec3<u32>, n: u32) -> vec3<f32> {
     }
     return normalize(d);
 }
+
+// plenoptic_recon's sample::face_uv: (face, u, v) of a direction, u and v in [0, 1].
+fn face_uv(dir: vec3<f32>) -> vec3<f32> {
+    let a = abs(dir);
+    var r = vec4<f32>(0.0);
+    if a.x >= a.y && a.x >= a.z {
+        r = select(vec4<f32>(1.0, dir.z, -dir.y, a.x), vec4<f32>(0.0, -dir.z, -dir.y, a.x), dir.x >= 0.0);
+    } else if a.y >= a.z {
+        r = select(vec4<f32>(3.0, dir.x, -dir.z, a.y), vec4<f32>(2.0, dir.x, dir.z, a.y), dir.y >= 0.0);
+    } else {
+        r = select(vec4<f32>(5.0, -dir.x, -dir.y, a.z), vec4<f32>(4.0, dir.x, -dir.y, a.z), dir.z >= 0.0);
+    }
+    return vec3<f32>(r.x, 0.5 * (r.y / r.w + 1.0), 0.5 * (r.z / r.w + 1.0));
+}
+
+// plenoptic_recon's sample::face_uv_direction: the direction through (u, v) on face `face`'s
+// plane, u and v not limited to [0, 1] (not normalised).
+fn face_uv_direction(face: u32, u: f32, v: f32) -> vec3<f32> {
+    let sc = 2.0 * u - 1.0;
+    let tc = 2.0 * v - 1.0;
+    switch face {
+        case 0u: { return vec3<f32>(1.0, -tc, -sc); }
+        case 1u: { return vec3<f32>(-1.0, -tc, sc); }
+        case 2u: { return vec3<f32>(sc, 1.0, tc); }
+        case 3u: { return vec3<f32>(sc, -1.0, -tc); }
+        case 4u: { return vec3<f32>(sc, -tc, 1.0); }
+        default: { return vec3<f32>(-sc, -tc, -1.0); }
+    }
+}
+
+// Tap `k` (0..4: (0,0), (1,0), (0,1), (1,1)) of the seamless bilinear filter of a face-size
+// `n` cube around `dir` (plenoptic_recon's sample::bilinear_taps): (column, row, face) and its
+// weight in w; weight 0 where the tap is the missing fourth texel of a cube corner.
+fn bilinear_tap(dir: vec3<f32>, n: u32, k: u32) -> vec4<f32> {
+    let fuv = face_uv(dir);
+    let face = u32(fuv.x);
+    let nf = f32(n);
+    let s = fuv.y * nf - 0.5;
+    let t = fuv.z * nf - 0.5;
+    let i0 = floor(s);
+    let j0 = floor(t);
+    let fx = s - i0;
+    let fy = t - j0;
+    let di = f32(k & 1u);
+    let dj = f32(k >> 1u);
+    let w = select(1.0 - fx, fx, di == 1.0) * select(1.0 - fy, fy, dj == 1.0);
+    let i = i0 + di;
+    let j = j0 + dj;
+    let in_i = i >= 0.0 && i < nf;
+    let in_j = j >= 0.0 && j < nf;
+    if in_i && in_j {
+        return vec4<f32>(i, j, f32(face), w);
+    }
+    if in_i || in_j {
+        let d = face_uv_direction(face, (i + 0.5) / nf, (j + 0.5) / nf);
+        return vec4<f32>(vec3<f32>(cube_texel(d, n)), w);
+    }
+    return vec4<f32>(0.0);
+}

@@ -1,5 +1,5 @@
 // Geometry-assisted reconstruction (thesis §8.2.3), per fragment of a proxy mesh.
-// Same lookups and weights as plenoptic_recon::geometry (nearest texel, id + distance test,
+// Same lookups and weights as plenoptic_recon::geometry (nearest or seamless bilinear texel, id + distance test,
 // w_view · w_time · ((1 + cos θ)/2)^p); no volume fallback or hole fill.
 
 #import bevy_pbr::forward_io::VertexOutput
@@ -9,7 +9,7 @@
 #endif
 #import bevy_pbr::prepass_utils
 
-#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction}
+#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
@@ -21,8 +21,11 @@ struct ReconParams {
     header: vec4<f32>,
     // x: depth tolerance, y: angular power.
     tuning: vec4<f32>,
-    // x: hole-fill radius (pixels), y: index of the heaviest lookup.
+    // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
+    // frame, w: coverage of glazing.
     fill: vec4<f32>,
+    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter).
+    flags: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -53,6 +56,29 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
         v.y = y;
     }
     return normalize(v);
+}
+
+// The radiance of the key at `layer0` in direction `d` (length `l`), seamlessly bilinear
+// over the taps that show `object` at distance `l` (relative tolerance `tol`) or are the
+// nearest texel `t` (plenoptic_recon's lookup::filtered).
+fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32, tol: f32) -> vec3<f32> {
+    var acc = vec4<f32>(0.0);
+    for (var k = 0u; k < 4u; k++) {
+        let tap = bilinear_tap(d, n, k);
+        if tap.w <= 0.0 {
+            continue;
+        }
+        let c = vec3<u32>(tap.xyz);
+        let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
+        let nearest = all(c == t);
+        if nearest || (texel.z == object && abs(bitcast<f32>(texel.y) - l) <= tol * l) {
+            acc += vec4<f32>(rgb9e5_decode(texel.x), 1.0) * tap.w;
+        }
+    }
+    if acc.w > 0.0 {
+        return acc.rgb / acc.w;
+    }
+    return rgb9e5_decode(textureLoad(cubes, t.xy, layer0 + t.z, 0).x);
 }
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
@@ -100,7 +126,11 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
             wa = pow(c, power);
         }
         let w = params.weight[k].x * wa;
-        sum += rgb9e5_decode(texel.x) * w;
+        var radiance = rgb9e5_decode(texel.x);
+        if params.flags.x == 1.0 {
+            radiance = filtered(u32(params.base[k].w), n, d, t, object, dist, tol);
+        }
+        sum += radiance * w;
         ws += w;
     }
     return vec4<f32>(sum, ws);

@@ -6,8 +6,9 @@
 //! Every proxy mesh is drawn with a [`PlenopticMaterial`] whose fragment shader
 //! (`geometry.wgsl`, beside this file) does the lookups of `plenoptic_recon`'s geometry mode:
 //! for each resident (base view, bracketing time key) the fragment's point is carried along
-//! its object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, looked up (nearest texel) in that key's
-//! cube, accepted if the cube saw the same object at the same distance, and blended with
+//! its object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, looked up in that key's cube (the nearest
+//! texel, or seamlessly bilinear over the texels of the same object and distance with the
+//! camera's `CubeFilter::Bilinear`, as on the CPU), accepted if the cube saw the same object at the same distance, and blended with
 //! weight `w_view · w_time · ((1 + cos θ)/2)^p`. The result, times the camera's exposure
 //! (`view.exposure`, as Bevy's lights), is written unlit into the camera's HDR target; depth
 //! comes from the rasterised proxy mesh.
@@ -198,6 +199,9 @@ pub struct ReconParams {
     /// image-mode passes' frame instead (image and volume modes), w: the glazing's coverage
     /// (its output alpha in geometry-assisted mode; 1 or 0 for opaque objects).
     pub fill: Vec4,
+    /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
+    /// `CubeFilter::Bilinear` (0: the nearest texel).
+    pub flags: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -432,6 +436,16 @@ fn update_materials(
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
                 if image_mode { 1.0 } else { 0.0 },
                 object_coverage(pack, of.id),
+            ),
+            flags: Vec4::new(
+                if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
+                    1.0
+                } else {
+                    0.0
+                },
+                0.0,
+                0.0,
+                0.0,
             ),
             ..default()
         };
