@@ -261,6 +261,14 @@ pub enum PackError {
         /// What is wrong.
         reason: String,
     },
+    /// The pack's materials (manifest tables or a texture chunk) are not valid.
+    #[error("materials of {}: {reason}", path.display())]
+    InvalidMaterial {
+        /// The pack (empty for in-memory sources).
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
     /// The caller handed the writer or an encoder something it cannot store.
     #[error("invalid input: {reason}")]
     InvalidInput {

@@ -388,6 +388,7 @@ pub fn write_pack_with(
                 Motion::Static
             },
             proxy_mesh: Some(id),
+            material: None,
         });
     }
     w.add_tracks(&tracks).unwrap();
