@@ -89,6 +89,26 @@ fn a_bake_writes_range_images_volumes_proxies_and_tracks() {
         let mesh = pack.proxy_mesh(o.id).unwrap();
         assert_eq!(mesh.indices.len(), 36);
     }
+    // Materials (pack 1.2): the scene's two, one per object; the boxes' UVs and tangents.
+    assert_eq!(pack.materials().len(), 2);
+    assert!(pack.textures().is_empty());
+    for o in &m.objects {
+        assert!(pack.object_material(o.id).is_some(), "{}", o.name);
+        let a = pack
+            .proxy_attributes(o.id)
+            .unwrap()
+            .expect("boxes have UVs");
+        assert_eq!(
+            a.tangents.len(),
+            pack.proxy_mesh(o.id).unwrap().positions.len()
+        );
+    }
+    eprintln!(
+        "pack {} bytes, proxy attributes {} bytes, manifest {} bytes",
+        pack.file_length(),
+        m.stats.bytes.get("proxy_attributes").copied().unwrap_or(0),
+        pack.header().manifest_length
+    );
     let tracks = pack.tracks().unwrap();
     let mover = tracks
         .objects
