@@ -103,11 +103,17 @@ fn a_bake_writes_range_images_volumes_proxies_and_tracks() {
             pack.proxy_mesh(o.id).unwrap().positions.len()
         );
     }
+    // What 1.2 adds to this pack: the attribute chunks and the manifest's material entries.
+    let mut without = m.clone();
+    without.materials.clear();
+    without.textures.clear();
+    without.objects.iter_mut().for_each(|o| o.material = None);
+    let manifest_growth = pack.header().manifest_length - without.to_json().unwrap().len() as u64;
     eprintln!(
-        "pack {} bytes, proxy attributes {} bytes, manifest {} bytes",
+        "pack {} bytes; 1.2 adds proxy attributes {} bytes (+ 48 per directory row), manifest {} bytes",
         pack.file_length(),
         m.stats.bytes.get("proxy_attributes").copied().unwrap_or(0),
-        pack.header().manifest_length
+        manifest_growth
     );
     let tracks = pack.tracks().unwrap();
     let mover = tracks

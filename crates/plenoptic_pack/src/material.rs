@@ -283,9 +283,10 @@ impl crate::PackReader {
     }
 
     /// Texture `index` of the texture table with its decoded mip levels (level 0 first). The
-    /// chunk's header is checked against the table before any level is decompressed; errors
-    /// are [`PackError::InvalidMaterial`] naming the pack, or the chunk errors of
-    /// [`crate::PackReader::chunk`].
+    /// chunk's header is checked against the table before any level is decompressed. Errors
+    /// name the pack: [`PackError::InvalidMaterial`] when the table and the chunk disagree (or
+    /// there is no such texture), [`PackError::InvalidTexture`] wrapping the chunk's own error
+    /// (checksum, KTX2 header, mip chain, zstd frames) otherwise.
     pub fn texture(&self, index: u32) -> Result<TextureImage> {
         let fail = |reason: String| PackError::InvalidMaterial {
             path: self.path().to_path_buf(),
@@ -300,9 +301,14 @@ impl crate::PackReader {
         let chunk = self
             .find(ChunkKind::MaterialTexture, NO_BASE_VIEW, index)
             .ok_or_else(|| fail(format!("texture {index} has no chunk")))?;
-        let bytes = self.chunk_bytes(chunk)?;
+        let wrap = |e: PackError| PackError::InvalidTexture {
+            path: self.path().to_path_buf(),
+            index,
+            source: Box::new(e),
+        };
+        let bytes = self.chunk_bytes(chunk).map_err(wrap)?;
         let info = crate::texture::inspect_texture(&bytes)
-            .map_err(|e| e.in_chunk(self.entries()[chunk].chunk_ref(chunk)))?;
+            .map_err(|e| wrap(e.in_chunk(self.entries()[chunk].chunk_ref(chunk))))?;
         if (info.width, info.height, info.levels, info.colour_space)
             != (entry.width, entry.height, entry.levels, entry.colour_space)
         {
@@ -318,7 +324,7 @@ impl crate::PackReader {
                 info.colour_space
             )));
         }
-        match self.chunk(chunk)? {
+        match self.chunk(chunk).map_err(wrap)? {
             crate::Chunk::Texture(t) => Ok(t),
             _ => unreachable!("decoded by kind"),
         }

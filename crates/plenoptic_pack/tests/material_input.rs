@@ -104,10 +104,18 @@ fn truncated_texture_chunk() {
     for len in [10, 100, chunk.len() / 2, chunk.len() - 1] {
         let r = open(pack_with(&chunk[..len], &good_attributes())).unwrap();
         let e = r.texture(0).unwrap_err();
-        assert!(
-            matches!(e, PackError::MalformedKtx2 { chunk: Some(c), .. } if c.kind == ChunkKind::MaterialTexture),
-            "{len}: {e}"
-        );
+        let text = e.to_string();
+        match e {
+            PackError::InvalidTexture { index, source, .. } => {
+                assert_eq!(index, 0);
+                assert!(
+                    matches!(*source, PackError::MalformedKtx2 { chunk: Some(c), .. } if c.kind == ChunkKind::MaterialTexture),
+                    "{len}: {source}"
+                );
+            }
+            e => panic!("{len}: {e}"),
+        }
+        assert!(text.starts_with("texture 0 of "), "{text}");
     }
 }
 
