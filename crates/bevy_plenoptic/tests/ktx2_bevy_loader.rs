@@ -193,7 +193,11 @@ fn material_texture_chunks_load_as_mipmapped_bevy_images() {
     let path = dir.path().join("textures.pack");
     let checker: Vec<u8> = (0..64u32 * 64)
         .flat_map(|i| {
-            let v = if (i % 64 + i / 64).is_multiple_of(2) { 0 } else { 255 };
+            let v = if (i % 64 + i / 64).is_multiple_of(2) {
+                0
+            } else {
+                255
+            };
             [v, v, v, 255]
         })
         .collect();

@@ -14,7 +14,11 @@ use plenoptic_scene::builder::{MaterialDesc, NodeDesc, SceneBuilder};
 fn checker(n: u32) -> Vec<u8> {
     (0..n * n)
         .flat_map(|i| {
-            let v = if (i % n + i / n).is_multiple_of(2) { 0 } else { 255 };
+            let v = if (i % n + i / n).is_multiple_of(2) {
+                0
+            } else {
+                255
+            };
             [v, v, v, 255]
         })
         .collect()
