@@ -14,7 +14,7 @@ use crate::directory::{ChunkEntry, ChunkKind, DIRECTORY_ROW_LEN, NO_BASE_VIEW};
 use crate::error::{PackError, Result};
 use crate::header::{HEADER_LEN, Header, VERSION_MAJOR, VERSION_MINOR};
 use crate::manifest::Manifest;
-use crate::material::validate_materials;
+use crate::material::{TextureEntry, validate_materials};
 use crate::proxy::{AnimationTracks, ProxyMesh, encode_proxy_mesh, encode_tracks};
 use crate::range_image::{
     CubeFormats, RangeImage, encode_distance, encode_normal, encode_object_id, encode_radiance,
@@ -40,6 +40,9 @@ pub struct PackWriter {
     addresses: HashSet<(ChunkKind, u32, u32)>,
     /// Vertex count of each proxy mesh added, by object id (for its attributes).
     proxy_vertices: HashMap<u32, u32>,
+    /// What each texture added with [`PackWriter::add_texture`] is, by index (checked against
+    /// the manifest's table at the end).
+    textures: HashMap<u32, TextureEntry>,
 }
 
 impl std::fmt::Debug for PackWriter {
@@ -82,15 +85,17 @@ impl PackWriter {
             entries: Vec::new(),
             addresses: HashSet::new(),
             proxy_vertices: HashMap::new(),
+            textures: HashMap::new(),
         })
     }
 
-    /// Bytes the writer holds in memory: its directory rows, address set and proxy vertex
-    /// counts. Does not grow with chunk payloads.
+    /// Bytes the writer holds in memory: its directory rows, address set, proxy vertex counts
+    /// and texture sizes. Does not grow with chunk payloads.
     pub fn buffered_bytes(&self) -> usize {
         self.entries.capacity() * std::mem::size_of::<ChunkEntry>()
             + self.addresses.capacity() * std::mem::size_of::<(ChunkKind, u32, u32)>()
             + self.proxy_vertices.capacity() * std::mem::size_of::<(u32, u32)>()
+            + self.textures.capacity() * std::mem::size_of::<(u32, TextureEntry)>()
     }
 
     /// Rows written so far.
@@ -289,17 +294,27 @@ impl PackWriter {
     }
 
     /// Encodes and adds a material texture with its mip chain under `index`, its entry in the
-    /// manifest's `textures` table.
+    /// manifest's `textures` table ([`PackWriter::finish`] checks that entry against it).
     pub fn add_texture(&mut self, index: u32, texture: &TextureImage) -> Result<usize> {
         let (bytes, len) = encode_texture(texture)?;
-        self.add_raw_chunk(
+        let row = self.add_raw_chunk(
             ChunkKind::MaterialTexture,
             NO_BASE_VIEW,
             index,
             &bytes,
             len,
             None,
-        )
+        )?;
+        self.textures.insert(
+            index,
+            TextureEntry {
+                width: texture.width(),
+                height: texture.height(),
+                levels: texture.levels.len() as u32,
+                colour_space: texture.colour_space,
+            },
+        );
+        Ok(row)
     }
 
     /// Encodes and adds the UVs and tangents of object `attributes.object_id`'s proxy mesh,
@@ -344,6 +359,15 @@ impl PackWriter {
         };
         validate_materials(manifest, Some(&has_texture_chunk))
             .map_err(|reason| PackError::input(format!("materials: {reason}")))?;
+        for (i, entry) in manifest.textures.iter().enumerate() {
+            if let Some(added) = self.textures.get(&(i as u32))
+                && added != entry
+            {
+                return Err(PackError::input(format!(
+                    "materials: the table says texture {i} is {entry:?}, the texture added is {added:?}"
+                )));
+            }
+        }
         for (i, e) in self.entries.iter().enumerate() {
             if e.base_view != NO_BASE_VIEW && e.base_view as usize >= manifest.base_views.len() {
                 return Err(PackError::UnknownBaseView {

@@ -161,6 +161,13 @@ fn the_writer_refuses_inconsistent_materials() {
     let e = w.finish(&m).unwrap_err();
     assert!(e.to_string().contains("no MaterialTexture chunk"), "{e}");
     assert!(!path.exists());
+    // A table entry that disagrees with the texture added.
+    let mut w = PackWriter::create(&path).unwrap();
+    let t = TextureImage::with_mips(ColourSpace::Srgb, 64, 64, checker(64)).unwrap();
+    w.add_texture(0, &t).unwrap();
+    w.add_texture(1, &t).unwrap();
+    let e = w.finish(&m).unwrap_err();
+    assert!(e.to_string().contains("the table says texture 1"), "{e}");
     // Attributes before their mesh, or of the wrong length.
     let mut w = PackWriter::create(&path).unwrap();
     assert!(w.add_proxy_attributes(&proxy_attributes(1)).is_err());
