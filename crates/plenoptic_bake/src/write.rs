@@ -230,7 +230,7 @@ pub struct AssembleOptions {
     pub timings_in_manifest: bool,
 }
 
-/// The manifest of a plan's pack, without statistics.
+/// The manifest of a plan's pack, without statistics and materials ([`assemble`] adds both).
 pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest {
     let mut m = bucketing(plan);
     m.view_space = match plan.view_space {
