@@ -4,6 +4,8 @@
 //! byte, its full mip chain gamma-correctly filtered, shared images stored once, and the
 //! proxies' UVs and tangents.
 
+mod common;
+
 use glam::{Vec2, Vec3, Vec4};
 use plenoptic_bake::materials::{pack_materials, proxy_attributes};
 use plenoptic_bake::write::proxy_meshes;
@@ -163,5 +165,37 @@ fn a_textured_scene_round_trips_through_the_pack() {
     assert_eq!(
         attributes[floor].uvs,
         scene.meshes[scene.objects[floor].mesh].uvs
+    );
+}
+
+#[test]
+fn a_bake_of_a_textured_scene_writes_its_textures() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = common::static_room();
+    let tex = b.add_texture_rgba8(64, 64, checker(64));
+    let tiles = b.add_material(MaterialDesc::diffuse(Vec3::ONE).base_color_texture(tex));
+    let floor = b.add_plane("rug", Vec2::splat(1.5), 1, tiles);
+    b.add_node(
+        NodeDesc::new("rug")
+            .mesh(floor)
+            .translation(Vec3::new(0.0, -1.9, 0.0)),
+    );
+    let recipe = common::write_recipe(dir.path(), &b, common::STATIC_SEGMENT, "q = 0.0");
+    plenoptic_bake::bake_recipe(&recipe, &plenoptic_bake::BakeOptions::default()).unwrap();
+    let pack = PackReader::open(dir.path().join("out/scene.pack")).unwrap();
+    let m = pack.manifest();
+    assert_eq!(pack.textures().len(), 1);
+    let rug = m.objects.iter().find(|o| o.name == "rug").unwrap();
+    let material = pack.object_material(rug.id).unwrap();
+    assert_eq!(material.base_colour_texture.unwrap().texture, 0);
+    let t = pack.texture(0).unwrap();
+    assert_eq!(t.levels.len(), 7);
+    assert_eq!(t.levels[0].texels, checker(64));
+    assert!(m.stats.bytes["textures"] > 0);
+    eprintln!(
+        "textured static room: pack {} bytes, texture chunk {} bytes, attributes {} bytes",
+        pack.file_length(),
+        m.stats.bytes["textures"],
+        m.stats.bytes["proxy_attributes"]
     );
 }
