@@ -12,9 +12,17 @@ fuzz_target!(|data: &[u8]| {
         for i in 0..reader.entries().len() {
             let _ = reader.chunk(i);
         }
+        for i in 0..reader.textures().len() {
+            let _ = reader.texture(i as u32);
+        }
+        for o in &reader.manifest().objects {
+            let _ = reader.proxy_attributes(o.id);
+        }
     }
     // The chunk decoders on their own, for inputs that are a single chunk.
     let _ = plenoptic_pack::decode_radiance(data);
     let _ = plenoptic_pack::decode_volume_block(data);
     let _ = plenoptic_pack::proxy::decode_tracks(data);
+    let _ = plenoptic_pack::decode_texture(data);
+    let _ = plenoptic_pack::decode_proxy_attributes(data);
 });

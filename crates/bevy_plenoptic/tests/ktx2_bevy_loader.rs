@@ -1,6 +1,7 @@
 //! Range-image chunks of a radiance pack are complete KTX2 files: Bevy's own KTX2 loader
 //! (`bevy_image` with `ktx2` and `zstd_rust`) must open each of the four cube kinds as a cube
-//! `Image` with the texels the baker wrote.
+//! `Image` with the texels the baker wrote, and (pack 1.2) each material texture as a 2-D
+//! `Image` with its whole mip chain.
 
 use std::time::Duration;
 
@@ -14,6 +15,7 @@ use plenoptic_pack::{
     BaseView, ChunkKind, CubeFormats, CubeImage, Manifest, PackReader, PackWriter, RangeImage,
     TimeRange, cube::rgb9e5_pack,
 };
+use plenoptic_pack::{ColourSpace, TextureEntry, TextureImage};
 
 const FACE: u32 = 8;
 
@@ -69,11 +71,15 @@ fn chunks(dir: &std::path::Path) -> Vec<(ChunkKind, Vec<u8>)> {
 }
 
 fn load_with_bevy(bytes: &[u8]) -> Image {
+    load_with_bevy_srgb(bytes, false)
+}
+
+fn load_with_bevy_srgb(bytes: &[u8], is_srgb: bool) -> Image {
     Image::from_buffer(
         bytes,
         ImageType::Extension("ktx2"),
         CompressedImageFormats::NONE,
-        false,
+        is_srgb,
         ImageSampler::Default,
         RenderAssetUsages::default(),
     )
@@ -176,4 +182,70 @@ fn asset_server_loads_an_extracted_chunk() {
         .unwrap_or_else(|| panic!("not loaded: {state:?}"));
     assert_eq!(image.texture_descriptor.size.depth_or_array_layers, 6);
     assert_eq!(image.texture_descriptor.format, TextureFormat::Rgb9e5Ufloat);
+}
+
+/// A material-texture chunk (pack 1.2) loads as a 2-D image with its full mip chain in Bevy's
+/// mip-major order; Bevy takes sRGB-ness from the loader's `is_srgb` (the pack's
+/// `ColourSpace::is_srgb`), not from the vkFormat.
+#[test]
+fn material_texture_chunks_load_as_mipmapped_bevy_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("textures.pack");
+    let checker: Vec<u8> = (0..64u32 * 64)
+        .flat_map(|i| {
+            let v = if (i % 64 + i / 64).is_multiple_of(2) {
+                0
+            } else {
+                255
+            };
+            [v, v, v, 255]
+        })
+        .collect();
+    let gradient: Vec<u8> = (0..32 * 8).flat_map(|i| [i as u8, 7, 200, 255]).collect();
+    let textures = [
+        TextureImage::with_mips(ColourSpace::Srgb, 64, 64, checker).unwrap(),
+        TextureImage::with_mips(ColourSpace::Linear, 32, 8, gradient).unwrap(),
+    ];
+    let mut writer = PackWriter::create(&path).unwrap();
+    let mut manifest = Manifest::new(
+        TimeRange {
+            start: 0.0,
+            end: 1.0,
+        },
+        1.0,
+    );
+    for (i, t) in textures.iter().enumerate() {
+        writer.add_texture(i as u32, t).unwrap();
+        manifest.textures.push(TextureEntry {
+            width: t.width(),
+            height: t.height(),
+            levels: t.levels.len() as u32,
+            colour_space: t.colour_space,
+        });
+    }
+    writer.finish(&manifest).unwrap();
+    let reader = PackReader::open(&path).unwrap();
+    for (i, t) in textures.iter().enumerate() {
+        let bytes = reader.texture_ktx2(i as u32).unwrap();
+        let image = load_with_bevy_srgb(&bytes, t.colour_space.is_srgb());
+        let d = &image.texture_descriptor;
+        assert_eq!((d.size.width, d.size.height), (t.width(), t.height()));
+        assert_eq!(d.size.depth_or_array_layers, 1);
+        assert_eq!(d.mip_level_count, t.levels.len() as u32);
+        assert_eq!(
+            d.dimension,
+            bevy::render::render_resource::TextureDimension::D2
+        );
+        assert_eq!(
+            d.format,
+            if t.colour_space.is_srgb() {
+                TextureFormat::Rgba8UnormSrgb
+            } else {
+                TextureFormat::Rgba8Unorm
+            }
+        );
+        assert!(image.texture_view_descriptor.is_none(), "no cube view");
+        let want: Vec<u8> = t.levels.iter().flat_map(|l| l.texels.clone()).collect();
+        assert_eq!(image.data.as_deref(), Some(want.as_slice()));
+    }
 }

@@ -84,6 +84,7 @@ pub mod bake;
 pub mod daylight;
 pub mod error;
 pub mod input;
+pub mod materials;
 pub mod plan;
 pub mod progress;
 pub mod reference;

@@ -437,6 +437,17 @@ fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> 
     for o in &m.objects {
         println!("    {:>4} {} ({:?})", o.id, o.name, o.motion);
     }
+    println!(
+        "  materials: {}, textures: {}",
+        m.materials.len(),
+        m.textures.len()
+    );
+    for (i, t) in m.textures.iter().enumerate() {
+        println!(
+            "    texture {i}: {} x {}, {} levels, {:?}",
+            t.width, t.height, t.levels, t.colour_space
+        );
+    }
     println!("  lights: {}", m.lights.len());
     println!("  chunks: {}", pack.entries().len());
     for (k, v) in &m.stats.bytes {

@@ -4,7 +4,9 @@
 //!
 //! Canonical chunk order: for each base view, its range images by time key (radiance,
 //! distance, object id, normal), then its volume blocks by bucket; then one proxy mesh per
-//! object in id order; then the animation tracks.
+//! object in id order; then the animation tracks; then the environment image; then (pack 1.2)
+//! the proxies' UVs and tangents in object id order and the material textures in table order
+//! ([`crate::materials`]).
 //!
 //! Statistics: the manifest's `stats` holds sample counts and bytes, which are the same for
 //! every run. Wall-clock times are not: by default they go to a sidecar file
@@ -253,7 +255,7 @@ pub struct AssembleOptions {
     pub timings_in_manifest: bool,
 }
 
-/// The manifest of a plan's pack, without statistics.
+/// The manifest of a plan's pack, without statistics and materials ([`assemble`] adds both).
 pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest {
     let mut m = bucketing(plan);
     m.view_space = match plan.view_space {
@@ -317,6 +319,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
                     Motion::Static
                 },
                 proxy_mesh: has_mesh.then_some(id),
+                material: None,
                 coverage: object_coverage(scene, i),
             }
         })
@@ -392,6 +395,8 @@ fn stat_name(kind: ChunkKind) -> &'static str {
         ChunkKind::ProxyMesh => "proxy",
         ChunkKind::AnimationTracks => "tracks",
         ChunkKind::EnvironmentImage => "environment",
+        ChunkKind::MaterialTexture => "textures",
+        ChunkKind::ProxyAttributes => "proxy_attributes",
         ChunkKind::Unknown(_) => "other",
     }
 }
@@ -461,6 +466,23 @@ pub fn assemble(
         writer.add_environment_image(image)?;
         *bytes.entry("environment".into()).or_default() += writer.bytes_written() - before;
     }
+
+    let materials = crate::materials::pack_materials(scene)?;
+    for attributes in crate::materials::proxy_attributes(scene) {
+        let before = writer.bytes_written();
+        writer.add_proxy_attributes(&attributes)?;
+        *bytes.entry("proxy_attributes".into()).or_default() += writer.bytes_written() - before;
+    }
+    for (i, image) in materials.images.iter().enumerate() {
+        let before = writer.bytes_written();
+        writer.add_texture(i as u32, image)?;
+        *bytes.entry("textures".into()).or_default() += writer.bytes_written() - before;
+    }
+    for (object, material) in manifest.objects.iter_mut().zip(&materials.object_material) {
+        object.material = *material;
+    }
+    manifest.textures = materials.textures;
+    manifest.materials = materials.materials;
 
     let cost = plan.cost(0.0);
     let s = &mut manifest.stats;

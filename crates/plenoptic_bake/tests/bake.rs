@@ -89,6 +89,32 @@ fn a_bake_writes_range_images_volumes_proxies_and_tracks() {
         let mesh = pack.proxy_mesh(o.id).unwrap();
         assert_eq!(mesh.indices.len(), 36);
     }
+    // Materials (pack 1.2): the scene's two, one per object; the boxes' UVs and tangents.
+    assert_eq!(pack.materials().len(), 2);
+    assert!(pack.textures().is_empty());
+    for o in &m.objects {
+        assert!(pack.object_material(o.id).is_some(), "{}", o.name);
+        let a = pack
+            .proxy_attributes(o.id)
+            .unwrap()
+            .expect("boxes have UVs");
+        assert_eq!(
+            a.tangents.len(),
+            pack.proxy_mesh(o.id).unwrap().positions.len()
+        );
+    }
+    // What 1.2 adds to this pack: the attribute chunks and the manifest's material entries.
+    let mut without = m.clone();
+    without.materials.clear();
+    without.textures.clear();
+    without.objects.iter_mut().for_each(|o| o.material = None);
+    let manifest_growth = pack.header().manifest_length - without.to_json().unwrap().len() as u64;
+    eprintln!(
+        "pack {} bytes; 1.2 adds proxy attributes {} bytes (+ 48 per directory row), manifest {} bytes",
+        pack.file_length(),
+        m.stats.bytes.get("proxy_attributes").copied().unwrap_or(0),
+        manifest_growth
+    );
     let tracks = pack.tracks().unwrap();
     let mover = tracks
         .objects

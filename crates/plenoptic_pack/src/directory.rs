@@ -33,6 +33,12 @@ pub enum ChunkKind {
     /// The environment's equirectangular image (code 9, since version 1.1). Base view:
     /// [`NO_BASE_VIEW`]. Key: 0.
     EnvironmentImage,
+    /// A material texture: a mipmapped KTX2 2-D texture (code 10, since version 1.2). Base
+    /// view: [`NO_BASE_VIEW`]. Key: index into the manifest's `textures` table.
+    MaterialTexture,
+    /// UVs and tangents of the proxy mesh with the same key (code 11, since version 1.2). Base
+    /// view: [`NO_BASE_VIEW`]. Key: object id.
+    ProxyAttributes,
     /// A kind written by a newer minor version. It is validated like every other chunk and its
     /// raw bytes can be read, but it cannot be decoded.
     Unknown(u32),
@@ -51,6 +57,8 @@ impl ChunkKind {
             ChunkKind::ProxyMesh => 7,
             ChunkKind::AnimationTracks => 8,
             ChunkKind::EnvironmentImage => 9,
+            ChunkKind::MaterialTexture => 10,
+            ChunkKind::ProxyAttributes => 11,
             ChunkKind::Unknown(c) => c,
         }
     }
@@ -67,6 +75,8 @@ impl ChunkKind {
             7 => ChunkKind::ProxyMesh,
             8 => ChunkKind::AnimationTracks,
             9 => ChunkKind::EnvironmentImage,
+            10 => ChunkKind::MaterialTexture,
+            11 => ChunkKind::ProxyAttributes,
             c => ChunkKind::Unknown(c),
         }
     }
@@ -90,8 +100,8 @@ pub struct ChunkEntry {
     pub kind: ChunkKind,
     /// Base view index into [`crate::Manifest::base_views`], or [`NO_BASE_VIEW`].
     pub base_view: u32,
-    /// Time key index (cubes), time bucket index (volume kinds), object id (proxy mesh), 0
-    /// (animation tracks).
+    /// Time key index (cubes), time bucket index (volume kinds), object id (proxy mesh and
+    /// attributes), texture index (material textures), 0 (animation tracks, environment).
     pub key: u32,
     /// Offset of the chunk's bytes in the file.
     pub offset: u64,

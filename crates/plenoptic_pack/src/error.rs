@@ -261,6 +261,25 @@ pub enum PackError {
         /// What is wrong.
         reason: String,
     },
+    /// The pack's materials (manifest tables or a texture chunk) are not valid.
+    #[error("materials of {}: {reason}", path.display())]
+    InvalidMaterial {
+        /// The pack (empty for in-memory sources).
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A material texture's chunk could not be read or decoded: the pack, the texture's index
+    /// in the texture table, and the chunk error (which names the chunk and the problem).
+    #[error("texture {index} of {}: {source}", path.display())]
+    InvalidTexture {
+        /// The pack (empty for in-memory sources).
+        path: PathBuf,
+        /// Index in the manifest's `textures` table.
+        index: u32,
+        /// What went wrong reading the chunk.
+        source: Box<PackError>,
+    },
     /// The caller handed the writer or an encoder something it cannot store.
     #[error("invalid input: {reason}")]
     InvalidInput {
@@ -307,6 +326,7 @@ impl PackError {
             PackError::MalformedKtx2 { chunk, .. } | PackError::MalformedChunk { chunk, .. } => {
                 *chunk
             }
+            PackError::InvalidTexture { source, .. } => source.chunk(),
             _ => None,
         }
     }

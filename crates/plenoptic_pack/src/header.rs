@@ -8,7 +8,7 @@ pub const MAGIC: [u8; 8] = *b"PLNPACK\0";
 /// The major format version this crate writes and reads.
 pub const VERSION_MAJOR: u16 = 1;
 /// The minor format version this crate writes. Readers accept any minor of their major.
-pub const VERSION_MINOR: u16 = 1;
+pub const VERSION_MINOR: u16 = 2;
 /// Size of the header in bytes.
 pub const HEADER_LEN: u64 = 128;
 

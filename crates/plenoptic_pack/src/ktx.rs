@@ -1,7 +1,8 @@
-//! A minimal KTX 2.0 writer and a strict reader for the pack's range-image cubes (see
-//! `docs/pack-format.md`, "Range-image chunks").
+//! A minimal KTX 2.0 writer and a strict reader for the pack's KTX2 chunks: the range-image
+//! cubes (see `docs/pack-format.md`, "Range-image chunks") and, through the same writer and
+//! header checks, the mipmapped material textures of [`crate::texture`].
 //!
-//! Written files: cubemap (`faceCount` 6, `layerCount` 0, `pixelDepth` 0), one mip level,
+//! Written cube files: cubemap (`faceCount` 6, `layerCount` 0, `pixelDepth` 0), one mip level,
 //! `supercompressionScheme` 2 (Zstandard, the level is one zstd frame, no dictionary), the
 //! Basic Data Format Descriptor of the vkFormat, and one key/value pair `KTXwriter`.
 //!
@@ -84,10 +85,29 @@ pub fn write_cube(format: Format, face_size: u32, raw: &[u8]) -> Result<Vec<u8>>
             raw.len()
         )));
     }
-    let compressed = zstd_compress(raw)?;
+    write_ktx2(format, (face_size, face_size), 6, &[raw])
+}
+
+/// Writes a complete KTX2 file of `faces` faces (1, or 6 for a cube), `layerCount` 0,
+/// `pixelDepth` 0 and one mip level per entry of `levels` (level 0, the largest, first; each
+/// the raw bytes of all faces of that level). Every level becomes one zstd frame
+/// (`supercompressionScheme` 2); the level data are stored smallest level first, as the KTX2
+/// specification orders them, from a 16-byte aligned offset, with no padding between them
+/// (the alignment of supercompressed levels is 1). The caller has checked sizes and format.
+pub(crate) fn write_ktx2(
+    format: Format,
+    (width, height): (u32, u32),
+    faces: u32,
+    levels: &[&[u8]],
+) -> Result<Vec<u8>> {
+    let compressed = levels
+        .iter()
+        .map(|l| zstd_compress(l))
+        .collect::<Result<Vec<_>>>()?;
     let (dfd, type_size) = canonical_dfd(format)?;
 
-    let mut out = vec![0u8; KTX_HEADER_LEN + LEVEL_INDEX_LEN];
+    let index_len = LEVEL_INDEX_LEN * levels.len();
+    let mut out = vec![0u8; KTX_HEADER_LEN + index_len];
     let dfd_offset = out.len();
     out.extend_from_slice(&dfd);
     align(&mut out, 4);
@@ -98,18 +118,21 @@ pub fn write_cube(format: Format, face_size: u32, raw: &[u8]) -> Result<Vec<u8>>
     align(&mut out, 4);
     let kvd_length = out.len() - kvd_offset;
     align(&mut out, 16);
-    let level_offset = out.len();
-    out.extend_from_slice(&compressed);
+    let mut offsets = vec![0u64; levels.len()];
+    for (l, data) in compressed.iter().enumerate().rev() {
+        offsets[l] = out.len() as u64;
+        out.extend_from_slice(data);
+    }
 
     let header = ktx2::Header {
         format: Some(format),
         type_size,
-        pixel_width: face_size,
-        pixel_height: face_size,
+        pixel_width: width,
+        pixel_height: height,
         pixel_depth: 0,
         layer_count: 0,
-        face_count: 6,
-        level_count: 1,
+        face_count: faces,
+        level_count: levels.len() as u32,
         supercompression_scheme: Some(SupercompressionScheme::Zstandard),
         index: ktx2::Index {
             dfd_byte_offset: dfd_offset as u32,
@@ -121,18 +144,23 @@ pub fn write_cube(format: Format, face_size: u32, raw: &[u8]) -> Result<Vec<u8>>
         },
     };
     out[..KTX_HEADER_LEN].copy_from_slice(&header.as_bytes());
-    let level = ktx2::LevelIndex {
-        byte_offset: level_offset as u64,
-        byte_length: compressed.len() as u64,
-        uncompressed_byte_length: raw.len() as u64,
-    };
-    out[KTX_HEADER_LEN..KTX_HEADER_LEN + LEVEL_INDEX_LEN].copy_from_slice(&level.as_bytes());
+    for (l, (raw, data)) in levels.iter().zip(&compressed).enumerate() {
+        let level = ktx2::LevelIndex {
+            byte_offset: offsets[l],
+            byte_length: data.len() as u64,
+            uncompressed_byte_length: raw.len() as u64,
+        };
+        let at = KTX_HEADER_LEN + l * LEVEL_INDEX_LEN;
+        out[at..at + LEVEL_INDEX_LEN].copy_from_slice(&level.as_bytes());
+    }
     Ok(out)
 }
 
-/// Checks a KTX2 cube chunk's header against the pack's rules without decompressing it.
-/// `accepted` lists the vkFormats allowed for the chunk's kind.
-pub fn inspect_cube(bytes: &[u8], accepted: &[Format]) -> Result<CubeInfo> {
+/// Parses the 80-byte KTX2 header and checks what every pack KTX2 chunk shares: a vkFormat
+/// from `accepted`, Zstandard supercompression, the canonical DFD of the format (which keeps
+/// malformed DFDs away from `ktx2` 0.5's DFD parser) and its `typeSize`. Returns the header
+/// and the format.
+pub(crate) fn check_header(bytes: &[u8], accepted: &[Format]) -> Result<(ktx2::Header, Format)> {
     let head: &[u8; KTX_HEADER_LEN] = bytes
         .get(..KTX_HEADER_LEN)
         .and_then(|h| h.try_into().ok())
@@ -146,18 +174,6 @@ pub fn inspect_cube(bytes: &[u8], accepted: &[Format]) -> Result<CubeInfo> {
     let format = h.format.filter(|f| accepted.contains(f)).ok_or_else(|| {
         PackError::ktx(format!("vkFormat {:?} not one of {accepted:?}", h.format))
     })?;
-    if h.face_count != 6 || h.layer_count != 0 || h.pixel_depth != 0 || h.level_count != 1 {
-        return Err(PackError::ktx(format!(
-            "not a single-level cube: faceCount {}, layerCount {}, pixelDepth {}, levelCount {}",
-            h.face_count, h.layer_count, h.pixel_depth, h.level_count
-        )));
-    }
-    if h.pixel_width != h.pixel_height || h.pixel_width > MAX_FACE_SIZE {
-        return Err(PackError::ktx(format!(
-            "faces are {}x{}; must be square and at most {MAX_FACE_SIZE}",
-            h.pixel_width, h.pixel_height
-        )));
-    }
     if h.supercompression_scheme != Some(SupercompressionScheme::Zstandard) {
         return Err(PackError::ktx(format!(
             "supercompression {:?}, expected Zstandard",
@@ -176,6 +192,25 @@ pub fn inspect_cube(bytes: &[u8], accepted: &[Format]) -> Result<CubeInfo> {
         return Err(PackError::ktx(format!(
             "typeSize {} for {format:?}, expected {type_size}",
             h.type_size
+        )));
+    }
+    Ok((h, format))
+}
+
+/// Checks a KTX2 cube chunk's header against the pack's rules without decompressing it.
+/// `accepted` lists the vkFormats allowed for the chunk's kind.
+pub fn inspect_cube(bytes: &[u8], accepted: &[Format]) -> Result<CubeInfo> {
+    let (h, format) = check_header(bytes, accepted)?;
+    if h.face_count != 6 || h.layer_count != 0 || h.pixel_depth != 0 || h.level_count != 1 {
+        return Err(PackError::ktx(format!(
+            "not a single-level cube: faceCount {}, layerCount {}, pixelDepth {}, levelCount {}",
+            h.face_count, h.layer_count, h.pixel_depth, h.level_count
+        )));
+    }
+    if h.pixel_width != h.pixel_height || h.pixel_width > MAX_FACE_SIZE {
+        return Err(PackError::ktx(format!(
+            "faces are {}x{}; must be square and at most {MAX_FACE_SIZE}",
+            h.pixel_width, h.pixel_height
         )));
     }
     let n = h.pixel_width as u64;

@@ -10,9 +10,13 @@
 //! with their optional (x, y, t) tetrahedral complex; [`volume`]), plus proxy geometry and
 //! animation tracks for the geometry-assisted reconstruction ([`proxy`]).
 //!
+//! Since version 1.2 a pack also carries each object's glTF material ([`material`]), its
+//! textures as mipmapped KTX2 files ([`texture`]) and the proxies' UVs and tangents
+//! ([`attributes`]) for the geometry-assisted reconstruction of design.md's "Pack v2".
+//!
 //! Layers, bottom-up: byte I/O → [`header`] → [`manifest`] → [`directory`] → [`cube`]
-//! addressing and quantizers → [`ktx`] (KTX2 cube files) → [`range_image`] → [`volume`] →
-//! [`proxy`] → [`writer`] → [`reader`].
+//! addressing and quantizers → [`ktx`] (KTX2 files) → [`range_image`], [`texture`] →
+//! [`volume`] → [`proxy`], [`attributes`], [`material`] → [`writer`] → [`reader`].
 //!
 //! A pack is untrusted input: every count and length is checked against the file and the caps
 //! before anything is allocated, every section and chunk is checksummed (xxh3-64), and a bad pack
@@ -44,6 +48,7 @@
 //! # }
 //! ```
 
+pub mod attributes;
 mod bytes;
 pub mod cube;
 pub mod directory;
@@ -52,9 +57,11 @@ mod error;
 pub mod header;
 pub mod ktx;
 pub mod manifest;
+pub mod material;
 pub mod proxy;
 pub mod range_image;
 pub mod reader;
+pub mod texture;
 pub mod volume;
 pub mod writer;
 
@@ -63,6 +70,7 @@ pub use glam;
 /// The environment model whose parameters the pack stores.
 pub use plenoptic_sky;
 
+pub use attributes::{ProxyAttributes, decode_proxy_attributes, encode_proxy_attributes};
 pub use cube::{direction_to_face_uv, face_uv_to_direction};
 pub use directory::{ChunkEntry, ChunkKind, NO_BASE_VIEW};
 pub use environment::{
@@ -74,6 +82,10 @@ pub use manifest::{
     Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, Manifest, Motion, ObjectEntry,
     TimeRange, Units, ViewSpace,
 };
+pub use material::{
+    AlphaMode, MaterialEntry, TextureBinding, TextureEntry, UvTransform, WrapMode,
+    validate_materials,
+};
 pub use proxy::{AnimationTracks, Interpolation, ObjectTracks, ProxyMesh, Track};
 pub use range_image::{
     CubeFormats, CubeImage, DistanceCube, DistanceFormat, NormalCube, NormalFormat, ObjectIdCube,
@@ -82,6 +94,10 @@ pub use range_image::{
     encode_radiance,
 };
 pub use reader::{Chunk, PackReader};
+pub use texture::{
+    ColourSpace, MAX_TEXTURE_SIDE, TextureImage, TextureLevel, decode_texture, encode_texture,
+    mip_count, mip_size,
+};
 pub use volume::{
     EncodedVolumeBlock, VolumeBlock, VolumeSample, decode_connectivity, decode_volume_block,
     encode_connectivity, encode_volume_block,

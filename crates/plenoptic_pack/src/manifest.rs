@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::environment::EnvironmentEntry;
 use crate::error::{PackError, Result};
+use crate::material::{MaterialEntry, TextureEntry};
 
 /// Largest manifest the reader accepts, in bytes.
 pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
@@ -40,6 +41,13 @@ pub struct Manifest {
     /// absent in older packs and in packs without an environment).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub environment: Option<EnvironmentEntry>,
+    /// The material textures (version 1.2; empty in older packs): entry `i` is the
+    /// [`crate::ChunkKind::MaterialTexture`] chunk with key `i`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<TextureEntry>,
+    /// The materials objects refer to (version 1.2; empty in older packs).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialEntry>,
 }
 
 impl Manifest {
@@ -61,6 +69,8 @@ impl Manifest {
             bake: BakeSettings::default(),
             stats: BakeStatistics::default(),
             environment: None,
+            textures: Vec::new(),
+            materials: Vec::new(),
         }
     }
 
@@ -238,10 +248,14 @@ pub struct ObjectEntry {
     /// Key of this object's [`crate::ChunkKind::ProxyMesh`] chunk (by convention the object id),
     /// if it has one.
     pub proxy_mesh: Option<u32>,
+    /// Index of the object's material in [`Manifest::materials`] (version 1.2); `None`: no
+    /// material (every object of an older pack).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<u32>,
     /// Coverage of a see-through surface (glTF `alphaMode: BLEND`, e.g. glass exported that
     /// way): the mean fraction of rays that stop at it, in (0, 1). A runtime composites the
     /// object over what lies behind it with this weight, so the sky shows through glazing at
-    /// full resolution. `None` (absent, and in packs before version 1.1's readers): opaque.
+    /// full resolution. `None` (absent, as in every older pack): opaque.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<f32>,
 }

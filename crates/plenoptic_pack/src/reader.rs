@@ -7,6 +7,7 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use crate::attributes::{ProxyAttributes, attributes_header, decode_proxy_attributes};
 use crate::bytes::{ByteReader, checksum};
 use crate::directory::{ChunkEntry, ChunkKind, DIRECTORY_ROW_LEN, NO_BASE_VIEW};
 use crate::environment::{decode_environment_image, environment_image_header};
@@ -14,6 +15,7 @@ use crate::error::{ChunkRef, PackError, Result, Section};
 use crate::header::{HEADER_LEN, Header};
 use crate::ktx::inspect_cube;
 use crate::manifest::{MAX_MANIFEST_BYTES, Manifest};
+use crate::material::validate_materials;
 use crate::proxy::{
     AnimationTracks, ProxyMesh, decode_proxy_mesh, decode_tracks, proxy_header, tracks_header,
 };
@@ -22,6 +24,7 @@ use crate::range_image::{
     RADIANCE_FORMATS, RadianceCube, RangeImage, decode_distance, decode_normal, decode_object_id,
     decode_radiance,
 };
+use crate::texture::{TextureImage, decode_texture, inspect_texture};
 use crate::volume::{
     VolumeBlock, block_header, connectivity_header, decode_connectivity, decode_volume_block,
 };
@@ -90,6 +93,10 @@ pub enum Chunk {
     Tracks(AnimationTracks),
     /// The environment's image.
     EnvironmentImage(EquirectImage),
+    /// A material texture with its mip levels.
+    Texture(TextureImage),
+    /// A proxy mesh's UVs and tangents.
+    ProxyAttributes(ProxyAttributes),
 }
 
 /// The uncompressed length a chunk's own header declares (validating that header).
@@ -104,6 +111,8 @@ pub(crate) fn declared_uncompressed_length(kind: ChunkKind, bytes: &[u8]) -> Res
         ChunkKind::ProxyMesh => proxy_header(bytes)?.4,
         ChunkKind::AnimationTracks => tracks_header(bytes)?.1,
         ChunkKind::EnvironmentImage => environment_image_header(bytes)?.2,
+        ChunkKind::MaterialTexture => inspect_texture(bytes)?.uncompressed_length,
+        ChunkKind::ProxyAttributes => attributes_header(bytes)?.3,
         ChunkKind::Unknown(_) => {
             return Err(PackError::input(
                 "unknown chunk kinds must be added with add_raw_chunk",
@@ -270,6 +279,14 @@ impl PackReader {
             manifest_range,
             directory_range,
         )?;
+        let has_texture_chunk =
+            |i: u32| index.contains_key(&(ChunkKind::MaterialTexture, NO_BASE_VIEW, i));
+        validate_materials(&manifest, Some(&has_texture_chunk)).map_err(|reason| {
+            PackError::InvalidMaterial {
+                path: path.clone(),
+                reason,
+            }
+        })?;
         Ok(PackReader {
             source,
             path,
@@ -360,6 +377,10 @@ impl PackReader {
             ChunkKind::AnimationTracks => decode_tracks(&bytes).map(Chunk::Tracks),
             ChunkKind::EnvironmentImage => {
                 decode_environment_image(&bytes).map(Chunk::EnvironmentImage)
+            }
+            ChunkKind::MaterialTexture => decode_texture(&bytes).map(Chunk::Texture),
+            ChunkKind::ProxyAttributes => {
+                decode_proxy_attributes(&bytes).map(Chunk::ProxyAttributes)
             }
             ChunkKind::Unknown(_) => return Err(PackError::UnknownChunkKind { chunk }),
         };

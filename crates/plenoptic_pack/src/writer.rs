@@ -1,23 +1,26 @@
 //! [`PackWriter`]: streams chunks to a temporary file next to the target, then writes the
 //! manifest and directory at the end, the header at offset 0, fsyncs and renames atomically.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use tempfile::NamedTempFile;
 
+use crate::attributes::{ProxyAttributes, encode_proxy_attributes};
 use crate::bytes::checksum;
 use crate::directory::{ChunkEntry, ChunkKind, DIRECTORY_ROW_LEN, NO_BASE_VIEW};
 use crate::error::{PackError, Result};
 use crate::header::{HEADER_LEN, Header, VERSION_MAJOR, VERSION_MINOR};
 use crate::manifest::Manifest;
+use crate::material::{TextureEntry, validate_materials};
 use crate::proxy::{AnimationTracks, ProxyMesh, encode_proxy_mesh, encode_tracks};
 use crate::range_image::{
     CubeFormats, RangeImage, encode_distance, encode_normal, encode_object_id, encode_radiance,
 };
 use crate::reader::declared_uncompressed_length;
+use crate::texture::{TextureImage, encode_texture};
 use crate::volume::{VolumeSample, encode_connectivity, encode_volume_block};
 
 /// Most chunks one pack may hold.
@@ -35,6 +38,11 @@ pub struct PackWriter {
     offset: u64,
     entries: Vec<ChunkEntry>,
     addresses: HashSet<(ChunkKind, u32, u32)>,
+    /// Vertex count of each proxy mesh added, by object id (for its attributes).
+    proxy_vertices: HashMap<u32, u32>,
+    /// What each texture added with [`PackWriter::add_texture`] is, by index (checked against
+    /// the manifest's table at the end).
+    textures: HashMap<u32, TextureEntry>,
 }
 
 impl std::fmt::Debug for PackWriter {
@@ -76,14 +84,18 @@ impl PackWriter {
             offset: HEADER_LEN,
             entries: Vec::new(),
             addresses: HashSet::new(),
+            proxy_vertices: HashMap::new(),
+            textures: HashMap::new(),
         })
     }
 
-    /// Bytes the writer holds in memory: its directory rows and address set. Does not grow with
-    /// chunk payloads.
+    /// Bytes the writer holds in memory: its directory rows, address set, proxy vertex counts
+    /// and texture sizes. Does not grow with chunk payloads.
     pub fn buffered_bytes(&self) -> usize {
         self.entries.capacity() * std::mem::size_of::<ChunkEntry>()
             + self.addresses.capacity() * std::mem::size_of::<(ChunkKind, u32, u32)>()
+            + self.proxy_vertices.capacity() * std::mem::size_of::<(u32, u32)>()
+            + self.textures.capacity() * std::mem::size_of::<(u32, TextureEntry)>()
     }
 
     /// Rows written so far.
@@ -240,14 +252,17 @@ impl PackWriter {
     /// Encodes and adds an object's proxy mesh (key: its object id).
     pub fn add_proxy_mesh(&mut self, mesh: &ProxyMesh) -> Result<usize> {
         let (bytes, len) = encode_proxy_mesh(mesh)?;
-        self.add_raw_chunk(
+        let index = self.add_raw_chunk(
             ChunkKind::ProxyMesh,
             NO_BASE_VIEW,
             mesh.object_id,
             &bytes,
             len,
             None,
-        )
+        )?;
+        self.proxy_vertices
+            .insert(mesh.object_id, mesh.positions.len() as u32);
+        Ok(index)
     }
 
     /// Encodes and adds the pack's animation tracks (key 0).
@@ -278,6 +293,57 @@ impl PackWriter {
         )
     }
 
+    /// Encodes and adds a material texture with its mip chain under `index`, its entry in the
+    /// manifest's `textures` table ([`PackWriter::finish`] checks that entry against it).
+    pub fn add_texture(&mut self, index: u32, texture: &TextureImage) -> Result<usize> {
+        let (bytes, len) = encode_texture(texture)?;
+        let row = self.add_raw_chunk(
+            ChunkKind::MaterialTexture,
+            NO_BASE_VIEW,
+            index,
+            &bytes,
+            len,
+            None,
+        )?;
+        self.textures.insert(
+            index,
+            TextureEntry {
+                width: texture.width(),
+                height: texture.height(),
+                levels: texture.levels.len() as u32,
+                colour_space: texture.colour_space,
+            },
+        );
+        Ok(row)
+    }
+
+    /// Encodes and adds the UVs and tangents of object `attributes.object_id`'s proxy mesh,
+    /// which must have been added before with [`PackWriter::add_proxy_mesh`] (each list is
+    /// empty or one entry per vertex).
+    pub fn add_proxy_attributes(&mut self, attributes: &ProxyAttributes) -> Result<usize> {
+        let vertices = *self
+            .proxy_vertices
+            .get(&attributes.object_id)
+            .ok_or_else(|| {
+                PackError::input(format!(
+                    "proxy attributes of object {} before its proxy mesh",
+                    attributes.object_id
+                ))
+            })?;
+        attributes
+            .check_vertex_count(vertices as usize)
+            .map_err(PackError::input)?;
+        let (bytes, len) = encode_proxy_attributes(attributes)?;
+        self.add_raw_chunk(
+            ChunkKind::ProxyAttributes,
+            NO_BASE_VIEW,
+            attributes.object_id,
+            &bytes,
+            len,
+            None,
+        )
+    }
+
     /// Writes the manifest and directory, then the header, fsyncs and renames the file to the
     /// target path. Fails (leaving the target untouched) if a chunk names a base view the
     /// manifest does not have.
@@ -286,6 +352,21 @@ impl PackWriter {
         if let Some(env) = &manifest.environment {
             env.validate()
                 .map_err(|reason| PackError::input(format!("environment: {reason}")))?;
+        }
+        let has_texture_chunk = |i: u32| {
+            self.addresses
+                .contains(&(ChunkKind::MaterialTexture, NO_BASE_VIEW, i))
+        };
+        validate_materials(manifest, Some(&has_texture_chunk))
+            .map_err(|reason| PackError::input(format!("materials: {reason}")))?;
+        for (i, entry) in manifest.textures.iter().enumerate() {
+            if let Some(added) = self.textures.get(&(i as u32))
+                && added != entry
+            {
+                return Err(PackError::input(format!(
+                    "materials: the table says texture {i} is {entry:?}, the texture added is {added:?}"
+                )));
+            }
         }
         for (i, e) in self.entries.iter().enumerate() {
             if e.base_view != NO_BASE_VIEW && e.base_view as usize >= manifest.base_views.len() {

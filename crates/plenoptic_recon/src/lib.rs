@@ -62,7 +62,7 @@
 //! let mut manifest = Manifest::new(TimeRange { start: 0.0, end: 1.0 }, 0.5);
 //! manifest.base_views.push(BaseView { id: 0, position: Vec3::ZERO, time_keys: vec![0.0] });
 //! manifest.objects.push(ObjectEntry {
-//!     id: 1, name: "box".into(), node_path: "/box".into(), motion: Motion::Static, proxy_mesh: Some(1), coverage: None,
+//!     id: 1, name: "box".into(), node_path: "/box".into(), motion: Motion::Static, proxy_mesh: Some(1), material: None, coverage: None,
 //! });
 //! writer.finish(&manifest).unwrap();
 //!

@@ -102,6 +102,7 @@ fn write_pack(path: &Path, complex: bool) {
         node_path: "/shell".into(),
         motion: Motion::Static,
         proxy_mesh: None,
+        material: None,
         coverage: None,
     });
     w.finish(&manifest).unwrap();

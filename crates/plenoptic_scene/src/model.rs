@@ -42,6 +42,21 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+impl Mesh {
+    /// Tangents computed from the UVs, as the importer computes them for a normal-mapped mesh
+    /// whose file has no TANGENT (Lengyel's per-vertex sum of UV gradients, orthogonalised
+    /// against the normal, bitangent sign in w): unit xyz, w = ±1. Empty unless the mesh has a
+    /// UV and a normal for every position.
+    pub fn uv_tangents(&self) -> Vec<Vec4> {
+        let n = self.positions.len();
+        let indices_ok = self.triangles.iter().flatten().all(|&i| (i as usize) < n);
+        if self.uvs.len() != n || self.normals.len() != n || !indices_ok {
+            return Vec::new();
+        }
+        crate::import::mesh::uv_tangents(self)
+    }
+}
+
 /// A glTF metallic-roughness material with the extensions plenoptic supports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {

@@ -68,6 +68,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             node_path: "/Scene/Room/Walls".into(),
             motion: Motion::Static,
             proxy_mesh: Some(1),
+            material: None,
             coverage: None,
         },
         ObjectEntry {
@@ -76,6 +77,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             node_path: "/Scene/Room/Chair".into(),
             motion: Motion::Animated,
             proxy_mesh: Some(2),
+            material: None,
             coverage: None,
         },
     ];
@@ -267,9 +269,142 @@ pub fn write_small_pack(path: &std::path::Path) -> Manifest {
     m
 }
 
-/// Reads and decodes every chunk; returns how many decoded.
+/// Reads and decodes every chunk, and every texture and proxy's attributes through their
+/// checked accessors; returns how many chunks decoded.
 pub fn read_all(r: &PackReader) -> usize {
+    for i in 0..r.textures().len() {
+        let _ = r.texture(i as u32);
+    }
+    for o in &r.manifest().objects {
+        let _ = r.proxy_attributes(o.id);
+        let _ = r.object_material(o.id);
+    }
     (0..r.entries().len())
         .filter(|&i| r.chunk(i).is_ok())
         .count()
+}
+
+/// A `n × n` RGBA8 checker of 1-texel cells: RGB 0 and 255, alpha 255 and 0 (alpha opposite).
+pub fn checker(n: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let v = if (x + y) % 2 == 0 { 0 } else { 255 };
+            out.extend([v, v, v, 255 - v]);
+        }
+    }
+    out
+}
+
+/// A texture whose every texel differs: a gradient in R and G, noise in B, alpha from both.
+pub fn gradient(w: u32, h: u32) -> Vec<u8> {
+    let mut rng = Rng(99);
+    let mut out = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            out.extend([
+                (x * 255 / w.max(2).saturating_sub(1).max(1)) as u8,
+                (y * 255 / h.max(2).saturating_sub(1).max(1)) as u8,
+                rng.next_u64() as u8,
+                ((x + y) * 7) as u8,
+            ]);
+        }
+    }
+    out
+}
+
+/// The materials of [`write_material_pack`]: a textured one with every slot, an untextured
+/// one, and texture 0 shared by two materials.
+pub fn materials() -> (Vec<TextureEntry>, Vec<MaterialEntry>) {
+    let bind = |texture| TextureBinding {
+        texture,
+        wrap_s: WrapMode::Repeat,
+        wrap_t: WrapMode::MirroredRepeat,
+        transform: None,
+    };
+    let textures = vec![
+        TextureEntry {
+            width: 64,
+            height: 64,
+            levels: 7,
+            colour_space: ColourSpace::Srgb,
+        },
+        TextureEntry {
+            width: 16,
+            height: 4,
+            levels: 5,
+            colour_space: ColourSpace::Linear,
+        },
+    ];
+    let full = MaterialEntry {
+        name: "tiles".into(),
+        base_colour: glam::Vec4::new(0.9, 0.8, 0.7, 0.5),
+        base_colour_texture: Some(TextureBinding {
+            transform: Some(UvTransform {
+                offset: glam::Vec2::new(0.25, -0.5),
+                rotation: 0.3,
+                scale: glam::Vec2::new(2.0, 3.0),
+            }),
+            ..bind(0)
+        }),
+        metallic: 0.25,
+        roughness: 0.625,
+        metallic_roughness_texture: Some(bind(1)),
+        normal_texture: Some(bind(1)),
+        normal_scale: 0.75,
+        emissive: Vec3::new(2.0, 0.0, 5.5),
+        emissive_texture: Some(bind(0)),
+        transmission: 0.5,
+        ior: 1.45,
+        double_sided: true,
+        alpha_mode: AlphaMode::Mask { cutoff: 0.3 },
+    };
+    let plain = MaterialEntry {
+        name: "plain".into(),
+        alpha_mode: AlphaMode::Blend,
+        ..MaterialEntry::default()
+    };
+    (textures, vec![full, plain])
+}
+
+/// The UVs and tangents of [`proxy_mesh`] (4 vertices).
+pub fn proxy_attributes(object_id: u32) -> ProxyAttributes {
+    ProxyAttributes {
+        object_id,
+        uvs: vec![
+            glam::Vec2::new(0.0, 0.0),
+            glam::Vec2::new(1.0, 0.0),
+            glam::Vec2::new(0.0, 1.5),
+            glam::Vec2::new(-0.25, 7.0),
+        ],
+        tangents: vec![
+            glam::Vec4::new(1.0, 0.0, 0.0, 1.0),
+            glam::Vec4::new(1.0, 0.0, 0.0, 1.0),
+            glam::Vec4::new(0.0, 1.0, 0.0, -1.0),
+            glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+        ],
+    }
+}
+
+/// [`write_small_pack`] plus materials (1.2): two textures, two materials (object 1 textured,
+/// object 2 plain), and UVs and tangents for object 1's proxy. Returns the manifest.
+pub fn write_material_pack(path: &std::path::Path) -> Manifest {
+    let mut m = manifest(2);
+    let mut w = PackWriter::create(path).unwrap();
+    w.add_range_image(0, 0, &room_image(4, 0.0), CubeFormats::default())
+        .unwrap();
+    w.add_proxy_mesh(&proxy_mesh(1, true)).unwrap();
+    w.add_proxy_mesh(&proxy_mesh(2, false)).unwrap();
+    w.add_proxy_attributes(&proxy_attributes(1)).unwrap();
+    let t0 = TextureImage::with_mips(ColourSpace::Srgb, 64, 64, checker(64)).unwrap();
+    let t1 = TextureImage::with_mips(ColourSpace::Linear, 16, 4, gradient(16, 4)).unwrap();
+    w.add_texture(0, &t0).unwrap();
+    w.add_texture(1, &t1).unwrap();
+    let (textures, materials) = materials();
+    m.textures = textures;
+    m.materials = materials;
+    m.objects[0].material = Some(0);
+    m.objects[1].material = Some(1);
+    w.finish(&m).unwrap();
+    m
 }

@@ -438,6 +438,7 @@ pub fn write_pack_with(
                 Motion::Static
             },
             proxy_mesh: Some(id),
+            material: None,
             // BLEND objects of the test scenes are untextured: their coverage is the factor's.
             coverage: {
                 let m = &scene.materials[obj.material];
