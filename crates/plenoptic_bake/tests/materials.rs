@@ -96,6 +96,7 @@ fn a_textured_scene_round_trips_through_the_pack() {
             motion: Motion::Static,
             proxy_mesh: Some(i as u32 + 1),
             material: *material,
+            coverage: None,
         });
     }
     m.textures = mats.textures.clone();
