@@ -19,6 +19,17 @@ pub struct RadianceSample {
     pub object: ObjectId,
     /// Shading normal of the first hit facing the ray; zero for a miss.
     pub normal: Vec3,
+    /// The part of `radiance` that the first hit's Lambertian lobe reflects: direct light
+    /// through the diffuse lobe plus the ambient field's indirect diffuse light. `radiance −
+    /// diffuse` is emission and the specular/view-dependent part. Filled by the multi-stage
+    /// renderer (the bake's denoiser filters `diffuse / albedo` and nothing else); zero from
+    /// the path tracer, which does not split.
+    pub diffuse: Vec3,
+    /// Diffuse albedo of the first hit, `(1 − metallic)(1 − transmission) · base colour` with
+    /// textures and vertex colours applied (no Fresnel factor: that stays in the lighting).
+    /// `diffuse / albedo` is the hit's diffuse lighting, what pack v2 stores apart from
+    /// reflectance. Zero for a miss and from the path tracer.
+    pub albedo: Vec3,
 }
 
 impl RadianceSample {
@@ -29,6 +40,8 @@ impl RadianceSample {
         distance: f32::INFINITY,
         object: NO_OBJECT,
         normal: Vec3::ZERO,
+        diffuse: Vec3::ZERO,
+        albedo: Vec3::ZERO,
     };
 
     pub(crate) fn first_hit(hit: &Hit, ray: &Ray) -> Self {
@@ -42,12 +55,15 @@ impl RadianceSample {
             distance: hit.distance,
             object: hit.object,
             normal: n,
+            diffuse: Vec3::ZERO,
+            albedo: Vec3::ZERO,
         }
     }
 }
 
-/// Renders `camera` with `spp` jittered samples per pixel: radiance is the mean, the auxiliary
-/// fields come from a ray through the pixel centre. Sample k of pixel i draws from
+/// Renders `camera` with `spp` jittered samples per pixel: radiance, its diffuse part and the
+/// albedo are means over the samples (so `diffuse / albedo` demodulates textures the way the
+/// pixel saw them), the other auxiliary fields come from a ray through the pixel centre. Sample k of pixel i draws from
 /// `Sampler::new(seed, i, k)`, so the image is the same for any thread count.
 pub fn render_camera<C, F>(camera: &C, spp: u32, seed: u64, f: F) -> Image<RadianceSample>
 where
@@ -58,7 +74,7 @@ where
     let spp = spp.max(1);
     Image::render(w, h, |x, y| {
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
         for k in 0..spp {
@@ -77,12 +93,16 @@ where
                 aux = r;
             }
             sum += r.radiance;
+            diffuse += r.diffuse;
+            albedo += r.albedo;
         }
         if !any {
             return RadianceSample::MISS;
         }
         RadianceSample {
             radiance: sum / spp as f32,
+            diffuse: diffuse / spp as f32,
+            albedo: albedo / spp as f32,
             ..aux
         }
     })
