@@ -5,7 +5,7 @@ use plenoptic_scene::{NO_OBJECT, ObjectId};
 
 use crate::accel::{Hit, Ray};
 use crate::camera::Camera;
-use crate::image::Image;
+use crate::image::{Image, luminance};
 use crate::sampling::Sampler;
 
 /// Radiance along one ray with what the first hit tells about the surface.
@@ -30,6 +30,11 @@ pub struct RadianceSample {
     /// `diffuse / albedo` is the hit's diffuse lighting, what pack v2 stores apart from
     /// reflectance. Zero for a miss and from the path tracer.
     pub albedo: Vec3,
+    /// Variance of the mean over the pixel's samples of the diffuse lighting's luminance
+    /// (each sample's `luminance(diffuse) / luminance(albedo)`): the noise the bake's denoiser
+    /// weighs luminance differences against. Zero with one sample per pixel (unknown) and
+    /// where `diffuse` is zero.
+    pub lighting_variance: f32,
 }
 
 impl RadianceSample {
@@ -42,6 +47,7 @@ impl RadianceSample {
         normal: Vec3::ZERO,
         diffuse: Vec3::ZERO,
         albedo: Vec3::ZERO,
+        lighting_variance: 0.0,
     };
 
     pub(crate) fn first_hit(hit: &Hit, ray: &Ray) -> Self {
@@ -57,6 +63,7 @@ impl RadianceSample {
             normal: n,
             diffuse: Vec3::ZERO,
             albedo: Vec3::ZERO,
+            lighting_variance: 0.0,
         }
     }
 }
@@ -75,6 +82,7 @@ where
     Image::render(w, h, |x, y| {
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
         let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
         for k in 0..spp {
@@ -95,6 +103,14 @@ where
             sum += r.radiance;
             diffuse += r.diffuse;
             albedo += r.albedo;
+            let a = luminance(r.albedo);
+            let l = if a > 1e-3 {
+                f64::from(luminance(r.diffuse) / a)
+            } else {
+                0.0
+            };
+            l1 += l;
+            l2 += l * l;
         }
         if !any {
             return RadianceSample::MISS;
@@ -103,6 +119,13 @@ where
             radiance: sum / spp as f32,
             diffuse: diffuse / spp as f32,
             albedo: albedo / spp as f32,
+            lighting_variance: if spp > 1 {
+                // Unbiased sample variance, over spp for the variance of the mean.
+                let n = f64::from(spp);
+                ((l2 - l1 * l1 / n).max(0.0) / (n - 1.0) / n) as f32
+            } else {
+                0.0
+            },
             ..aux
         }
     })
