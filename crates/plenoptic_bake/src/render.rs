@@ -167,7 +167,13 @@ pub fn render_range_image(
         None => to_range_image(n, &faces),
         Some(settings) => {
             let mut lighting = LightingCube::from_faces(n, &faces);
-            crate::denoise::denoise(&mut lighting, settings);
+            // One sample per pixel reports no variance: estimate it from the image.
+            let settings = DenoiseSettings {
+                sample_variance: settings.sample_variance
+                    && renderer.settings.samples_per_pixel >= 2,
+                ..*settings
+            };
+            crate::denoise::denoise(&mut lighting, &settings);
             lighting.to_range_image()
         }
     })

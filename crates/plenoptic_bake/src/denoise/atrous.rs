@@ -8,8 +8,9 @@
 //!  · exp(−|ℓ_q − ℓ_p| / (σ_ℓ √var_p + ε))`
 //!
 //! with `x` the texel's surface point (direction × distance from the base view), `ℓ` the
-//! lighting's luminance and `var` its variance, estimated before the first pass from the 5 × 5
-//! surface neighbourhood and propagated (`var'_p = Σ w² var_q / (Σ w)²`). Weights are
+//! lighting's luminance and `var` its variance: before the first pass the renderer's per-texel
+//! variance smoothed over 3 × 3 texels (or, without it, the lighting's spread over 5 × 5),
+//! then propagated (`var'_p = Σ w² var_q / (Σ w)²`). Weights are
 //! normalised per texel, so a constant lighting stays constant wherever the guides cut.
 //! Texels without lighting (misses, black albedo) are left as they are and are never taps.
 
@@ -43,7 +44,8 @@ pub fn denoise_on(cube: &mut LightingCube, grid: &CubeGrid, settings: &DenoiseSe
     }
     let mut lighting = std::mem::take(&mut cube.lighting);
     let guides = Guides::new(cube, grid, settings);
-    let mut var = guides.initial_variance(&lighting);
+    let samples = settings.sample_variance.then_some(cube.variance.as_slice());
+    let mut var = guides.initial_variance(&lighting, samples);
     for pass in 0..settings.passes.min(16) {
         let step = 1i32 << pass;
         let (l, v): (Vec<Vec3>, Vec<f32>) = (0..lighting.len())
@@ -118,11 +120,36 @@ impl<'a> Guides<'a> {
         w_n * (-plane * plane).exp()
     }
 
-    /// Variance of the lighting's luminance over each texel's 5 × 5 surface neighbourhood
-    /// (taps weighted by [`Self::geometric`]), the noise estimate of the luminance weight.
-    fn initial_variance(&self, lighting: &[Vec3]) -> Vec<f32> {
+    /// The noise estimate of the luminance weight before the first pass: the renderer's
+    /// variance smoothed over the 3 × 3 surface neighbourhood (taps weighted by
+    /// [`Self::geometric`]) when `samples` is given, else the spread of the lighting's
+    /// luminance over the 5 × 5 surface neighbourhood.
+    fn initial_variance(&self, lighting: &[Vec3], samples: Option<&[f32]>) -> Vec<f32> {
         if !self.sigma_luminance.is_finite() {
             return vec![0.0; lighting.len()];
+        }
+        if let Some(var) = samples {
+            return (0..lighting.len())
+                .into_par_iter()
+                .map(|p| {
+                    if !self.filterable[p] {
+                        return 0.0;
+                    }
+                    let (face, i, j) = self.grid.coords(p);
+                    let (mut sw, mut sv) = (0.0f32, 0.0f32);
+                    for (ky, hy) in [0.25f32, 0.5, 0.25].iter().enumerate() {
+                        for (kx, hx) in [0.25f32, 0.5, 0.25].iter().enumerate() {
+                            let q = self.grid.offset(face, i, j, kx as i32 - 1, ky as i32 - 1);
+                            let w = hx * hy * self.geometric(p, q);
+                            if w > 0.0 {
+                                sw += w;
+                                sv += w * var[q];
+                            }
+                        }
+                    }
+                    sv / sw
+                })
+                .collect();
         }
         (0..lighting.len())
             .into_par_iter()

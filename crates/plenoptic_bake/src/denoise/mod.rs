@@ -39,10 +39,14 @@
 //!   depend on how far the surface is.
 //! - Luminance: instead of Dammertz et al.'s colour weight with a σ halved every pass, the
 //!   luminance weight of SVGF (Schied et al., "Spatiotemporal Variance-Guided Filtering", HPG
-//!   2017): `exp(−|ℓ_p − ℓ_q| / (σ_ℓ √var_p))`, with the variance estimated from the texel's
-//!   3 × 3 surface neighbourhood and carried through the passes (`var' = Σ w² var / (Σ w)²`).
-//!   It keeps shadow edges that are well above the noise. `σ_ℓ = ∞` turns it off, and then
-//!   every weight depends on the guides alone.
+//!   2017): `exp(−|ℓ_p − ℓ_q| / (σ_ℓ √var_p))`, with the variance of the texel's samples from
+//!   the renderer ([`RadianceSample::lighting_variance`]) smoothed over its 3 × 3 surface
+//!   neighbourhood, and carried through the passes (`var' = Σ w² var / (Σ w)²`). It keeps
+//!   shadow edges that are well above the noise: a sun shadow's edge is sharp and noise-free
+//!   in every sample, so it is not averaged away. With one sample per pixel the variance is
+//!   estimated from the lighting's spread over 5 × 5 texels instead, which counts such edges
+//!   as noise (measured: it blurs the sunlit floor's shadow edges). `σ_ℓ = ∞` turns the
+//!   weight off, and then every weight depends on the guides alone.
 //! - Seams: taps are addressed through their direction ([`cube::CubeGrid::offset`]), so the
 //!   footprint crosses face edges as if the cube were one surface.
 //! - Time keys: for static geometry the guides (id, normal, distance of the pixel-centre ray)
@@ -87,6 +91,12 @@ pub struct DenoiseSettings {
     /// Scale of the luminance weight in standard deviations of the noise; infinite turns
     /// the luminance weight off (weights from the guides alone).
     pub sigma_luminance: f32,
+    /// Take the noise from the renderer's per-texel variance ([`LightingCube::variance`],
+    /// which needs two or more samples per pixel), smoothed over the 3 × 3 surface
+    /// neighbourhood; else estimate it from the spread of the lighting over the 5 × 5
+    /// neighbourhood (which also counts real edges such as shadow boundaries as noise, and
+    /// so blurs them).
+    pub sample_variance: bool,
 }
 
 impl Default for DenoiseSettings {
@@ -96,6 +106,7 @@ impl Default for DenoiseSettings {
             sigma_normal: 128.0,
             sigma_plane: 0.02,
             sigma_luminance: 4.0,
+            sample_variance: true,
         }
     }
 }
@@ -118,6 +129,9 @@ pub struct LightingCube {
     pub object: Vec<u32>,
     /// Shading normal facing the ray; zero for a miss.
     pub normal: Vec<Vec3>,
+    /// The renderer's variance of the lighting's luminance
+    /// ([`RadianceSample::lighting_variance`]); zero where unknown.
+    pub variance: Vec<f32>,
 }
 
 impl LightingCube {
@@ -138,6 +152,7 @@ impl LightingCube {
             distance: Vec::new(),
             object: Vec::new(),
             normal: Vec::new(),
+            variance: Vec::new(),
         };
         for s in samples {
             let radiance = s.radiance.max(Vec3::ZERO);
@@ -148,6 +163,7 @@ impl LightingCube {
             c.distance.push(s.distance);
             c.object.push(pack_object_id(s.object));
             c.normal.push(s.normal);
+            c.variance.push(s.lighting_variance);
         }
         c
     }
