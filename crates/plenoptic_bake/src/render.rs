@@ -22,8 +22,8 @@ use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
 use plenoptic_trace::image::luminance;
 use plenoptic_trace::sampling::Sampler;
 use plenoptic_trace::{
-    AmbientField, CubeCamera, MultiStageRenderer, MultiStageSettings, PlacedScene,
-    RadianceSample, Ray, SceneAccel,
+    AmbientField, CubeCamera, MultiStageRenderer, MultiStageSettings, PlacedScene, RadianceSample,
+    Ray, SceneAccel,
 };
 use rayon::prelude::*;
 

@@ -22,7 +22,6 @@
 use glam::Vec3;
 use plenoptic_pack::cube::{direction_to_texel, face_uv_to_direction, texel_direction};
 
-
 /// A cube of face size `n`, with its texel directions.
 #[derive(Debug, Clone)]
 pub struct CubeGrid {

@@ -190,8 +190,14 @@ fn assert_edge_kept(c: &mut LightingCube, side: impl Fn(usize) -> Option<bool>, 
             .collect();
         assert!(border.len() > 10, "{name}: {} border texels", border.len());
         let (m, _) = mean_and_rms(border.iter().map(|&i| lum(i)), truth);
-        println!("{name}: side {truth}: {} texels at the edge, mean {m:.4}", border.len());
-        assert!((m - truth).abs() < 0.03 * truth, "{name}: side {truth} mean {m}");
+        println!(
+            "{name}: side {truth}: {} texels at the edge, mean {m:.4}",
+            border.len()
+        );
+        assert!(
+            (m - truth).abs() < 0.03 * truth,
+            "{name}: side {truth} mean {m}"
+        );
     }
 }
 
@@ -225,9 +231,8 @@ fn a_depth_step_is_not_blurred() {
     let mut c = cube(64, &geometry, level, 0.2, 5);
     let grid = CubeGrid::new(64);
     let (normal, dist) = (c.normal.clone(), c.distance.clone());
-    let side = move |i: usize| {
-        (normal[i] == Vec3::Y).then(|| (grid.direction(i) * dist[i]).y > -0.8)
-    };
+    let side =
+        move |i: usize| (normal[i] == Vec3::Y).then(|| (grid.direction(i) * dist[i]).y > -0.8);
     assert_edge_kept(&mut c, side, "depth step");
 }
 
@@ -294,20 +299,29 @@ fn a_gradient_across_a_seam_stays_continuous() {
     for [a, b, a_in, b_in] in seam_pairs(&grid) {
         // The step across the seam against the steps beside it, before and after.
         let jump = (l(&c, b) - l(&c, a)).abs();
-        let inner = (l(&c, a) - l(&c, a_in)).abs().max((l(&c, b_in) - l(&c, b)).abs());
+        let inner = (l(&c, a) - l(&c, a_in))
+            .abs()
+            .max((l(&c, b_in) - l(&c, b)).abs());
         let inner_in = (l(&input, a) - l(&input, a_in))
             .abs()
             .max((l(&input, b_in) - l(&input, b)).abs());
         let jump_in = (l(&input, b) - l(&input, a)).abs();
         worst_jump = worst_jump.max(jump / jump_in.max(1e-6));
         worst_inner = worst_inner.max(jump / inner.max(inner_in).max(1e-6));
-        worst_dev = worst_dev.max((l(&c, a) - l(&input, a)).abs().max((l(&c, b) - l(&input, b)).abs()));
+        worst_dev = worst_dev.max(
+            (l(&c, a) - l(&input, a))
+                .abs()
+                .max((l(&c, b) - l(&input, b)).abs()),
+        );
     }
     println!(
         "seam: jump/input jump ≤ {worst_jump:.3}, jump/inner step ≤ {worst_inner:.3}, |out − in| ≤ {worst_dev:.4}"
     );
     assert!(worst_jump < 1.5, "the seam step grew {worst_jump}×");
-    assert!(worst_inner < 2.0, "the seam step is {worst_inner}× the steps beside it");
+    assert!(
+        worst_inner < 2.0,
+        "the seam step is {worst_inner}× the steps beside it"
+    );
     // Not vacuous: the footprint (radius 62 texels) does reshape the gradient near the
     // horizon's cut, and it does so on both sides of the seam alike.
     assert!(worst_dev > 1e-3, "the filter did nothing ({worst_dev})");
@@ -317,7 +331,10 @@ fn a_gradient_across_a_seam_stays_continuous() {
 fn two_keys_of_a_static_scene_come_out_closer() {
     let settings = DenoiseSettings::default();
     let light = |d: Vec3, _: Vec3| 1.0 + 0.3 * d.y;
-    let (mut a, mut b) = (cube(48, &room, light, 0.2, 8), cube(48, &room, light, 0.2, 9));
+    let (mut a, mut b) = (
+        cube(48, &room, light, 0.2, 8),
+        cube(48, &room, light, 0.2, 9),
+    );
     let diff = |a: &LightingCube, b: &LightingCube| {
         let s: f64 = (0..a.len())
             .map(|i| f64::from((a.radiance(i) - b.radiance(i)).length_squared()))

@@ -117,8 +117,7 @@ impl<'f> MultiStageRenderer<'f> {
         let props = SurfaceProps::at(scene, &hit);
         if let Some(out) = first.as_deref_mut() {
             *out = RadianceSample::first_hit(&hit, ray);
-            out.albedo =
-                props.base_color * ((1.0 - props.metallic) * (1.0 - props.transmission));
+            out.albedo = props.base_color * ((1.0 - props.metallic) * (1.0 - props.transmission));
         }
         let mut diffuse = Vec3::ZERO;
         let mut l = Vec3::ZERO;
