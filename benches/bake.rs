@@ -8,12 +8,15 @@
 //! and time key), `volumes` (every base view), `write` (assembling the pack from the work
 //! directory's items: proxy geometry, tracks, manifest). All on all cores.
 //!
-//! `cargo bench --no-default-features --bench bake`
+//! `denoise`: the range-image denoiser (`plenoptic_bake::denoise`) on one 128-px and one
+//! 256-px cube of the scene with its guides, all cores; the cube's rendering is not timed.
+//!
+//! `cargo bench --no-default-features --bench bake` (`-- denoise` for the denoiser only)
 
 use std::hint::black_box;
 use std::path::Path;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use plenoptic_bake::bake::render_item;
 use plenoptic_bake::plan;
 use plenoptic_bake::render::BakeRenderer;
@@ -160,5 +163,46 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// The denoiser alone on one range image of the scene (real guides: ids, normals and
+/// distances of the room, the boxes and the lamp's lighting at 2 spp), per cube size.
+fn bench_denoise(c: &mut Criterion) {
+    use plenoptic_bake::denoise::cube::CubeGrid;
+    use plenoptic_bake::denoise::{DenoiseSettings, LightingCube, atrous::denoise_on};
+    use plenoptic_trace::{CubeCamera, MultiStageRenderer, MultiStageSettings};
+    let scene = scene();
+    let recipe = Recipe::from_str_named(RECIPE, "bench.toml", Path::new(".")).unwrap();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let (mut p, _) = plan::decompose(&recipe, &scene, &accel);
+    let fields = plan::ambient_phase(&mut p, &scene, &accel).unwrap();
+    let placed = accel.at_time(0.0);
+    let renderer = MultiStageRenderer::new(
+        MultiStageSettings {
+            samples_per_pixel: 2,
+            max_specular_depth: 1,
+            ..MultiStageSettings::default()
+        },
+        &fields[0],
+    );
+    let settings = DenoiseSettings::default();
+    let mut g = c.benchmark_group("denoise");
+    g.sample_size(10);
+    for n in [128u32, 256] {
+        let cube = CubeCamera::new(p.base_views[0].position, n).unwrap();
+        let lighting = LightingCube::from_faces(n, &renderer.render_cube(&placed, &cube));
+        let grid = CubeGrid::new(n);
+        g.bench_function(format!("cube_{n}"), |b| {
+            b.iter_batched(
+                || lighting.clone(),
+                |mut l| {
+                    denoise_on(&mut l, &grid, &settings);
+                    black_box(l)
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_denoise);
 criterion_main!(benches);

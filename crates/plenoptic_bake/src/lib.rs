@@ -13,7 +13,8 @@
 //! - [`render`]: range images (radiance, distance, object id, normal cubes) at every base
 //!   view and time key with the multi-stage renderer, the ambient field interpolated linearly
 //!   in time; [`volume`]: temporal volumes, random and adaptive (direction, t) samples with
-//!   validity radii.
+//!   validity radii; [`denoise`]: the edge-aware à-trous filter of the range images' diffuse
+//!   lighting (demodulated by albedo, seam-aware, guided by id, normal and distance).
 //! - [`write`](mod@write): chunks, proxy geometry, animation tracks, manifest and statistics; the pack is
 //!   assembled in a canonical order.
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
@@ -82,6 +83,7 @@
 
 pub mod bake;
 pub mod daylight;
+pub mod denoise;
 pub mod error;
 pub mod input;
 pub mod materials;

@@ -7,6 +7,9 @@
 //! (volumes), and results are collected in a fixed order, so the output does not depend on
 //! the number of threads.
 //!
+//! Denoising: with `quality.denoise` the diffuse lighting of every range image is filtered
+//! before it is quantised into the pack ([`crate::denoise`]); volume samples are not.
+//!
 //! Object ids: the pack reserves 0 for "no object", so a scene object `i` is stored as `i + 1`
 //! ([`pack_object_id`]). Misses have infinite distance and a zero normal.
 
@@ -19,11 +22,12 @@ use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
 use plenoptic_trace::image::luminance;
 use plenoptic_trace::sampling::Sampler;
 use plenoptic_trace::{
-    AmbientField, CubeCamera, MultiStageRenderer, MultiStageSettings, RadianceSample, Ray,
-    SceneAccel,
+    AmbientField, CubeCamera, MultiStageRenderer, MultiStageSettings, PlacedScene, RadianceSample,
+    Ray, SceneAccel,
 };
 use rayon::prelude::*;
 
+use crate::denoise::{DenoiseSettings, LightingCube};
 use crate::error::Result;
 use crate::plan::{Plan, ambient::field_at};
 
@@ -96,9 +100,8 @@ impl<'a> BakeRenderer<'a> {
             &field,
         );
         let n = self.plan.quality.range_image_size.max(1);
-        let cube = CubeCamera::new(view.position, n)?;
-        let faces = renderer.render_cube(&placed, &cube);
-        Ok(to_range_image(n, &faces))
+        let denoise = self.plan.quality.denoise.then(DenoiseSettings::default);
+        render_range_image(&renderer, &placed, view.position, n, denoise.as_ref())
     }
 
     /// The ambient field at time `t`, interpolated once per distinct `t` and cached (volume
@@ -146,6 +149,34 @@ impl<'a> BakeRenderer<'a> {
         let mut sampler = Sampler::new(seed, stream, 0);
         renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler)
     }
+}
+
+/// The range image of face size `n` seen from `position` with `renderer`, its diffuse
+/// lighting denoised with `denoise` when given ([`crate::denoise`]). Without denoising the
+/// result is exactly [`to_range_image`] of the rendered faces.
+pub fn render_range_image(
+    renderer: &MultiStageRenderer<'_>,
+    placed: &PlacedScene<'_>,
+    position: Vec3,
+    n: u32,
+    denoise: Option<&DenoiseSettings>,
+) -> Result<RangeImage> {
+    let cube = CubeCamera::new(position, n)?;
+    let faces = renderer.render_cube(placed, &cube);
+    Ok(match denoise {
+        None => to_range_image(n, &faces),
+        Some(settings) => {
+            let mut lighting = LightingCube::from_faces(n, &faces);
+            // One sample per pixel reports no variance: estimate it from the image.
+            let settings = DenoiseSettings {
+                sample_variance: settings.sample_variance
+                    && renderer.settings.samples_per_pixel >= 2,
+                ..*settings
+            };
+            crate::denoise::denoise(&mut lighting, &settings);
+            lighting.to_range_image()
+        }
+    })
 }
 
 /// Converts six rendered faces (KTX2 layer order, `n`² pixels each) into a range image.

@@ -514,3 +514,31 @@ fn reference_render_and_compare_commands() {
     );
     assert_eq!(text.lines().count(), 3, "{text}");
 }
+
+#[test]
+fn quality_denoise_filters_the_stored_lighting_and_keeps_the_guides() {
+    // The static room at 4 spp, baked with and without `denoise = true`: the guides are the
+    // same, the radiance is not, and its mean over the cube stays within 2 %.
+    let bake_with = |denoise: bool| {
+        let dir = tempfile::tempdir().unwrap();
+        let recipe = write_recipe(
+            dir.path(),
+            &static_room(),
+            STATIC_SEGMENT,
+            &format!("q = 0.0\nsamples_per_pixel = 4\nrange_image_size = 24\ndenoise = {denoise}"),
+        );
+        let report = bake_recipe(&recipe, &BakeOptions::default()).unwrap();
+        assert_eq!(report.plan.quality.denoise, denoise);
+        let pack = PackReader::open(pack_path(dir.path())).unwrap();
+        pack.range_image(0, 0).unwrap()
+    };
+    let (off, on) = (bake_with(false), bake_with(true));
+    assert_eq!(off.object_id, on.object_id);
+    assert_eq!(off.distance, on.distance);
+    assert_ne!(off.radiance, on.radiance);
+    let mean = |c: &plenoptic_pack::CubeImage<glam::Vec3>| {
+        c.texels.iter().map(|t| t.x + t.y + t.z).sum::<f32>() / c.texels.len() as f32
+    };
+    let (m_off, m_on) = (mean(&off.radiance), mean(&on.radiance));
+    assert!((m_on / m_off - 1.0).abs() < 0.02, "mean {m_off} → {m_on}");
+}

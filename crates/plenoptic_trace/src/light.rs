@@ -307,10 +307,69 @@ pub fn estimate_direct(
     samples: u32,
     sampler: &mut Sampler,
 ) -> Vec3 {
+    direct(placed, hit, bsdf, lobes, competing, samples, sampler, false).total
+}
+
+/// What [`estimate_direct_split`] returns: direct light and its Lambertian part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirectLight {
+    /// All of it: what [`estimate_direct`] returns for the same random numbers.
+    pub total: Vec3,
+    /// The part reflected by the Lambertian lobe, with its share of the MIS weights;
+    /// `total − diffuse` is the specular/glossy part.
+    pub diffuse: Vec3,
+}
+
+/// [`estimate_direct`] with the Lambertian lobe's share kept apart (the bake's denoiser
+/// filters diffuse lighting only). Draws the same random numbers and returns the same total;
+/// the split costs a few more BSDF evaluations per light sample.
+pub fn estimate_direct_split(
+    placed: &PlacedScene<'_>,
+    hit: &Hit,
+    bsdf: &Bsdf,
+    lobes: Lobes,
+    competing: Competing<'_>,
+    samples: u32,
+    sampler: &mut Sampler,
+) -> DirectLight {
+    direct(placed, hit, bsdf, lobes, competing, samples, sampler, true)
+}
+
+/// The Lambertian part of [`weighted`]`(bsdf, wi, f_all, light_pdf, strategies)` where `lobes`
+/// were evaluated: the diffuse BSDF value with the weights of the strategies that contain it.
+fn diffuse_part(bsdf: &Bsdf, wi: Vec3, lobes: Lobes, light_pdf: f32, strategies: &[Lobes]) -> Vec3 {
+    if lobes == Lobes::Specular {
+        return Vec3::ZERO;
+    }
+    let (f_d, _) = bsdf.eval(wi, Lobes::Diffuse);
+    if f_d == Vec3::ZERO {
+        return f_d;
+    }
+    let mut w = 1.0;
+    for &l in strategies {
+        if l != Lobes::Specular {
+            w += power_heuristic(light_pdf, bsdf.eval(wi, l).1) - 1.0;
+        }
+    }
+    f_d * w
+}
+
+#[allow(clippy::too_many_arguments)]
+fn direct(
+    placed: &PlacedScene<'_>,
+    hit: &Hit,
+    bsdf: &Bsdf,
+    lobes: Lobes,
+    competing: Competing<'_>,
+    samples: u32,
+    sampler: &mut Sampler,
+    split: bool,
+) -> DirectLight {
     let scene = placed.scene();
     let lights = placed.lights();
     let n = bsdf.normal();
     let mut total = Vec3::ZERO;
+    let mut diffuse = Vec3::ZERO;
     for i in 0..lights.punctual_count() {
         let u = if lights.punctual[i].0.angular_radius > 0.0 {
             sampler.next_2d()
@@ -329,9 +388,14 @@ pub fn estimate_direct(
             continue;
         }
         total += f * ls.value * ls.wi.dot(n).abs();
+        if split {
+            diffuse += diffuse_part(bsdf, ls.wi, lobes, f32::INFINITY, &[])
+                * ls.value
+                * ls.wi.dot(n).abs();
+        }
     }
     if samples > 0 && lights.has_emissive() {
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut sum_d) = (Vec3::ZERO, Vec3::ZERO);
         for _ in 0..samples {
             let u_pick = sampler.next_f32();
             let u = sampler.next_2d();
@@ -348,14 +412,20 @@ pub fn estimate_direct(
                 continue;
             }
             sum += f * ls.value * (ls.wi.dot(n).abs() / ls.pdf);
+            if split {
+                sum_d += diffuse_part(bsdf, ls.wi, lobes, ls.pdf, competing.emissive)
+                    * ls.value
+                    * (ls.wi.dot(n).abs() / ls.pdf);
+            }
         }
         total += sum / samples as f32;
+        diffuse += sum_d / samples as f32;
     }
     if let Some((env_lobes, env_competing)) = competing.environment
         && samples > 0
         && lights.env.can_sample()
     {
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut sum_d) = (Vec3::ZERO, Vec3::ZERO);
         for _ in 0..samples {
             let Some(es) = lights.env.sample(sampler.next_2d()) else {
                 continue;
@@ -373,8 +443,14 @@ pub fn estimate_direct(
                 continue;
             }
             sum += f * es.radiance * (es.wi.dot(n).abs() / es.pdf);
+            if split {
+                sum_d += diffuse_part(bsdf, es.wi, env_lobes, es.pdf, env_competing)
+                    * es.radiance
+                    * (es.wi.dot(n).abs() / es.pdf);
+            }
         }
         total += sum / samples as f32;
+        diffuse += sum_d / samples as f32;
     }
-    total
+    DirectLight { total, diffuse }
 }

@@ -5,7 +5,7 @@ use plenoptic_scene::{NO_OBJECT, ObjectId};
 
 use crate::accel::{Hit, Ray};
 use crate::camera::Camera;
-use crate::image::Image;
+use crate::image::{Image, luminance};
 use crate::sampling::Sampler;
 
 /// Radiance along one ray with what the first hit tells about the surface.
@@ -19,6 +19,22 @@ pub struct RadianceSample {
     pub object: ObjectId,
     /// Shading normal of the first hit facing the ray; zero for a miss.
     pub normal: Vec3,
+    /// The part of `radiance` that the first hit's Lambertian lobe reflects: direct light
+    /// through the diffuse lobe plus the ambient field's indirect diffuse light. `radiance −
+    /// diffuse` is emission and the specular/view-dependent part. Filled by the multi-stage
+    /// renderer (the bake's denoiser filters `diffuse / albedo` and nothing else); zero from
+    /// the path tracer, which does not split.
+    pub diffuse: Vec3,
+    /// Diffuse albedo of the first hit, `(1 − metallic)(1 − transmission) · base colour` with
+    /// textures and vertex colours applied (no Fresnel factor: that stays in the lighting).
+    /// `diffuse / albedo` is the hit's diffuse lighting, what pack v2 stores apart from
+    /// reflectance. Zero for a miss and from the path tracer.
+    pub albedo: Vec3,
+    /// Variance of the mean over the pixel's samples of the diffuse lighting's luminance
+    /// (each sample's `luminance(diffuse) / luminance(albedo)`): the noise the bake's denoiser
+    /// weighs luminance differences against. Zero with one sample per pixel (unknown) and
+    /// where `diffuse` is zero.
+    pub lighting_variance: f32,
 }
 
 impl RadianceSample {
@@ -29,6 +45,9 @@ impl RadianceSample {
         distance: f32::INFINITY,
         object: NO_OBJECT,
         normal: Vec3::ZERO,
+        diffuse: Vec3::ZERO,
+        albedo: Vec3::ZERO,
+        lighting_variance: 0.0,
     };
 
     pub(crate) fn first_hit(hit: &Hit, ray: &Ray) -> Self {
@@ -42,12 +61,16 @@ impl RadianceSample {
             distance: hit.distance,
             object: hit.object,
             normal: n,
+            diffuse: Vec3::ZERO,
+            albedo: Vec3::ZERO,
+            lighting_variance: 0.0,
         }
     }
 }
 
-/// Renders `camera` with `spp` jittered samples per pixel: radiance is the mean, the auxiliary
-/// fields come from a ray through the pixel centre. Sample k of pixel i draws from
+/// Renders `camera` with `spp` jittered samples per pixel: radiance, its diffuse part and the
+/// albedo are means over the samples (so `diffuse / albedo` demodulates textures the way the
+/// pixel saw them), the other auxiliary fields come from a ray through the pixel centre. Sample k of pixel i draws from
 /// `Sampler::new(seed, i, k)`, so the image is the same for any thread count.
 pub fn render_camera<C, F>(camera: &C, spp: u32, seed: u64, f: F) -> Image<RadianceSample>
 where
@@ -58,7 +81,8 @@ where
     let spp = spp.max(1);
     Image::render(w, h, |x, y| {
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
         for k in 0..spp {
@@ -77,12 +101,31 @@ where
                 aux = r;
             }
             sum += r.radiance;
+            diffuse += r.diffuse;
+            albedo += r.albedo;
+            let a = luminance(r.albedo);
+            let l = if a > 1e-3 {
+                f64::from(luminance(r.diffuse) / a)
+            } else {
+                0.0
+            };
+            l1 += l;
+            l2 += l * l;
         }
         if !any {
             return RadianceSample::MISS;
         }
         RadianceSample {
             radiance: sum / spp as f32,
+            diffuse: diffuse / spp as f32,
+            albedo: albedo / spp as f32,
+            lighting_variance: if spp > 1 {
+                // Unbiased sample variance, over spp for the variance of the mean.
+                let n = f64::from(spp);
+                ((l2 - l1 * l1 / n).max(0.0) / (n - 1.0) / n) as f32
+            } else {
+                0.0
+            },
             ..aux
         }
     })

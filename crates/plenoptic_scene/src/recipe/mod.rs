@@ -156,6 +156,8 @@ pub struct QualityToml {
     pub max_specular_depth: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_samples_per_pixel: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoise: Option<bool>,
 }
 
 /// A validated recipe.
@@ -512,7 +514,8 @@ impl QualityToml {
             ambient_rms,
             temporal_volume_samples,
             max_specular_depth,
-            reference_samples_per_pixel
+            reference_samples_per_pixel,
+            denoise
         );
         check_quality(&q, err)?;
         Ok(q)

@@ -47,6 +47,9 @@ impl Preset {
     }
 }
 
+/// Whether the presets denoise the range images (see [`Quality::denoise`]).
+pub const DENOISE_DEFAULT: bool = false;
+
 /// Bake quality settings (docs/architecture.md "Baking"; thesis ch. 5–7). Start from a preset and
 /// override single fields; every field states its cost.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -86,6 +89,12 @@ pub struct Quality {
     /// Samples per pixel of the reference path tracer that renders ground truth for the
     /// metrics. Not part of the pack: only the error report's trustworthiness depends on it.
     pub reference_samples_per_pixel: u32,
+    /// Denoise the range images' diffuse lighting before quantisation (edge-aware à-trous
+    /// filter guided by object id, normal and distance; `plenoptic_bake::denoise`). Textures,
+    /// emission and reflections are not filtered. Costs well under the rendering of a range
+    /// image; removes most of the pixel noise of few samples per pixel.
+    #[serde(default)]
+    pub denoise: bool,
 }
 
 impl Quality {
@@ -103,6 +112,7 @@ impl Quality {
             temporal_volume_samples: 20_000,
             max_specular_depth: 2,
             reference_samples_per_pixel: 64,
+            denoise: DENOISE_DEFAULT,
         }
     }
 
@@ -120,6 +130,7 @@ impl Quality {
             temporal_volume_samples: 100_000,
             max_specular_depth: 4,
             reference_samples_per_pixel: 256,
+            denoise: DENOISE_DEFAULT,
         }
     }
 
@@ -137,6 +148,7 @@ impl Quality {
             temporal_volume_samples: 500_000,
             max_specular_depth: 6,
             reference_samples_per_pixel: 1024,
+            denoise: DENOISE_DEFAULT,
         }
     }
 
@@ -154,6 +166,7 @@ impl Quality {
             temporal_volume_samples: 2_000_000,
             max_specular_depth: 8,
             reference_samples_per_pixel: 4096,
+            denoise: DENOISE_DEFAULT,
         }
     }
 }

@@ -13,6 +13,11 @@
 //! + specular reflection and refraction traced recursively up to `max_specular_depth`
 //!   (one ray for ideal lobes, `glossy_samples` GGX samples for rough ones at the first hit).
 //!
+//! The first hit's Lambertian share (its direct light through the diffuse lobe plus the
+//! ambient term) is returned apart as [`RadianceSample::diffuse`], with the hit's diffuse
+//! albedo, for the bake's denoiser (pack v2: lighting apart from reflectance). Splitting draws
+//! no extra random numbers: the radiance is the same with or without it.
+//!
 //! Emitters and the environment found by glossy rays and by light sampling are combined with
 //! the power heuristic; the diffuse lobe sees emitters through light sampling only. A ray that
 //! leaves the scene returns the environment's radiance (the sky behind windows).
@@ -24,7 +29,7 @@ use super::AmbientField;
 use crate::accel::{PlacedScene, Ray};
 use crate::camera::{Camera, CubeCamera};
 use crate::image::Image;
-use crate::light::{Competing, estimate_direct};
+use crate::light::{Competing, estimate_direct_split};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::render::{RadianceSample, render_camera};
 use crate::sampling::{Sampler, power_heuristic};
@@ -80,9 +85,8 @@ impl<'f> MultiStageRenderer<'f> {
         sampler: &mut Sampler,
     ) -> RadianceSample {
         let mut out = RadianceSample::MISS;
-        out.radiance = self.shade(placed, ray, sampler, 0, None, &mut |hit| {
-            out = RadianceSample::first_hit(hit, ray);
-        });
+        let radiance = self.shade(placed, ray, sampler, 0, None, Some(&mut out));
+        out.radiance = radiance;
         out
     }
 
@@ -93,7 +97,8 @@ impl<'f> MultiStageRenderer<'f> {
         s: &mut Sampler,
         depth: u32,
         prev_pdf: Option<f32>,
-        on_hit: &mut dyn FnMut(&crate::Hit),
+        // At the first hit: receives the hit's auxiliary data, albedo and diffuse part.
+        mut first: Option<&mut RadianceSample>,
     ) -> Vec3 {
         let Some(hit) = placed.intersect(ray) else {
             // The environment: seen directly, through delta bounces, or weighted against
@@ -108,9 +113,13 @@ impl<'f> MultiStageRenderer<'f> {
             };
             return env.radiance(ray.direction) * w;
         };
-        on_hit(&hit);
         let scene = placed.scene();
         let props = SurfaceProps::at(scene, &hit);
+        if let Some(out) = first.as_deref_mut() {
+            *out = RadianceSample::first_hit(&hit, ray);
+            out.albedo = props.base_color * ((1.0 - props.metallic) * (1.0 - props.transmission));
+        }
+        let mut diffuse = Vec3::ZERO;
         let mut l = Vec3::ZERO;
         let le = props.emission(&hit);
         if le != Vec3::ZERO {
@@ -130,7 +139,9 @@ impl<'f> MultiStageRenderer<'f> {
                 emissive: &[Lobes::Specular],
                 environment: Some((Lobes::Specular, &[Lobes::Specular])),
             };
-            l += estimate_direct(placed, &hit, &bsdf, Lobes::All, competing, n, s);
+            let direct = estimate_direct_split(placed, &hit, &bsdf, Lobes::All, competing, n, s);
+            l += direct.total;
+            diffuse += direct.diffuse;
         }
         if bsdf.has(Lobes::Diffuse) {
             // One-sample estimate of the Lambertian lobe's directional albedo (its Fresnel
@@ -139,7 +150,12 @@ impl<'f> MultiStageRenderer<'f> {
             let albedo = bsdf
                 .sample(u_lobe, s.next_2d(), Lobes::Diffuse)
                 .map_or(Vec3::ZERO, |b| b.weight);
-            l += albedo * self.field.irradiance_seen(placed, &hit, wo) / PI;
+            let ambient = albedo * self.field.irradiance_seen(placed, &hit, wo) / PI;
+            l += ambient;
+            diffuse += ambient;
+        }
+        if let Some(out) = first {
+            out.diffuse = diffuse;
         }
         if depth < self.settings.max_specular_depth && bsdf.has(Lobes::Specular) {
             let rough = !bsdf.is_delta(Lobes::Specular);
@@ -157,7 +173,7 @@ impl<'f> MultiStageRenderer<'f> {
                 };
                 let next = Ray::new(hit.offset_origin(bs.wi), bs.wi);
                 let pdf = (!bs.delta).then_some(bs.pdf);
-                sum += bs.weight * self.shade(placed, &next, s, depth + 1, pdf, &mut |_| {});
+                sum += bs.weight * self.shade(placed, &next, s, depth + 1, pdf, None);
             }
             l += sum / count as f32;
         }

@@ -1,0 +1,218 @@
+//! Denoising of the baked lighting before quantisation (issue 12, item 4; docs/architecture.md,
+//! "Pack v2: lighting from the pack, detail from the geometry": the diffuse lighting per texel,
+//! "denoised in the bake (edge-aware, guided by id, normal and distance, continuous across
+//! cube seams and time keys)"; thesis ch. 8, separating illumination quality from image
+//! quality).
+//!
+//! # What is filtered
+//!
+//! A range-image texel's radiance is split by the multi-stage renderer
+//! ([`plenoptic_trace::RadianceSample::diffuse`], [`plenoptic_trace::RadianceSample::albedo`])
+//! into a [`LightingCube`]:
+//!
+//! `radiance = albedo ⊙ lighting + residual`
+//!
+//! - `lighting`: the first hit's diffuse lighting, diffuse radiance / diffuse albedo per
+//!   channel (demodulated: textures are divided out, so filtering it does not blur them). This
+//!   is the only part filtered.
+//! - `albedo`: `(1 − metallic)(1 − transmission) · base colour`, mean over the texel's samples.
+//! - `residual`: emission, the specular/view-dependent part (glossy and mirror reflections,
+//!   refraction, the environment seen directly) and the diffuse radiance of channels whose
+//!   albedo is below [`MIN_ALBEDO`]. Not filtered: a reflection's detail is geometry seen in
+//!   another direction, not noise, and guides of the first hit cannot tell its edges.
+//!
+//! This record is pack v2's "lighting apart from reflectance": the pack can store `lighting`
+//! (and `residual` as the view-dependent part) and the runtime multiply by `albedo(uv)`.
+//!
+//! # The filter
+//!
+//! Edge-avoiding à-trous wavelet transform: H. Dammertz, D. Sewtz, J. Hanika, H. P. A. Lensch,
+//! "Edge-Avoiding À-Trous Wavelet Transform for fast Global Illumination Filtering", HPG 2010
+//! ([`atrous`]). Passes of a 5 × 5 B3-spline kernel with holes (step 1, 2, 4, …), each tap
+//! weighted by edge-stopping functions of the guides. Variant, and why:
+//!
+//! - Guides: the object id (taps on another object have weight 0), the normal
+//!   (`max(0, n_p·n_q)^σ_n`) and the distance, as the distance of the tap's surface point from
+//!   the tangent plane at the centre texel relative to the centre's distance (a plane seen at
+//!   a grazing angle keeps its weights; a depth step on one object is cut). Dammertz et al.
+//!   used world position and normal; the plane distance is the cube's equivalent that does not
+//!   depend on how far the surface is.
+//! - Luminance: instead of Dammertz et al.'s colour weight with a σ halved every pass, the
+//!   luminance weight of SVGF (Schied et al., "Spatiotemporal Variance-Guided Filtering", HPG
+//!   2017): `exp(−|ℓ_p − ℓ_q| / (σ_ℓ √var_p))`, with the variance of the texel's samples from
+//!   the renderer ([`RadianceSample::lighting_variance`]) smoothed over its 3 × 3 surface
+//!   neighbourhood, and carried through the passes (`var' = Σ w² var / (Σ w)²`). It keeps
+//!   shadow edges that are well above the noise: a sun shadow's edge is sharp and noise-free
+//!   in every sample, so it is not averaged away. With one sample per pixel the variance is
+//!   estimated from the lighting's spread over 5 × 5 texels instead, which counts such edges
+//!   as noise (measured: it blurs the sunlit floor's shadow edges). `σ_ℓ = ∞` turns the
+//!   weight off, and then every weight depends on the guides alone.
+//! - Seams: taps are addressed through their direction ([`cube::CubeGrid::offset`]), so the
+//!   footprint crosses face edges as if the cube were one surface.
+//! - Time keys: for static geometry the guides (id, normal, distance of the pixel-centre ray)
+//!   are identical at every key of a base view, so the geometric weights are too, and the
+//!   independent noise of two keys is averaged over the same footprints: their difference
+//!   shrinks with their noise (flicker). A temporal term across keys is not part of this:
+//!   range images are rendered as independent work items (resumable, shardable), and the
+//!   spatial filter already gives the consistency above.
+//!
+//! Each pass runs in parallel over texels (rayon) and is deterministic whatever the thread
+//! count. Cost: `25 · passes` taps per texel; see `benches/bake.rs` (`denoise`).
+
+pub mod atrous;
+pub mod cube;
+#[cfg(test)]
+mod tests;
+
+use glam::Vec3;
+use plenoptic_pack::{CubeImage, RangeImage};
+use plenoptic_trace::{Image, RadianceSample};
+use serde::{Deserialize, Serialize};
+
+use crate::render::pack_object_id;
+
+pub use atrous::denoise;
+
+/// Albedo channels below this are not demodulated: their diffuse radiance goes to the
+/// residual, unfiltered (dividing by a near-zero albedo would amplify noise without bound).
+pub const MIN_ALBEDO: f32 = 1e-3;
+
+/// Settings of the denoiser.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DenoiseSettings {
+    /// À-trous passes; pass `k` uses holes of `2^k` texels, so the footprint's radius is
+    /// `2·(2^passes − 1)` texels. Cost is linear in it.
+    pub passes: u32,
+    /// Exponent of the normal weight `max(0, n_p·n_q)^σ_n`.
+    pub sigma_normal: f32,
+    /// Scale of the plane-distance weight, relative to the centre texel's distance:
+    /// `exp(−(|n_p·(x_q − x_p)| / (σ_z d_p))²)`.
+    pub sigma_plane: f32,
+    /// Scale of the luminance weight in standard deviations of the noise; infinite turns
+    /// the luminance weight off (weights from the guides alone).
+    pub sigma_luminance: f32,
+    /// Take the noise from the renderer's per-texel variance ([`LightingCube::variance`],
+    /// which needs two or more samples per pixel), smoothed over the 3 × 3 surface
+    /// neighbourhood; else estimate it from the spread of the lighting over the 5 × 5
+    /// neighbourhood (which also counts real edges such as shadow boundaries as noise, and
+    /// so blurs them).
+    pub sample_variance: bool,
+}
+
+impl Default for DenoiseSettings {
+    fn default() -> Self {
+        Self {
+            passes: 5,
+            sigma_normal: 128.0,
+            sigma_plane: 0.02,
+            sigma_luminance: 4.0,
+            sample_variance: true,
+        }
+    }
+}
+
+/// A cube of per-texel lighting records with their guides (see the module doc):
+/// `radiance = albedo ⊙ lighting + residual`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightingCube {
+    /// Texels per face edge.
+    pub face_size: u32,
+    /// Diffuse lighting (demodulated diffuse radiance); the part the denoiser filters.
+    pub lighting: Vec<Vec3>,
+    /// Diffuse albedo.
+    pub albedo: Vec<Vec3>,
+    /// Emission, the specular/view-dependent part and undemodulated diffuse radiance.
+    pub residual: Vec<Vec3>,
+    /// Distance along the texel's centre ray; infinite for a miss.
+    pub distance: Vec<f32>,
+    /// Pack object id (0: none).
+    pub object: Vec<u32>,
+    /// Shading normal facing the ray; zero for a miss.
+    pub normal: Vec<Vec3>,
+    /// The renderer's variance of the lighting's luminance
+    /// ([`RadianceSample::lighting_variance`]); zero where unknown.
+    pub variance: Vec<f32>,
+}
+
+impl LightingCube {
+    /// Splits six rendered faces (KTX2 layer order, `n`² pixels each) into records.
+    pub fn from_faces(n: u32, faces: &[Image<RadianceSample>; 6]) -> Self {
+        let nn = (n * n) as usize;
+        let samples = || (0..6 * nn).map(|i| &faces[i / nn].pixels[i % nn]);
+        Self::from_samples(n, samples())
+    }
+
+    /// Splits `6·n²` samples in cube order into records.
+    pub fn from_samples<'s>(n: u32, samples: impl Iterator<Item = &'s RadianceSample>) -> Self {
+        let mut c = Self {
+            face_size: n,
+            lighting: Vec::new(),
+            albedo: Vec::new(),
+            residual: Vec::new(),
+            distance: Vec::new(),
+            object: Vec::new(),
+            normal: Vec::new(),
+            variance: Vec::new(),
+        };
+        for s in samples {
+            let radiance = s.radiance.max(Vec3::ZERO);
+            let (lighting, albedo, residual) = split(radiance, s.diffuse, s.albedo);
+            c.lighting.push(lighting);
+            c.albedo.push(albedo);
+            c.residual.push(residual);
+            c.distance.push(s.distance);
+            c.object.push(pack_object_id(s.object));
+            c.normal.push(s.normal);
+            c.variance.push(s.lighting_variance);
+        }
+        c
+    }
+
+    /// Number of texels.
+    pub fn len(&self) -> usize {
+        self.lighting.len()
+    }
+
+    /// Whether there are no texels.
+    pub fn is_empty(&self) -> bool {
+        self.lighting.is_empty()
+    }
+
+    /// Whether texel `i` has lighting to filter: a hit with some albedo.
+    pub fn filterable(&self, i: usize) -> bool {
+        self.object[i] != 0 && self.albedo[i].max_element() > MIN_ALBEDO
+    }
+
+    /// Radiance of texel `i`: `albedo ⊙ lighting + residual`, never negative.
+    pub fn radiance(&self, i: usize) -> Vec3 {
+        (self.albedo[i] * self.lighting[i] + self.residual[i]).max(Vec3::ZERO)
+    }
+
+    /// The range image of the records: radiance re-modulated, the guides as they are.
+    pub fn to_range_image(&self) -> RangeImage {
+        let n = self.face_size;
+        RangeImage {
+            radiance: CubeImage::from_fn(n, |i, _| self.radiance(i)),
+            distance: CubeImage::from_fn(n, |i, _| self.distance[i]),
+            object_id: CubeImage::from_fn(n, |i, _| self.object[i]),
+            normal: CubeImage::from_fn(n, |i, _| self.normal[i]),
+        }
+    }
+}
+
+/// `(lighting, albedo, residual)` of a texel with `radiance`, of which `diffuse` is the
+/// Lambertian part, over `albedo`.
+fn split(radiance: Vec3, diffuse: Vec3, albedo: Vec3) -> (Vec3, Vec3, Vec3) {
+    let diffuse = diffuse.max(Vec3::ZERO).min(radiance);
+    let mut lighting = Vec3::ZERO;
+    let mut kept = Vec3::ZERO;
+    for c in 0..3 {
+        if albedo[c] > MIN_ALBEDO {
+            lighting[c] = diffuse[c] / albedo[c];
+            kept[c] = diffuse[c];
+        }
+    }
+    // What is not demodulated stays in the residual, so radiance is exactly recovered.
+    let albedo = Vec3::select(albedo.cmpgt(Vec3::splat(MIN_ALBEDO)), albedo, Vec3::ZERO);
+    (lighting, albedo, radiance - kept)
+}
