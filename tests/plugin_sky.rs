@@ -153,6 +153,23 @@ fn cpu_camera(eye: Vec3, transform: &Transform) -> plenoptic_recon::Camera {
     .unwrap()
 }
 
+/// The sky pack in a new directory, its reconstructor, and the CPU camera, transform and time
+/// of [`view`].
+fn sky_fixture() -> (
+    tempfile::TempDir,
+    Reconstructor,
+    plenoptic_recon::Camera,
+    Transform,
+    f32,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    sky_pack(&path);
+    let (eye, transform, t) = view();
+    let rec = Reconstructor::open(&path).unwrap();
+    (dir, rec, cpu_camera(eye, &transform), transform, t)
+}
+
 /// The pixels that see no proxy geometry (object id 0 in the mask): where the sky shows.
 fn no_proxy_pixels(object: &[u32]) -> Vec<usize> {
     (0..object.len()).filter(|&j| object[j] == 0).collect()
@@ -242,12 +259,7 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
 /// background behind the proxies), so its sky is on screen.
 #[test]
 fn cpu_backend_shows_the_sky() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sky.pack");
-    sky_pack(&path);
-    let (eye, transform, t) = view();
-    let rec = Reconstructor::open(&path).unwrap();
-    let cam = cpu_camera(eye, &transform);
+    let (dir, rec, cam, transform, t) = sky_fixture();
     let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     let mask = rec.proxy().unwrap().mask_raster(&cam, t);
     let sky_pixels = no_proxy_pixels(&mask.object);
@@ -423,12 +435,7 @@ fn gpu_window_open_or_glazed_matches_cpu() {
 /// alike: the tunables reach WGSL from the camera's settings, not from constants.
 #[test]
 fn a_recon_settings_change_moves_gpu_and_cpu_alike() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sky.pack");
-    sky_pack(&path);
-    let (eye, transform, t) = view();
-    let cam = cpu_camera(eye, &transform);
-    let mut rec = Reconstructor::open(&path).unwrap();
+    let (dir, mut rec, cam, transform, t) = sky_fixture();
     let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
     let mut frames = Vec::new();
     // Base views blended: both of the pack's, then only the nearest (the streaming working
@@ -474,12 +481,7 @@ fn a_recon_settings_change_moves_gpu_and_cpu_alike() {
 /// of the same object and distance, as the CPU's do.
 #[test]
 fn gpu_bilinear_lookups_match_cpu() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sky.pack");
-    sky_pack(&path);
-    let (eye, transform, t) = view();
-    let cam = cpu_camera(eye, &transform);
-    let mut rec = Reconstructor::open(&path).unwrap();
+    let (dir, mut rec, cam, transform, t) = sky_fixture();
     let (nearest, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     rec.settings.cube_filter = plenoptic_recon::CubeFilter::Bilinear;
     let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
