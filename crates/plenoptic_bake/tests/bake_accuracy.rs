@@ -244,6 +244,24 @@ fn two_rooms() -> Scene {
     plenoptic_scene::load_slice(&bytes, "two_rooms.glb", None).unwrap()
 }
 
+/// The CI's base views of the two rooms: (name, position, yaw, pitch).
+const VIEWS: [(&str, Vec3, f32, f32); 4] = [
+    ("sunlit floor", Vec3::new(-3.0, 1.6, -1.0), 0.6, -0.6),
+    ("mirror", Vec3::new(-1.0, 1.6, -1.2), 2.7, -0.1),
+    (
+        "indirect room, doorway",
+        Vec3::new(3.0, 1.6, 0.5),
+        1.3,
+        -0.25,
+    ),
+    (
+        "indirect room, corner",
+        Vec3::new(1.5, 1.6, -1.0),
+        -2.4,
+        -0.3,
+    ),
+];
+
 /// Four base views of the two rooms (the draft bake's ambient field): the sunlit floor, the
 /// mirror, and two views of the room lit only indirectly. Mean luminance within 3 %, 8 × 8
 /// block means within 5 % for 90 % of blocks, corrected relative LRMS ≤ 0.10.
@@ -261,22 +279,7 @@ fn base_views_agree_with_the_path_tracer() {
         start.elapsed().as_secs_f64()
     );
     let (w, h) = (32, 24);
-    let views = [
-        ("sunlit floor", Vec3::new(-3.0, 1.6, -1.0), 0.6, -0.6),
-        ("mirror", Vec3::new(-1.0, 1.6, -1.2), 2.7, -0.1),
-        (
-            "indirect room, doorway",
-            Vec3::new(3.0, 1.6, 0.5),
-            1.3,
-            -0.25,
-        ),
-        (
-            "indirect room, corner",
-            Vec3::new(1.5, 1.6, -1.0),
-            -2.4,
-            -0.3,
-        ),
-    ];
+    let views = VIEWS;
     let mut failures = Vec::new();
     for (name, p, yaw, pitch) in views {
         let f = base_view_frame(name, &accel, &field, &camera(p, yaw, pitch, w, h), 4096);
@@ -336,22 +339,7 @@ fn denoise_sweep(which: &[usize], variants: &[(&str, DenoiseSettings)]) {
     let quality = Quality::draft();
     let field = bake_field(&accel, &quality, 0.0);
     let placed = accel.at_time(0.0);
-    let views = [
-        ("sunlit floor", Vec3::new(-3.0, 1.6, -1.0), 0.6, -0.6),
-        ("mirror", Vec3::new(-1.0, 1.6, -1.2), 2.7, -0.1),
-        (
-            "indirect room, doorway",
-            Vec3::new(3.0, 1.6, 0.5),
-            1.3,
-            -0.25,
-        ),
-        (
-            "indirect room, corner",
-            Vec3::new(1.5, 1.6, -1.0),
-            -2.4,
-            -0.3,
-        ),
-    ];
+    let views = VIEWS;
     let renderer = |spp| {
         MultiStageRenderer::new(
             MultiStageSettings {
