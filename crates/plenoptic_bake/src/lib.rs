@@ -19,7 +19,7 @@
 //!   assembled in a canonical order.
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
 //! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA;
-//!   [`reference`]: path-traced reference frames along a camera path.
+//!   [`reference`](mod@reference): path-traced reference frames along a camera path.
 //! - [`delaunay3`]: the 3D Delaunay complex (x, y, t) of temporal volumes (a re-export of
 //!   [`plenoptic_recon::delaunay3`], which also slices it at reconstruction).
 //!
