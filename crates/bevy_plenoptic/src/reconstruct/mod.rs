@@ -390,7 +390,22 @@ fn update_materials(
         &MeshMaterial3d<background::PlenopticBackgroundMaterial>,
     )>,
     mut background_materials: ResMut<Assets<background::PlenopticBackgroundMaterial>>,
+    mut warned: Local<HashSet<AssetId<RadiancePack>>>,
 ) {
+    // The per-object materials carry one camera's lookups: say so, once per pack, when more
+    // cameras show it (issue: per-view state in the render world).
+    let mut seen: HashMap<AssetId<RadiancePack>, usize> = HashMap::new();
+    for (cam, _) in &cameras {
+        let n = seen.entry(cam.pack.id()).or_default();
+        *n += 1;
+        if *n == 2 && warned.insert(cam.pack.id()) {
+            warn!(
+                "plenoptic: several cameras show one pack; its proxies are reconstructed for \
+                 the first camera's position, time and mode only, so the others show that \
+                 camera's frame on them (the background is per camera)"
+            );
+        }
+    }
     let mut frames: HashMap<AssetId<RadiancePack>, FrameLookups> = HashMap::new();
     let mut frame = |id: AssetId<RadiancePack>, cam: &PlenopticCamera, at: Vec3| {
         let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
