@@ -22,7 +22,7 @@ use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
 use common::*;
 use pack::{PackSpec, open_room, windowed_room, write_pack_with};
-use plenoptic_pack::plenoptic_sky::{Environment, SkyParams, SunTrack, SunTrackSample};
+use plenoptic_pack::plenoptic_sky::{Environment, SkyParams};
 use plenoptic_recon::{Mode, Reconstructor};
 
 /// Compares `gpu` with `cpu` over the pixels `which`, as `plugin_scene_render.rs` does: per
@@ -35,6 +35,22 @@ fn compare(gpu: &[Vec3], cpu: &[Vec3], which: &[usize]) -> (f32, f32, f32) {
     let mean = which.iter().map(|&j| err(j)).sum::<f32>() / n;
     let frac = |limit: f32| which.iter().filter(|&&j| err(j) < limit).count() as f32 / n;
     (mean, frac(0.05), frac(0.2))
+}
+
+/// Asserts that `gpu` equals `cpu` over the pixels `which` within the GPU-versus-CPU bounds of
+/// `plugin_scene_render.rs` (mean relative error below 0.003, 99.5 % of pixels within 5 %,
+/// 99.9 % within 20 %), printing the figures as `what`; returns the mean.
+fn assert_gpu_matches(gpu: &[Vec3], cpu: &[Vec3], which: &[usize], what: &str) -> f32 {
+    let (mean, f5, f20) = compare(gpu, cpu, which);
+    eprintln!(
+        "GPU vs CPU, {what}: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} \
+         within 20 %"
+    );
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "{what}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+    mean
 }
 
 /// Renders until the camera's keys are resident and two read-backs agree.
@@ -50,17 +66,35 @@ fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
-    let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
-    let data = render_until(app, image.clone(), 600, |d| {
-        let px = rgba16f_pixels(d);
-        let shown = px.len() == (WIDTH * HEIGHT) as usize
-            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
-            && px.iter().any(|c| c.max_element() > 0.01);
-        let stable = prev.borrow().as_deref() == Some(d);
-        *prev.borrow_mut() = Some(d.to_vec());
-        shown && stable
-    });
-    rgba16f_pixels(&data)
+    // Two equal read-backs in a row are not enough: while a pipeline still compiles, Bevy
+    // skips what it draws (the glazing's transparent pipeline, on a loaded machine), and
+    // those frames are equal too. A frame counts once it is still the same after a further
+    // 0.3 s of updates.
+    let stable_frame = |app: &mut App| {
+        let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
+        render_until(app, image.clone(), 600, |d| {
+            let px = rgba16f_pixels(d);
+            let shown = px.len() == (WIDTH * HEIGHT) as usize
+                && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
+                && px.iter().any(|c| c.max_element() > 0.01);
+            let stable = prev.borrow().as_deref() == Some(d);
+            *prev.borrow_mut() = Some(d.to_vec());
+            shown && stable
+        })
+    };
+    let mut data = stable_frame(app);
+    for _ in 0..20 {
+        for _ in 0..15 {
+            app.update();
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let again = stable_frame(app);
+        if again == data {
+            return rgba16f_pixels(&data);
+        }
+        data = again;
+    }
+    panic!("the frame kept changing");
 }
 
 /// Writes the open room with a sky (scale 1: kcd/m², a few units, beside the test shading's
@@ -80,19 +114,7 @@ fn env_pack(path: &std::path::Path, env: Environment) {
 
 /// Writes `scene` with `env` and a moving sun to `path`.
 fn write_room_pack(scene: &plenoptic_scene::Scene, path: &std::path::Path, env: Environment) {
-    let track = SunTrack::new(vec![
-        SunTrackSample {
-            time: 0.0,
-            direction: Vec3::new(1.0, 0.15, 0.2).normalize(),
-            illuminance: Vec3::splat(20_000.0),
-        },
-        SunTrackSample {
-            time: 2.0,
-            direction: Vec3::new(-0.3, 1.0, -0.4).normalize(),
-            illuminance: Vec3::splat(100_000.0),
-        },
-    ])
-    .unwrap();
+    let track = pack::moving_sun();
     write_pack_with(
         scene,
         &PackSpec::segment(2, vec![0.0, 2.0], 16),
@@ -204,22 +226,8 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
     let gpu = settle(&mut app, camera, &image);
     // Measured on lavapipe: sky pixels mean 0.00053, all within 5 % (f16 rounding); the
     // whole frame mean 0.00049; EV100 + 1 is exactly half (a power of two in f16).
-    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
-    eprintln!(
-        "GPU vs CPU sky: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
-    );
-    assert!(
-        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-        "sky: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-    );
-    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &all);
-    eprintln!(
-        "GPU vs CPU frame: mean relative error {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
-    );
-    assert!(
-        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-        "frame: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-    );
+    assert_gpu_matches(&gpu, &cpu.radiance, &sky_pixels, "sky");
+    assert_gpu_matches(&gpu, &cpu.radiance, &all, "frame");
 
     // One EV100 more: half the light, everywhere (linear output, no tonemapping).
     app.world_mut().get_mut::<Exposure>(camera).unwrap().ev100 = EV100_UNIT + 1.0;
@@ -245,13 +253,11 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
         e.get_mut::<PlenopticCamera>().unwrap().mode = ReconMode::Image;
     }
     let gpu_image = settle(&mut app, camera, &image);
-    let (mean, f5, f20) = compare(&gpu_image, &cpu_image.radiance, &sky_pixels);
-    eprintln!(
-        "GPU vs CPU sky, image mode: mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %"
-    );
-    assert!(
-        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-        "image-mode sky: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    assert_gpu_matches(
+        &gpu_image,
+        &cpu_image.radiance,
+        &sky_pixels,
+        "image-mode sky",
     );
 }
 
@@ -367,17 +373,12 @@ fn gpu_image_and_uniform_environments_match_cpu() {
         assert!(sky_pixels.len() * 5 > mask.object.len());
         let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
         let gpu = settle(&mut app, camera, &image);
-        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &sky_pixels);
         let kind = if matches!(env, Environment::Image { .. }) {
             "image"
         } else {
             "uniform"
         };
-        eprintln!("GPU vs CPU {kind}: mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} within 20 %");
-        assert!(
-            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-            "{kind}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-        );
+        assert_gpu_matches(&gpu, &cpu.radiance, &sky_pixels, kind);
     }
 }
 
@@ -413,21 +414,12 @@ fn gpu_window_open_or_glazed_matches_cpu() {
 
         let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
         let gpu = settle(&mut app, camera, &image);
-        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &window);
-        eprintln!(
-            "GPU vs CPU, {name} window ({:.1} % of the frame): mean relative error {mean:.5}, \
-             {f5:.4} within 5 %, {f20:.4} within 20 %",
-            100.0 * fraction
-        );
-        let all: Vec<usize> = (0..mask.object.len()).collect();
-        let (all_mean, _, _) = compare(&gpu, &cpu.radiance, &all);
-        eprintln!("GPU vs CPU, {name}: whole frame mean {all_mean:.5}");
         // Measured on lavapipe: open 0.00033, glazed 0.00081 (the composite differs from the
         // pane's baked texels by 1.6, plenoptic_recon's glazing test).
-        assert!(
-            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-            "{name} window: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-        );
+        let what = format!("{name} window ({:.1} % of the frame)", 100.0 * fraction);
+        assert_gpu_matches(&gpu, &cpu.radiance, &window, &what);
+        let all: Vec<usize> = (0..mask.object.len()).collect();
+        assert_gpu_matches(&gpu, &cpu.radiance, &all, &format!("{name}, whole frame"));
     }
 }
 
@@ -450,15 +442,7 @@ fn a_recon_settings_change_moves_gpu_and_cpu_alike() {
             .max_views = views;
         let gpu = settle(&mut app, camera, &image);
         let all: Vec<usize> = (0..gpu.len()).collect();
-        let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &all);
-        eprintln!(
-            "max_views {views}: GPU vs CPU mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} \
-             within 20 %"
-        );
-        assert!(
-            mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-            "max_views {views}: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-        );
+        assert_gpu_matches(&gpu, &cpu.radiance, &all, &format!("max_views {views}"));
         frames.push((gpu, cpu.radiance));
     }
     // The change is visible, on both backends alike.
@@ -495,16 +479,11 @@ fn gpu_bilinear_lookups_match_cpu() {
     let room: Vec<usize> = (0..cpu.object.len())
         .filter(|&j| cpu.object[j] != 0)
         .collect();
-    let (mean, f5, f20) = compare(&gpu, &cpu.radiance, &room);
     let (_, unchanged, _) = compare(&cpu.radiance, &nearest.radiance, &room);
     eprintln!(
-        "bilinear: GPU vs CPU on the room's pixels mean {mean:.5}, {f5:.4} within 5 %, {f20:.4} \
-         within 20 %; {:.1} % of them differ from nearest by 5 % or more",
+        "bilinear: {:.1} % of the room's pixels differ from nearest by 5 % or more",
         100.0 * (1.0 - unchanged)
     );
     assert!(unchanged < 0.97, "bilinear changes the frame: {unchanged}");
-    assert!(
-        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
-        "bilinear: mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
-    );
+    assert_gpu_matches(&gpu, &cpu.radiance, &room, "bilinear, the room's pixels");
 }

@@ -149,11 +149,7 @@ fn truncated_or_inconsistent_image_chunks_are_named_errors() {
 
     let path = dir.path().join("header.pack");
     write_image_pack(&path, &bytes[..9], 16, 8);
-    let msg = PackReader::open(&path)
-        .unwrap()
-        .environment()
-        .unwrap_err()
-        .to_string();
+    let msg = environment_error(&path);
     assert!(
         msg.contains("header.pack") && msg.contains("EnvironmentImage"),
         "{msg}"
@@ -180,11 +176,7 @@ fn truncated_or_inconsistent_image_chunks_are_named_errors() {
         sun: None,
     });
     w.finish(&m).unwrap();
-    let msg = PackReader::open(&path)
-        .unwrap()
-        .environment()
-        .unwrap_err()
-        .to_string();
+    let msg = environment_error(&path);
     assert!(
         msg.contains("manifest.pack") && msg.contains("8 × 8"),
         "{msg}"
@@ -194,11 +186,7 @@ fn truncated_or_inconsistent_image_chunks_are_named_errors() {
     let path = dir.path().join("missing.pack");
     let w = PackWriter::create(&path).unwrap();
     w.finish(&m).unwrap();
-    let msg = PackReader::open(&path)
-        .unwrap()
-        .environment()
-        .unwrap_err()
-        .to_string();
+    let msg = environment_error(&path);
     assert!(
         msg.contains("missing.pack") && msg.contains("EnvironmentImage"),
         "{msg}"
@@ -248,4 +236,13 @@ fn invalid_sun_tracks_and_parameters_are_refused() {
         None,
     ));
     assert!(w.finish(&m).is_err());
+}
+
+/// The message of the error reading the environment of the pack at `path` (which opens).
+fn environment_error(path: &std::path::Path) -> String {
+    PackReader::open(path)
+        .unwrap()
+        .environment()
+        .unwrap_err()
+        .to_string()
 }

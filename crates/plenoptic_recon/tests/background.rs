@@ -5,24 +5,12 @@
 mod common;
 
 use common::{PackSpec, open_room, write_pack_with};
-use plenoptic_pack::plenoptic_sky::{Environment, SkyParams, SunTrack, SunTrackSample};
+use plenoptic_pack::plenoptic_sky::{Environment, SkyParams, SunTrack};
 use plenoptic_recon::{Camera, Mode, Reconstructor};
 use plenoptic_trace::glam::Vec3;
 
 fn track() -> SunTrack {
-    SunTrack::new(vec![
-        SunTrackSample {
-            time: 0.0,
-            direction: Vec3::new(1.0, 0.15, 0.2).normalize(),
-            illuminance: Vec3::splat(20_000.0),
-        },
-        SunTrackSample {
-            time: 2.0,
-            direction: Vec3::new(-0.3, 1.0, -0.4).normalize(),
-            illuminance: Vec3::splat(100_000.0),
-        },
-    ])
-    .unwrap()
+    common::moving_sun()
 }
 
 #[test]

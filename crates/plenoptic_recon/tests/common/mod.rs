@@ -298,6 +298,25 @@ impl PackSpec {
     }
 }
 
+/// The test packs' sun: from low in the east (20,000 lx) at t = 0 to high (100,000 lx) at
+/// t = 2.
+pub fn moving_sun() -> plenoptic_pack::plenoptic_sky::SunTrack {
+    use plenoptic_pack::plenoptic_sky::{SunTrack, SunTrackSample};
+    SunTrack::new(vec![
+        SunTrackSample {
+            time: 0.0,
+            direction: Vec3::new(1.0, 0.15, 0.2).normalize(),
+            illuminance: Vec3::splat(20_000.0),
+        },
+        SunTrackSample {
+            time: 2.0,
+            direction: Vec3::new(-0.3, 1.0, -0.4).normalize(),
+            illuminance: Vec3::splat(100_000.0),
+        },
+    ])
+    .unwrap()
+}
+
 /// Ends of the test view-space segment.
 pub fn segment_ends() -> (Vec3, Vec3) {
     (Vec3::new(-1.0, 1.3, 1.0), Vec3::new(1.0, 1.3, 1.0))
