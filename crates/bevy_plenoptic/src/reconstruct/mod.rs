@@ -450,7 +450,8 @@ fn update_materials(
                 cam.settings.hole_fill_radius as f32,
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
                 if image_mode { 1.0 } else { 0.0 },
-                object_coverage(pack, of.id),
+                // The material's coverage, set below.
+                1.0,
             ),
             flags: Vec4::new(
                 if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
@@ -481,6 +482,8 @@ fn update_materials(
                 proxy.map_or(Mat4::IDENTITY, |p| p.transform_at(l.tau).to_matrix()) * inv_now;
         }
         if let Some(mut mat) = materials.get_mut(&handle.0) {
+            // Looked up in the manifest once, when the material was attached.
+            params.fill.w = mat.coverage;
             mat.params = params;
         }
     }
