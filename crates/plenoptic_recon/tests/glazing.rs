@@ -100,6 +100,12 @@ fn an_open_window_shows_the_sky_and_a_blended_pane_is_composited_over_it() {
     let (frame, report) = glazed.render(&camera, 0.0, Mode::GeometryAssisted).unwrap();
     assert_eq!(report.glazing_pixels, pane.len());
     let composited = mean_error(&frame.radiance, &want, &pane);
+    let luminance = |c: &[Vec3]| {
+        pane.iter()
+            .map(|&j| c[j].dot(Vec3::new(0.2126, 0.7152, 0.0722)))
+            .sum::<f32>()
+    };
+    let ratio = luminance(&frame.radiance) / luminance(&want);
 
     // The same pack drawn as before, the pane an opaque proxy showing its baked texels.
     let baked = pack(dir.path(), "baked.pack", Some(ALPHA), false);
@@ -108,8 +114,13 @@ fn an_open_window_shows_the_sky_and_a_blended_pane_is_composited_over_it() {
     let texels = mean_error(&old.radiance, &want, &pane);
     eprintln!(
         "pane pixels {}: mean relative error composited {composited:.4}, baked texels \
-         {texels:.4}",
-        pane.len()
+         {texels:.4}; mean-luminance ratio composited {ratio:.4}, baked texels {:.4}",
+        pane.len(),
+        luminance(&old.radiance) / luminance(&want)
+    );
+    assert!(
+        (ratio - 1.0).abs() < 0.02,
+        "composited mean luminance ratio {ratio}"
     );
     // Most of the error is the pane's own reconstruction where the sky below the horizon is
     // black behind it: a quarter of the cube's texels saw the pane, the rest is hole fill.
