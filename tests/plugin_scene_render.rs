@@ -238,7 +238,6 @@ fn plugin_and_cpu_frames_from(
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::Reconstructor;
-    use std::cell::RefCell;
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("room.pack");
@@ -332,16 +331,7 @@ fn plugin_and_cpu_frames_from(
             "t = {time}"
         );
     }
-    let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
-    let data = render_until(&mut app, image, 600, |d| {
-        let px = decode(d);
-        let shown = px.len() == (WIDTH * HEIGHT) as usize
-            && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
-            && px.iter().any(|c| c.max_element() > 0.01);
-        let stable = prev.borrow().as_deref() == Some(d);
-        *prev.borrow_mut() = Some(d.to_vec());
-        shown && stable
-    });
+    let data = settled_frame(&mut app, &image);
     Frames {
         gpu: decode(&data),
         cpu: cpu.radiance,

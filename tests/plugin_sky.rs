@@ -12,8 +12,6 @@ mod common;
 #[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
-use std::cell::RefCell;
-
 use bevy::camera::{Exposure, Hdr};
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
@@ -66,35 +64,7 @@ fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
-    // Two equal read-backs in a row are not enough: while a pipeline still compiles, Bevy
-    // skips what it draws (the glazing's transparent pipeline, on a loaded machine), and
-    // those frames are equal too. A frame counts once it is still the same after a further
-    // 0.3 s of updates.
-    let stable_frame = |app: &mut App| {
-        let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
-        render_until(app, image.clone(), 600, |d| {
-            let px = rgba16f_pixels(d);
-            let shown = px.len() == (WIDTH * HEIGHT) as usize
-                && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
-                && px.iter().any(|c| c.max_element() > 0.01);
-            let stable = prev.borrow().as_deref() == Some(d);
-            *prev.borrow_mut() = Some(d.to_vec());
-            shown && stable
-        })
-    };
-    let mut data = stable_frame(app);
-    for _ in 0..20 {
-        for _ in 0..15 {
-            app.update();
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        let again = stable_frame(app);
-        if again == data {
-            return rgba16f_pixels(&data);
-        }
-        data = again;
-    }
-    panic!("the frame kept changing");
+    rgba16f_pixels(&settled_frame(app, image))
 }
 
 /// Writes the open room with a sky (scale 1: kcd/m², a few units, beside the test shading's

@@ -138,3 +138,36 @@ pub fn rgba16f_pixels(d: &[u8]) -> Vec<bevy::math::Vec3> {
         })
         .collect()
 }
+
+/// The frame `image` settles on (an `Rgba16Float` target): shown (every pixel drawn, not the
+/// test's red clear colour, something lit), equal in two read-backs in a row, and still the
+/// same after a further 0.3 s of updates. Two equal read-backs are not enough while a
+/// pipeline still compiles: Bevy skips what it would draw (on a loaded machine, the depth
+/// prepass or the glazing's transparent pipeline), and those frames are equal too.
+pub fn settled_frame(app: &mut App, image: &Handle<Image>) -> Vec<u8> {
+    let stable_frame = |app: &mut App| {
+        let prev: std::cell::RefCell<Option<Vec<u8>>> = Default::default();
+        render_until(app, image.clone(), 600, |d| {
+            let px = rgba16f_pixels(d);
+            let shown = px.len() == (WIDTH * HEIGHT) as usize
+                && px.iter().all(|c| !(c.x > 0.99 && c.y < 0.01 && c.z < 0.01))
+                && px.iter().any(|c| c.max_element() > 0.01);
+            let stable = prev.borrow().as_deref() == Some(d);
+            *prev.borrow_mut() = Some(d.to_vec());
+            shown && stable
+        })
+    };
+    let mut data = stable_frame(app);
+    for _ in 0..20 {
+        for _ in 0..15 {
+            app.update();
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let again = stable_frame(app);
+        if again == data {
+            return data;
+        }
+        data = again;
+    }
+    panic!("the frame kept changing");
+}
