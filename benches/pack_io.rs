@@ -62,11 +62,15 @@ fn room(view: Vec3, phase: f32) -> RangeImage {
         let falloff = 3.0 * lambert / (0.2 + to_light.length_squared()) + 0.05;
         let albedo = Vec3::new(0.5 + 0.04 * id as f32, 0.5, 0.55 - 0.03 * id as f32);
         let mut r = albedo * falloff;
+        let (mut l, mut e) = (Vec3::splat(falloff), Vec3::ZERO);
         if id != 9 && id != 10 && axis == 0 && d.x > 0.0 && p.y.abs() < 0.5 && p.z.abs() < 1.0 {
             r = Vec3::new(40.0, 38.0, 35.0) * (1.0 + 0.1 * phase);
+            (l, e) = (Vec3::ZERO, r);
             id = 20;
         }
         img.radiance.texels[i] = r;
+        img.lighting.texels[i] = l;
+        img.non_diffuse.texels[i] = e;
         img.distance.texels[i] = dist;
         img.object_id.texels[i] = id;
         img.normal.texels[i] = normal;
@@ -116,6 +120,8 @@ fn fixture() -> Fixture {
                     direction: cube::texel_direction(FACE, i),
                     t: rnd() * 0.5,
                     radiance: img.radiance.texels[i],
+                    lighting: img.lighting.texels[i],
+                    non_diffuse: img.non_diffuse.texels[i],
                     distance: img.distance.texels[i],
                     normal: img.normal.texels[i],
                     object_id: img.object_id.texels[i],

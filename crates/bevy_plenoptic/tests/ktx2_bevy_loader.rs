@@ -1,5 +1,5 @@
 //! Range-image chunks of a radiance pack are complete KTX2 files: Bevy's own KTX2 loader
-//! (`bevy_image` with `ktx2` and `zstd_rust`) must open each of the four cube kinds as a cube
+//! (`bevy_image` with `ktx2` and `zstd_rust`) must open each of the six cube kinds as a cube
 //! `Image` with the texels the baker wrote, and (pack 1.2) each material texture as a 2-D
 //! `Image` with its whole mip chain.
 
@@ -26,6 +26,8 @@ fn range_image() -> RangeImage {
         radiance: CubeImage::from_fn(FACE, |_, d| {
             Vec3::new(d.x.abs() * 4.0, d.y.abs(), 0.25 + d.z.abs() * 100.0)
         }),
+        lighting: CubeImage::from_fn(FACE, |_, d| Vec3::new(0.5 + d.x.abs(), d.y.abs(), 2.0)),
+        non_diffuse: CubeImage::from_fn(FACE, |_, d| Vec3::new(0.0, d.z.abs() * 3.0, 0.1)),
         distance: CubeImage::from_fn(FACE, |i, d| 1.0 + i as f32 * 0.01 + d.x.abs()),
         object_id: CubeImage::from_fn(FACE, |i, _| {
             (i as u32 / (FACE * FACE)) * 1000 + i as u32 % 7
@@ -34,7 +36,7 @@ fn range_image() -> RangeImage {
     }
 }
 
-/// Writes a one-view pack and returns the raw bytes of its four range-image chunks, read back
+/// Writes a one-view pack and returns the raw bytes of its six range-image chunks, read back
 /// through the pack reader (so the checksum path is exercised too).
 fn chunks(dir: &std::path::Path) -> Vec<(ChunkKind, Vec<u8>)> {
     let path = dir.join("one.pack");
@@ -58,6 +60,8 @@ fn chunks(dir: &std::path::Path) -> Vec<(ChunkKind, Vec<u8>)> {
     let reader = PackReader::open(&path).unwrap();
     [
         ChunkKind::RadianceCube,
+        ChunkKind::LightingCube,
+        ChunkKind::NonDiffuseCube,
         ChunkKind::DistanceCube,
         ChunkKind::ObjectIdCube,
         ChunkKind::NormalCube,
@@ -114,6 +118,16 @@ fn every_range_image_chunk_loads_as_a_bevy_cubemap() {
                     .iter()
                     .map(|&c| rgb9e5_pack(c))
                     .collect();
+                assert_eq!(words(data), want);
+            }
+            ChunkKind::LightingCube | ChunkKind::NonDiffuseCube => {
+                assert_eq!(image.texture_descriptor.format, TextureFormat::Rgb9e5Ufloat);
+                let cube = if kind == ChunkKind::LightingCube {
+                    &expected.lighting
+                } else {
+                    &expected.non_diffuse
+                };
+                let want: Vec<u32> = cube.texels.iter().map(|&c| rgb9e5_pack(c)).collect();
                 assert_eq!(words(data), want);
             }
             ChunkKind::DistanceCube => {

@@ -179,16 +179,17 @@ pub fn render_range_image(
     })
 }
 
-/// Converts six rendered faces (KTX2 layer order, `n`² pixels each) into a range image.
+/// Converts six rendered faces (KTX2 layer order, `n`² pixels each) into a range image: the
+/// radiance as rendered, split into lighting and non-diffuse radiance for pack v2
+/// ([`LightingCube::to_range_image`]).
 pub fn to_range_image(n: u32, faces: &[plenoptic_trace::Image<RadianceSample>; 6]) -> RangeImage {
+    let mut image = LightingCube::from_faces(n, faces).to_range_image();
+    // The radiance exactly as rendered (the split re-modulates it up to rounding).
     let nn = (n * n) as usize;
-    let get = |i: usize| &faces[i / nn].pixels[i % nn];
-    RangeImage {
-        radiance: CubeImage::from_fn(n, |i, _| get(i).radiance.max(Vec3::ZERO)),
-        distance: CubeImage::from_fn(n, |i, _| get(i).distance),
-        object_id: CubeImage::from_fn(n, |i, _| pack_object_id(get(i).object)),
-        normal: CubeImage::from_fn(n, |i, _| get(i).normal),
-    }
+    image.radiance = CubeImage::from_fn(n, |i, _| {
+        faces[i / nn].pixels[i % nn].radiance.max(Vec3::ZERO)
+    });
+    image
 }
 
 /// Whether two samples disagree: different object, or luminance differing by more than

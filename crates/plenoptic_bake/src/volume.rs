@@ -202,14 +202,19 @@ pub fn sample_volume(r: &BakeRenderer<'_>, bv: usize, budget: usize) -> Vec<Volu
         parents = next;
     }
     all.iter()
-        .map(|s| VolumeSample {
-            direction: s.dir,
-            t: s.t,
-            radiance: s.sample.radiance.max(Vec3::ZERO),
-            distance: s.sample.distance,
-            normal: s.sample.normal,
-            object_id: pack_object_id(s.sample.object),
-            radius: s.cell.radius(),
+        .map(|s| {
+            let (lighting, non_diffuse) = crate::denoise::split_sample(&s.sample);
+            VolumeSample {
+                direction: s.dir,
+                t: s.t,
+                radiance: s.sample.radiance.max(Vec3::ZERO),
+                lighting,
+                non_diffuse,
+                distance: s.sample.distance,
+                normal: s.sample.normal,
+                object_id: pack_object_id(s.sample.object),
+                radius: s.cell.radius(),
+            }
         })
         .collect()
 }

@@ -3,7 +3,7 @@
 //! in canonical order.
 //!
 //! Canonical chunk order: for each base view, its range images by time key (radiance,
-//! distance, object id, normal), then its volume blocks by bucket; then one proxy mesh per
+//! lighting, non-diffuse, distance, object id, normal), then its volume blocks by bucket; then one proxy mesh per
 //! object in id order; then the animation tracks; then the environment image; then (pack 1.2)
 //! the proxies' UVs and tangents in object id order and the material textures in table order
 //! ([`crate::materials`]).
@@ -45,7 +45,8 @@ pub const FORMATS: CubeFormats = CubeFormats {
     normal: plenoptic_pack::NormalFormat::Rg16Snorm,
 };
 
-/// The four cube chunks of a range image.
+/// The six cube chunks of a range image (lighting and non-diffuse radiance in the radiance
+/// format).
 pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<ItemChunk>> {
     let c = |kind, bytes| ItemChunk {
         kind,
@@ -58,6 +59,14 @@ pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<I
         c(
             ChunkKind::RadianceCube,
             encode_radiance(&image.radiance, FORMATS.radiance)?,
+        ),
+        c(
+            ChunkKind::LightingCube,
+            encode_radiance(&image.lighting, FORMATS.radiance)?,
+        ),
+        c(
+            ChunkKind::NonDiffuseCube,
+            encode_radiance(&image.non_diffuse, FORMATS.radiance)?,
         ),
         c(
             ChunkKind::DistanceCube,
@@ -387,6 +396,8 @@ fn environment_entry(start: f32, end: f32, scene: &Scene) -> Option<EnvironmentE
 fn stat_name(kind: ChunkKind) -> &'static str {
     match kind {
         ChunkKind::RadianceCube => "radiance",
+        ChunkKind::LightingCube => "lighting",
+        ChunkKind::NonDiffuseCube => "non_diffuse",
         ChunkKind::DistanceCube => "distance",
         ChunkKind::ObjectIdCube => "object_id",
         ChunkKind::NormalCube => "normal",

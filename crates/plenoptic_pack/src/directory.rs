@@ -39,6 +39,12 @@ pub enum ChunkKind {
     /// UVs and tangents of the proxy mesh with the same key (code 11, since version 1.2). Base
     /// view: [`NO_BASE_VIEW`]. Key: object id.
     ProxyAttributes,
+    /// KTX2 cube of diffuse lighting (code 12, since version 2.0): per texel, the factor by
+    /// which the surface's diffuse albedo turns into outgoing radiance. Key: time key index.
+    LightingCube,
+    /// KTX2 cube of the radiance that is not the Lambertian lobe's (code 13, since version
+    /// 2.0): emission plus the specular part as seen from the base view. Key: time key index.
+    NonDiffuseCube,
     /// A kind written by a newer minor version. It is validated like every other chunk and its
     /// raw bytes can be read, but it cannot be decoded.
     Unknown(u32),
@@ -59,6 +65,8 @@ impl ChunkKind {
             ChunkKind::EnvironmentImage => 9,
             ChunkKind::MaterialTexture => 10,
             ChunkKind::ProxyAttributes => 11,
+            ChunkKind::LightingCube => 12,
+            ChunkKind::NonDiffuseCube => 13,
             ChunkKind::Unknown(c) => c,
         }
     }
@@ -77,6 +85,8 @@ impl ChunkKind {
             9 => ChunkKind::EnvironmentImage,
             10 => ChunkKind::MaterialTexture,
             11 => ChunkKind::ProxyAttributes,
+            12 => ChunkKind::LightingCube,
+            13 => ChunkKind::NonDiffuseCube,
             c => ChunkKind::Unknown(c),
         }
     }
@@ -89,6 +99,8 @@ impl ChunkKind {
                 | ChunkKind::DistanceCube
                 | ChunkKind::ObjectIdCube
                 | ChunkKind::NormalCube
+                | ChunkKind::LightingCube
+                | ChunkKind::NonDiffuseCube
         )
     }
 }

@@ -75,6 +75,18 @@ pub enum PackError {
     /// The first 8 bytes are not the pack magic.
     #[error("not a radiance pack: magic is {0:02x?}")]
     BadMagic([u8; 8]),
+    /// A version-1 pack: it stores outgoing radiance only, without the lighting apart from
+    /// reflectance that version 2 reconstructs from.
+    #[error(
+        "pack version {major}.{minor} predates version 2 (lighting stored apart from the \
+         materials); re-bake it with `plenoptic bake`"
+    )]
+    NeedsRebake {
+        /// Major version in the file.
+        major: u16,
+        /// Minor version in the file.
+        minor: u16,
+    },
     /// The major version is one this reader does not know.
     #[error("unsupported pack version {major}.{minor} (this reader reads {supported}.x)")]
     UnsupportedVersion {

@@ -6,9 +6,9 @@ use crate::error::{PackError, Result, Section};
 /// The 8 bytes every pack starts with.
 pub const MAGIC: [u8; 8] = *b"PLNPACK\0";
 /// The major format version this crate writes and reads.
-pub const VERSION_MAJOR: u16 = 1;
+pub const VERSION_MAJOR: u16 = 2;
 /// The minor format version this crate writes. Readers accept any minor of their major.
-pub const VERSION_MINOR: u16 = 2;
+pub const VERSION_MINOR: u16 = 0;
 /// Size of the header in bytes.
 pub const HEADER_LEN: u64 = 128;
 
@@ -70,6 +70,12 @@ impl Header {
         }
         let version_major = r.u16()?;
         let version_minor = r.u16()?;
+        if version_major == 1 {
+            return Err(PackError::NeedsRebake {
+                major: version_major,
+                minor: version_minor,
+            });
+        }
         if version_major != VERSION_MAJOR {
             return Err(PackError::UnsupportedVersion {
                 major: version_major,

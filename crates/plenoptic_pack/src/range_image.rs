@@ -1,5 +1,7 @@
-//! Range images (thesis ch. 6): per base view and time key, four cubes of radiance, distance,
-//! object id and normal, each stored as its own KTX2 chunk.
+//! Range images (thesis ch. 6): per base view and time key, cubes of radiance, distance,
+//! object id and normal, each stored as its own KTX2 chunk; since version 2 also the diffuse
+//! lighting and the non-diffuse radiance (`docs/architecture.md`, "Pack v2"), so that the
+//! runtime can multiply the lighting by the material's albedo at screen resolution.
 
 use glam::{Vec2, Vec3};
 use half::f16;
@@ -324,12 +326,23 @@ pub fn decode_normal(bytes: &[u8]) -> Result<NormalCube> {
     })
 }
 
-/// The four cubes of one base view at one time key (thesis §6.1: a range image is radiance
-/// plus range; id and normal serve reprojection and masks).
+/// The cubes of one base view at one time key (thesis §6.1: a range image is radiance plus
+/// range; id and normal serve reprojection and masks; lighting and the non-diffuse part are
+/// version 2's split of the radiance).
+///
+/// Per texel, `radiance ≈ albedo · lighting + non_diffuse`, where `albedo` is the surface's
+/// diffuse albedo, `(1 − metallic)(1 − transmission) · base colour`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RangeImage {
-    /// Radiance.
+    /// Radiance: what image and volume modes warp (the thesis's input).
     pub radiance: RadianceCube,
+    /// Diffuse lighting: the factor by which the diffuse albedo turns into outgoing radiance
+    /// (direct light through the Lambertian lobe plus indirect diffuse light). Texels whose
+    /// surface has no diffuse albedo carry their neighbours' lighting on the same object, or
+    /// zero.
+    pub lighting: RadianceCube,
+    /// Emission plus the specular part of the radiance, as seen from the base view.
+    pub non_diffuse: RadianceCube,
     /// Distance along each texel's ray.
     pub distance: DistanceCube,
     /// Object ids.
@@ -343,6 +356,8 @@ impl RangeImage {
     pub fn new(face_size: u32) -> Self {
         RangeImage {
             radiance: CubeImage::filled(face_size, Vec3::ZERO),
+            lighting: CubeImage::filled(face_size, Vec3::ZERO),
+            non_diffuse: CubeImage::filled(face_size, Vec3::ZERO),
             distance: CubeImage::filled(face_size, f32::INFINITY),
             object_id: CubeImage::filled(face_size, 0),
             normal: CubeImage::filled(face_size, Vec3::Z),

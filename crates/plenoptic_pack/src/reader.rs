@@ -72,6 +72,10 @@ impl<R: Read + Seek + Send> Source for StreamSource<R> {
 pub enum Chunk {
     /// A radiance cube.
     Radiance(RadianceCube),
+    /// A diffuse-lighting cube.
+    Lighting(RadianceCube),
+    /// A non-diffuse radiance cube.
+    NonDiffuse(RadianceCube),
     /// A distance cube.
     Distance(DistanceCube),
     /// An object-id cube.
@@ -102,7 +106,9 @@ pub enum Chunk {
 /// The uncompressed length a chunk's own header declares (validating that header).
 pub(crate) fn declared_uncompressed_length(kind: ChunkKind, bytes: &[u8]) -> Result<u64> {
     Ok(match kind {
-        ChunkKind::RadianceCube => inspect_cube(bytes, &RADIANCE_FORMATS)?.uncompressed_length,
+        ChunkKind::RadianceCube | ChunkKind::LightingCube | ChunkKind::NonDiffuseCube => {
+            inspect_cube(bytes, &RADIANCE_FORMATS)?.uncompressed_length
+        }
         ChunkKind::DistanceCube => inspect_cube(bytes, &DISTANCE_FORMATS)?.uncompressed_length,
         ChunkKind::ObjectIdCube => inspect_cube(bytes, &OBJECT_ID_FORMATS)?.uncompressed_length,
         ChunkKind::NormalCube => inspect_cube(bytes, &NORMAL_FORMATS)?.uncompressed_length,
@@ -363,6 +369,8 @@ impl PackReader {
         }
         let decoded = match e.kind {
             ChunkKind::RadianceCube => decode_radiance(&bytes).map(Chunk::Radiance),
+            ChunkKind::LightingCube => decode_radiance(&bytes).map(Chunk::Lighting),
+            ChunkKind::NonDiffuseCube => decode_radiance(&bytes).map(Chunk::NonDiffuse),
             ChunkKind::DistanceCube => decode_distance(&bytes).map(Chunk::Distance),
             ChunkKind::ObjectIdCube => decode_object_id(&bytes).map(Chunk::ObjectId),
             ChunkKind::NormalCube => decode_normal(&bytes).map(Chunk::Normal),
@@ -406,6 +414,22 @@ impl PackReader {
         }
     }
 
+    /// The diffuse-lighting cube of `base_view` at time key `key`.
+    pub fn lighting(&self, base_view: u32, key: u32) -> Result<RadianceCube> {
+        match self.get(ChunkKind::LightingCube, base_view, key)? {
+            Chunk::Lighting(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// The non-diffuse radiance cube of `base_view` at time key `key`.
+    pub fn non_diffuse(&self, base_view: u32, key: u32) -> Result<RadianceCube> {
+        match self.get(ChunkKind::NonDiffuseCube, base_view, key)? {
+            Chunk::NonDiffuse(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
     /// The distance cube of `base_view` at time key `key`.
     pub fn distance(&self, base_view: u32, key: u32) -> Result<DistanceCube> {
         match self.get(ChunkKind::DistanceCube, base_view, key)? {
@@ -430,10 +454,12 @@ impl PackReader {
         }
     }
 
-    /// All four cubes of `base_view` at time key `key`.
+    /// All six cubes of `base_view` at time key `key`.
     pub fn range_image(&self, base_view: u32, key: u32) -> Result<RangeImage> {
         Ok(RangeImage {
             radiance: self.radiance(base_view, key)?,
+            lighting: self.lighting(base_view, key)?,
+            non_diffuse: self.non_diffuse(base_view, key)?,
             distance: self.distance(base_view, key)?,
             object_id: self.object_id(base_view, key)?,
             normal: self.normal(base_view, key)?,

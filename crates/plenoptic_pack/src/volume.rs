@@ -18,7 +18,7 @@ pub const MAX_TETRAHEDRA: u32 = 1 << 26;
 const BLOCK_MAGIC: [u8; 4] = *b"PVB1";
 const CONNECTIVITY_MAGIC: [u8; 4] = *b"PVC1";
 /// Stored bytes per sample before zstd.
-pub const SAMPLE_BYTES: usize = 24;
+pub const SAMPLE_BYTES: usize = 32;
 
 /// One temporal-volume sample as the baker produced it (before quantization).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +31,11 @@ pub struct VolumeSample {
     pub t: f32,
     /// HDR radiance, linear RGB. Stored RGB9E5: per-channel error ≤ max(r,g,b)·2⁻⁹.
     pub radiance: Vec3,
+    /// Diffuse lighting (version 2): what the surface's diffuse albedo multiplies, as in a
+    /// range image's lighting cube. Stored RGB9E5.
+    pub lighting: Vec3,
+    /// Emission plus the specular part of `radiance` (version 2). Stored RGB9E5.
+    pub non_diffuse: Vec3,
     /// Distance along the direction, metres. Stored as f32: exact.
     pub distance: f32,
     /// Unit normal. Stored like `direction`: angular error ≤ 1e-4 rad.
@@ -137,6 +142,12 @@ pub fn encode_volume_block(
     });
     col(&mut raw, &|s| s.distance.to_le_bytes().to_vec());
     col(&mut raw, &|s| {
+        rgb9e5_pack(s.lighting).to_le_bytes().to_vec()
+    });
+    col(&mut raw, &|s| {
+        rgb9e5_pack(s.non_diffuse).to_le_bytes().to_vec()
+    });
+    col(&mut raw, &|s| {
         oct_unorm16(s.normal)[0].to_le_bytes().to_vec()
     });
     col(&mut raw, &|s| {
@@ -194,10 +205,12 @@ pub fn decode_volume_block(bytes: &[u8]) -> Result<VolumeBlock> {
     let tq = column(4, 2);
     let rad = column(6, 4);
     let dist = column(10, 4);
-    let nu = column(14, 2);
-    let nv = column(16, 2);
-    let ids = column(18, 4);
-    let radius = column(22, 2);
+    let light = column(14, 4);
+    let non_diffuse = column(18, 4);
+    let nu = column(22, 2);
+    let nv = column(24, 2);
+    let ids = column(26, 4);
+    let radius = column(30, 2);
     let u16_at = |c: &[u8], i: usize| u16::from_le_bytes([c[2 * i], c[2 * i + 1]]);
     let u32_at = |c: &[u8], i: usize| {
         u32::from_le_bytes([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]])
@@ -208,6 +221,8 @@ pub fn decode_volume_block(bytes: &[u8]) -> Result<VolumeBlock> {
             t: t0 + crate::cube::from_unorm16(u16_at(tq, i)) * (t1 - t0),
             radiance: rgb9e5_unpack(u32_at(rad, i)),
             distance: f32::from_bits(u32_at(dist, i)),
+            lighting: rgb9e5_unpack(u32_at(light, i)),
+            non_diffuse: rgb9e5_unpack(u32_at(non_diffuse, i)),
             normal: from_oct_unorm16([u16_at(nu, i), u16_at(nv, i)]),
             object_id: u32_at(ids, i),
             radius: f16::from_bits(u16_at(radius, i)).to_f32(),

@@ -195,7 +195,8 @@ impl PackWriter {
         Ok(self.entries.len() - 1)
     }
 
-    /// Encodes and adds the four cubes of a range image under `(base_view, time_key)`.
+    /// Encodes and adds the six cubes of a range image under `(base_view, time_key)` (lighting
+    /// and the non-diffuse part in the radiance format).
     pub fn add_range_image(
         &mut self,
         base_view: u32,
@@ -205,6 +206,10 @@ impl PackWriter {
     ) -> Result<()> {
         let r = encode_radiance(&image.radiance, formats.radiance)?;
         self.add_chunk(ChunkKind::RadianceCube, base_view, time_key, &r)?;
+        let l = encode_radiance(&image.lighting, formats.radiance)?;
+        self.add_chunk(ChunkKind::LightingCube, base_view, time_key, &l)?;
+        let s = encode_radiance(&image.non_diffuse, formats.radiance)?;
+        self.add_chunk(ChunkKind::NonDiffuseCube, base_view, time_key, &s)?;
         let d = encode_distance(&image.distance, formats.distance)?;
         self.add_chunk(ChunkKind::DistanceCube, base_view, time_key, &d)?;
         let o = encode_object_id(&image.object_id, formats.object_id)?;

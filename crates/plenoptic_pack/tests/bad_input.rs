@@ -69,15 +69,30 @@ fn wrong_magic() {
 #[test]
 fn unknown_major_version() {
     let mut b = small_pack();
-    rewrite_header(&mut b, |h| h.version_major = 2);
+    rewrite_header(&mut b, |h| h.version_major = 3);
     assert!(matches!(
         open(b).unwrap_err(),
         PackError::UnsupportedVersion {
-            major: 2,
-            supported: 1,
+            major: 3,
+            supported: 2,
             ..
         }
     ));
+}
+
+#[test]
+fn version_one_packs_must_be_rebaked() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| {
+        h.version_major = 1;
+        h.version_minor = 2;
+    });
+    let err = open(b).unwrap_err();
+    assert!(
+        matches!(err, PackError::NeedsRebake { major: 1, minor: 2 }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("re-bake"), "{err}");
 }
 
 #[test]
@@ -108,7 +123,7 @@ fn directory_entry_past_eof() {
     match open(b).unwrap_err() {
         PackError::ChunkOutOfBounds { chunk, limit, .. } => {
             assert_eq!(chunk.index, 3);
-            assert_eq!(chunk.kind, ChunkKind::NormalCube);
+            assert_eq!(chunk.kind, ChunkKind::DistanceCube);
             assert_eq!(limit, len);
         }
         e => panic!("{e}"),
@@ -178,14 +193,14 @@ fn section_out_of_bounds() {
 fn chunk_checksum_mismatch() {
     let mut b = small_pack();
     let h = header(&b);
-    // Row 5: the distance cube of base view 0 at time key 1.
-    let row = h.directory_offset as usize + 5 * 48;
+    // Row 9: the distance cube of base view 0 at time key 1 (six cubes per range image).
+    let row = h.directory_offset as usize + 9 * 48;
     let off = u64::from_le_bytes(b[row + 16..row + 24].try_into().unwrap()) as usize;
     b[off + 200] ^= 0x40;
     let r = open(b).unwrap();
-    match r.chunk(5).unwrap_err() {
+    match r.chunk(9).unwrap_err() {
         PackError::ChecksumMismatch { chunk, .. } => {
-            assert_eq!(chunk.index, 5);
+            assert_eq!(chunk.index, 9);
             assert_eq!(chunk.kind, ChunkKind::DistanceCube);
             assert_eq!(chunk.base_view, 0);
             assert_eq!(chunk.key, 1);

@@ -16,7 +16,10 @@ fn materials_textures_and_attributes_round_trip() {
     let path = dir.path().join("mat.pack");
     let m = write_material_pack(&path);
     let r = PackReader::open(&path).unwrap();
-    assert_eq!(r.header().version_minor, 2);
+    assert_eq!(
+        (r.header().version_major, r.header().version_minor),
+        (VERSION_MAJOR, VERSION_MINOR)
+    );
     assert_eq!(r.manifest(), &m);
     let (textures, materials) = common::materials();
     assert_eq!(r.textures(), textures.as_slice());

@@ -142,8 +142,14 @@ fn volume_block_fields() {
         let s = &samples[input as usize];
         assert!(angle(s.direction, stored.direction) <= 1e-4);
         assert!((s.t - stored.t).abs() <= (t1 - t0) / 131070.0 + 1e-6);
-        let bound = s.radiance.max_element() * 2f32.powi(-9) + 2f32.powi(-24);
-        assert!((s.radiance - stored.radiance).abs().max_element() <= bound);
+        for (want, got) in [
+            (s.radiance, stored.radiance),
+            (s.lighting, stored.lighting),
+            (s.non_diffuse, stored.non_diffuse),
+        ] {
+            let bound = want.max_element() * 2f32.powi(-9) + 2f32.powi(-24);
+            assert!((want - got).abs().max_element() <= bound);
+        }
         assert_eq!(s.distance, stored.distance);
         assert!(angle(s.normal, stored.normal) <= 1e-4);
         assert_eq!(s.object_id, stored.object_id);
@@ -193,12 +199,23 @@ fn whole_pack_round_trip() {
     let m = write_small_pack(&path);
     let r = PackReader::open(&path).unwrap();
     assert_eq!(r.manifest(), &m);
-    assert_eq!(r.header().version_major, 1);
+    assert_eq!(r.header().version_major, 2);
     assert_eq!(read_all(&r), r.entries().len());
     let img = room_image(8, 0.3);
     let back = r.range_image(1, 1).unwrap();
     assert_eq!(back.distance, img.distance);
     assert_eq!(back.object_id, img.object_id);
+    // Version 2's lighting and non-diffuse cubes, within RGB9E5's bound.
+    for (stored, want) in [
+        (&back.lighting, &img.lighting),
+        (&back.non_diffuse, &img.non_diffuse),
+    ] {
+        for (a, b) in stored.texels.iter().zip(&want.texels) {
+            assert!((*a - *b).abs().max_element() <= b.max_element() / 256.0 + 1e-6);
+        }
+    }
+    assert!(img.lighting.texels.iter().any(|l| l.x > 0.1));
+    assert!(img.non_diffuse.texels.iter().any(|e| e.x > 1.0));
     assert_eq!(r.proxy_mesh(1).unwrap(), proxy_mesh(1, true));
     assert_eq!(r.proxy_mesh(2).unwrap(), proxy_mesh(2, false));
     assert_eq!(r.tracks().unwrap(), tracks());

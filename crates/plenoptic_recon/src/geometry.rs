@@ -34,6 +34,7 @@ use crate::frame::{FallbackReport, Frame, Report};
 use crate::lookup::{FastKey, NO_SLOT, PackedTexels, Scratch, Shade};
 use crate::proxy::GeometryMask;
 use crate::reconstructor::{CubeFilter, KeyCubes, Reconstructor};
+use crate::shading::Channel;
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
 use crate::{Error, Result, sample};
@@ -63,16 +64,43 @@ pub(crate) enum Layer<'a> {
     Only(&'a [u32]),
 }
 
-/// Renders one frame in geometry-assisted mode, from the proxies of `layer` (a given `mask`
-/// is used whole).
+/// What one geometry-assisted pass looks up ([`crate::shading`] runs one per channel).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pass<'a> {
+    /// The proxies rasterized.
+    pub layer: Layer<'a>,
+    /// The colour looked up in the cubes and volume samples.
+    pub channel: Channel,
+    /// Pack ids whose pixels are left black and unfilled (another pass shades them).
+    pub skip: &'a [u32],
+}
+
+impl<'a> Pass<'a> {
+    /// Radiance of every proxy of `layer`.
+    pub fn radiance(layer: Layer<'a>) -> Self {
+        Pass {
+            layer,
+            channel: Channel::Radiance,
+            skip: &[],
+        }
+    }
+}
+
+/// Renders one frame in geometry-assisted mode, from the proxies of `pass.layer` (a given
+/// `mask` is used whole).
 pub(crate) fn render(
     rec: &Reconstructor,
     camera: &Camera,
     t: f32,
     mask: Option<&GeometryMask>,
-    layer: Layer<'_>,
+    pass: Pass<'_>,
     report: &mut Report,
 ) -> Result<Frame> {
+    let Pass {
+        layer,
+        channel,
+        skip,
+    } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
         return Err(Error::Unusable("no proxy geometry".into()));
@@ -81,6 +109,7 @@ pub(crate) fn render(
     let views = rec.view_weights(camera.position);
     let ids = proxy.object_ids();
     let slot_of = SlotMap::new(ids);
+    let skipped: Vec<bool> = ids.iter().map(|o| skip.contains(o)).collect();
     let inv_now: Vec<Affine3A> = ids
         .iter()
         .map(|&o| proxy.transform(o, t).inverse())
@@ -98,7 +127,7 @@ pub(crate) fn render(
         }
         let mut got = Vec::new();
         for (k, wt) in pairs {
-            if let Some(c) = rec.key_cubes(v, k, &mut report.missing) {
+            if let Some(c) = rec.key_cubes_in(v, k, channel, &mut report.missing) {
                 got.push((k, wt, c));
             }
         }
@@ -114,7 +143,10 @@ pub(crate) fn render(
                 .into_iter()
                 .filter(|&k| k != k0 && k != k1)
                 .take(2)
-                .find_map(|k| rec.key_cubes(v, k, &mut report.missing).map(|c| (k, c)))
+                .find_map(|k| {
+                    rec.key_cubes_in(v, k, channel, &mut report.missing)
+                        .map(|c| (k, c))
+                })
             {
                 got.push((k, 1.0, c));
             }
@@ -130,12 +162,12 @@ pub(crate) fn render(
             keys.push(ViewKey {
                 base: bv.position,
                 weight: w * wt / total,
-                packed: rec.packed_texels(v, k, &c),
+                packed: rec.packed_texels(v, k, channel, &c),
                 cubes: c,
                 motion,
             });
         }
-        if let Some(index) = VolumeIndex::build(rec, v, t, &mut report.missing) {
+        if let Some(index) = VolumeIndex::build(rec, v, t, channel, &mut report.missing) {
             volumes.push((bv.position, w, index));
         }
     }
@@ -236,7 +268,7 @@ pub(crate) fn render(
             let y0 = i * ROWS;
             if let MaskSource::Raster(tris) = &source {
                 // Camera-space depth into `dep`, object into `obj`.
-                crate::raster::raster_band(tris, w, y0, dep, obj);
+                crate::raster::raster_band(tris, w, y0, dep, obj, None);
             }
             let rows = rad
                 .chunks_mut(w)
@@ -284,8 +316,8 @@ pub(crate) fn render(
                         continue;
                     }
                     match slot_of.get(o) {
-                        Some(slot) => s.slot[x] = slot as u32,
-                        None => cls[x] = NONE,
+                        Some(slot) if !skipped[slot] => s.slot[x] = slot as u32,
+                        _ => cls[x] = NONE,
                     }
                 }
                 shade.row(s, obj);

@@ -21,7 +21,8 @@ use glam::Vec3;
 
 use crate::background::{self, Coverage};
 use crate::frame::{Frame, Report};
-use crate::geometry::{self, Layer};
+use crate::geometry::Layer;
+use crate::shading;
 use crate::{Camera, Reconstructor, Result};
 
 /// The pack ids and coverages of the pack's see-through objects.
@@ -44,7 +45,7 @@ pub(crate) fn render(
     report: &mut Report,
 ) -> Result<Frame> {
     let ids: Vec<u32> = glazing.iter().map(|g| g.0).collect();
-    let mut behind = geometry::render(rec, camera, t, None, Layer::Without(&ids), report)?;
+    let mut behind = shading::render(rec, camera, t, None, Layer::Without(&ids), report)?;
     background::apply(
         &rec.environment().at(t),
         camera,
@@ -53,7 +54,7 @@ pub(crate) fn render(
     );
     let start = std::time::Instant::now();
     let mut front_report = Report::default();
-    let front = geometry::render(rec, camera, t, None, Layer::Only(&ids), &mut front_report)?;
+    let front = shading::render(rec, camera, t, None, Layer::Only(&ids), &mut front_report)?;
     let covered = composite(&mut behind, &front, glazing);
     report
         .stage_ms

@@ -83,6 +83,7 @@ pub mod frame;
 mod geometry;
 mod glazing;
 mod lookup;
+mod material;
 pub mod motion;
 pub mod path;
 pub mod proxy;
@@ -90,6 +91,7 @@ mod raster;
 pub mod reconstructor;
 mod sample;
 pub mod settings;
+mod shading;
 pub mod temporal;
 pub mod viewspace;
 pub mod volume;
@@ -101,7 +103,7 @@ pub use motion::ObjectMotion;
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
 pub use reconstructor::Reconstructor;
-pub use settings::{CubeFilter, ReconSettings};
+pub use settings::{CubeFilter, ReconSettings, Shading};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -23,6 +23,8 @@ struct Tri {
     y: [f32; 3],
     iz: [f32; 3],
     object: u32,
+    /// Index into [`Projected::sources`].
+    source: u32,
     ymin: f32,
     ymax: f32,
 }
@@ -31,6 +33,9 @@ struct Tri {
 /// the near plane and projected for `camera`: what [`raster_band`] scan-converts.
 pub(crate) struct Projected {
     tris: Vec<Tri>,
+    /// Per projected triangle: (index into the projected objects, triangle index in its
+    /// mesh). A triangle clipped into two shares its source.
+    pub sources: Vec<(u32, u32)>,
 }
 
 /// Places, clips and projects `objects` for `camera`.
@@ -38,14 +43,15 @@ pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)
     let b = camera.basis();
     let (sx, sy) = (0.5 * b.width / b.tan_x, 0.5 * b.height / b.tan_y);
     let mut tris = Vec::new();
+    let mut sources = Vec::new();
     let mut cam: Vec<Vec3> = Vec::new();
-    for &(object, xf, mesh) in objects {
+    for (oi, &(object, xf, mesh)) in objects.iter().enumerate() {
         cam.clear();
         cam.extend(mesh.positions.iter().map(|&p| {
             let d = xf.transform_point3(p) - b.position;
             Vec3::new(d.dot(b.right), d.dot(b.up), d.dot(b.forward))
         }));
-        for t in &mesh.triangles {
+        for (ti, t) in mesh.triangles.iter().enumerate() {
             let [Some(v0), Some(v1), Some(v2)] = t.map(|i| cam.get(i as usize).copied()) else {
                 continue;
             };
@@ -72,6 +78,8 @@ pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)
                     1.0 / p.z,
                 )
             };
+            let source = sources.len() as u32;
+            let mut used = false;
             for k in 1..len.saturating_sub(1) {
                 let (p0, p1, p2) = (proj(poly[0]), proj(poly[k]), proj(poly[k + 1]));
                 let x = [p0.0, p1.0, p2.0];
@@ -93,17 +101,23 @@ pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)
                     y,
                     iz: [p0.2, p1.2, p2.2],
                     object,
+                    source,
                     ymin,
                     ymax,
                 });
+                used = true;
+            }
+            if used {
+                sources.push((oi as u32, ti as u32));
             }
         }
     }
-    Projected { tris }
+    Projected { tris, sources }
 }
 
 /// Scan-converts the rows `y0..y0 + zbuf.len() / width` of `tris`: `zbuf` (camera-space depth,
-/// ∞ initially) and `obj` (the nearest object) are that band of the image.
+/// ∞ initially) and `obj` (the nearest object) are that band of the image; `prim`, when
+/// given, receives the nearest triangle's index into [`Projected::sources`].
 ///
 /// Each triangle row visits only the span where its edge functions can be non-negative
 /// (solved in f64, widened by two pixels), and tests every pixel of the span exactly as a
@@ -115,6 +129,7 @@ pub(crate) fn raster_band(
     y0: usize,
     zbuf: &mut [f32],
     obj: &mut [u32],
+    mut prim: Option<&mut [u32]>,
 ) {
     let w = width;
     let rows = zbuf.len() / w.max(1);
@@ -192,6 +207,9 @@ pub(crate) fn raster_band(
                     for i in 0..4 {
                         if bits & (1 << i) != 0 {
                             obj[j + i] = t.object;
+                            if let Some(p) = prim.as_deref_mut() {
+                                p[j + i] = t.source;
+                            }
                         }
                     }
                 }
@@ -205,6 +223,9 @@ pub(crate) fn raster_band(
                 if z < zbuf[j] {
                     zbuf[j] = z;
                     obj[j] = t.object;
+                    if let Some(p) = prim.as_deref_mut() {
+                        p[j] = t.source;
+                    }
                 }
             }
         }
@@ -229,7 +250,7 @@ pub(crate) fn rasterize(
         .enumerate()
         .for_each(|(band, ((obj, dep), pos))| {
             let y0 = band * BAND;
-            raster_band(&tris, w, y0, dep, obj);
+            raster_band(&tris, w, y0, dep, obj, None);
             for (j, (z, p)) in dep.iter_mut().zip(pos.iter_mut()).enumerate() {
                 if z.is_finite() {
                     let (px, py) = ((j % w) as f32 + 0.5, (y0 + j / w) as f32 + 0.5);
@@ -247,4 +268,34 @@ pub(crate) fn rasterize(
         position,
         depth,
     }
+}
+
+/// Per pixel of `camera`'s image: the nearest of `tris`' objects (0: none), its triangle's
+/// index into [`Projected::sources`] and the distance from the eye along the pixel's ray (∞:
+/// none). What the material lookups of [`crate::shading`] need beside the mask.
+pub(crate) fn rasterize_sources(
+    camera: &Camera,
+    tris: &Projected,
+) -> (Vec<u32>, Vec<u32>, Vec<f32>) {
+    let b = camera.basis();
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let mut object = vec![0u32; w * h];
+    let mut prim = vec![u32::MAX; w * h];
+    let mut depth = vec![f32::INFINITY; w * h];
+    object
+        .par_chunks_mut(w * BAND)
+        .zip(prim.par_chunks_mut(w * BAND))
+        .zip(depth.par_chunks_mut(w * BAND))
+        .enumerate()
+        .for_each(|(band, ((obj, pr), dep))| {
+            let y0 = band * BAND;
+            raster_band(tris, w, y0, dep, obj, Some(pr));
+            for (j, z) in dep.iter_mut().enumerate() {
+                if z.is_finite() {
+                    let (px, py) = ((j % w) as f32 + 0.5, (y0 + j / w) as f32 + 0.5);
+                    *z /= b.direction(px, py).dot(b.forward);
+                }
+            }
+        });
+    (object, prim, depth)
 }

@@ -20,7 +20,8 @@ use crate::frame::{FallbackReport, Frame, Mode, Report};
 use crate::geometry::Layer;
 use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
-pub use crate::settings::{CubeFilter, ReconSettings};
+pub use crate::settings::{CubeFilter, ReconSettings, Shading};
+use crate::shading::Channel;
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
@@ -40,7 +41,9 @@ pub struct Reconstructor {
     bins: Mutex<HashMap<(u32, u32), Arc<BlockBins>>>,
     /// Interleaved texels of (view, key) for the geometry-assisted lookups; an entry is
     /// rebuilt when the chunk cache has reloaded its cubes.
-    packed: Mutex<HashMap<(u32, u32), Arc<PackedTexels>>>,
+    packed: Mutex<HashMap<(u32, u32, Channel), Arc<PackedTexels>>>,
+    /// The pack's materials, proxy UVs and decoded textures, loaded on first use.
+    materials: std::sync::OnceLock<crate::material::Materials>,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -55,6 +58,8 @@ impl std::fmt::Debug for Reconstructor {
 /// The cubes of one base view at one time key.
 #[derive(Clone)]
 pub(crate) struct KeyCubes {
+    /// The colour looked up: the radiance, or the channel [`Reconstructor::key_cubes_in`] was
+    /// asked for (lighting, non-diffuse radiance).
     pub radiance: Arc<CubeImage<Vec3>>,
     pub distance: Arc<CubeImage<f32>>,
     pub ids: Arc<CubeImage<u32>>,
@@ -83,6 +88,7 @@ impl Reconstructor {
             cache: Mutex::new(Cache::default()),
             bins: Mutex::new(HashMap::new()),
             packed: Mutex::new(HashMap::new()),
+            materials: std::sync::OnceLock::new(),
         }
     }
 
@@ -99,6 +105,12 @@ impl Reconstructor {
     /// The proxy geometry, if the pack has readable proxy meshes.
     pub fn proxy(&self) -> Option<&ProxyGeometry> {
         self.proxy.as_ref()
+    }
+
+    /// The pack's materials and proxy UVs (read on first use).
+    pub(crate) fn materials(&self) -> &crate::material::Materials {
+        self.materials
+            .get_or_init(|| crate::material::Materials::load(&self.pack))
     }
 
     /// The temporal filter half-width in use.
@@ -121,6 +133,14 @@ impl Reconstructor {
             ChunkKind::RadianceCube => self
                 .pack
                 .radiance(view, key)
+                .map(|c| Cached::Radiance(Arc::new(c))),
+            ChunkKind::LightingCube => self
+                .pack
+                .lighting(view, key)
+                .map(|c| Cached::Radiance(Arc::new(c))),
+            ChunkKind::NonDiffuseCube => self
+                .pack
+                .non_diffuse(view, key)
                 .map(|c| Cached::Radiance(Arc::new(c))),
             ChunkKind::DistanceCube => self
                 .pack
@@ -160,11 +180,23 @@ impl Reconstructor {
         value
     }
 
-    /// The three cubes of (view, key), or a description of what failed.
+    /// The radiance, distance, id (and normal) cubes of (view, key), or a description of
+    /// what failed.
     pub(crate) fn key_cubes(
         &self,
         view: usize,
         key: usize,
+        missing: &mut Vec<String>,
+    ) -> Option<KeyCubes> {
+        self.key_cubes_in(view, key, Channel::Radiance, missing)
+    }
+
+    /// [`Self::key_cubes`] with the colour of `channel` in place of the radiance.
+    pub(crate) fn key_cubes_in(
+        &self,
+        view: usize,
+        key: usize,
+        channel: Channel,
         missing: &mut Vec<String>,
     ) -> Option<KeyCubes> {
         let (v, k) = (view as u32, key as u32);
@@ -172,9 +204,9 @@ impl Reconstructor {
             missing.push(format!("{kind} cube of base view {view}, key {key}: {e}"));
             None
         };
-        let radiance = match self.cached(ChunkKind::RadianceCube, v, k) {
+        let radiance = match self.cached(channel.kind(), v, k) {
             Cached::Radiance(c) => c,
-            Cached::Failed(e) => return fail("radiance", e),
+            Cached::Failed(e) => return fail(channel.name(), e),
             _ => return None,
         };
         let distance = match self.cached(ChunkKind::DistanceCube, v, k) {
@@ -256,14 +288,16 @@ impl Reconstructor {
         Some(b)
     }
 
-    /// The cubes of (view, key) interleaved per texel (built once per decoded key).
+    /// The cubes of (view, key) interleaved per texel (built once per decoded key and
+    /// channel).
     pub(crate) fn packed_texels(
         &self,
         view: usize,
         key: usize,
+        channel: Channel,
         cubes: &KeyCubes,
     ) -> Arc<PackedTexels> {
-        let k = (view as u32, key as u32);
+        let k = (view as u32, key as u32, channel);
         let mut packed = self.packed.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(p) = packed.get(&k)
             && p.built_from(cubes)
@@ -338,7 +372,7 @@ impl Reconstructor {
                 return Ok((frame, report));
             }
             Mode::GeometryAssisted if self.proxy.is_some() => {
-                crate::geometry::render(self, camera, t, None, Layer::All, &mut report)?
+                crate::shading::render(self, camera, t, None, Layer::All, &mut report)?
             }
             Mode::GeometryAssisted => {
                 report
@@ -383,7 +417,7 @@ impl Reconstructor {
             ..Report::default()
         };
         let mut frame =
-            crate::geometry::render(self, camera, t, Some(mask), Layer::All, &mut report)?;
+            crate::shading::render(self, camera, t, Some(mask), Layer::All, &mut report)?;
         let env = self.environment.at(t);
         background::apply(&env, camera, Coverage::Mask(mask), &mut frame);
         Ok((frame, report))

@@ -44,6 +44,21 @@ pub struct ReconSettings {
     /// Image and volume modes: largest splat edge, pixels (a texel's footprint is capped at
     /// it; larger closes more gaps near the camera and blurs more).
     pub max_splat_px: f32,
+    /// What the geometry-assisted mode shows on objects that have a material in the pack.
+    pub shading: Shading,
+}
+
+/// What the geometry-assisted mode shows on objects with a material ([`crate::shading`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Shading {
+    /// The material's albedo at each pixel's UV × the baked lighting + the baked non-diffuse
+    /// radiance (pack v2): textures at screen resolution. Objects without a material show
+    /// their radiance. Three lookup passes instead of one (benches/recon.rs).
+    #[default]
+    Materials,
+    /// The baked radiance, as image and volume modes and version-1 packs show it: textures
+    /// at cube resolution, one lookup pass. What the plugin's GPU path shows today.
+    Radiance,
 }
 
 /// How radiance is read from a base view's cube in the geometry-assisted mode.
@@ -76,6 +91,7 @@ impl Default for ReconSettings {
             cube_filter: CubeFilter::Nearest,
             same_surface: 0.03,
             max_splat_px: 8.0,
+            shading: Shading::Materials,
         }
     }
 }

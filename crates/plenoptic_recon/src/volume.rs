@@ -33,6 +33,7 @@ use crate::camera::Camera;
 use crate::delaunay3::{DelaunayError, Interpolate, SliceTriangle, slice_at};
 use crate::frame::{Frame, Report};
 use crate::reconstructor::Reconstructor;
+use crate::shading::Channel;
 use crate::warp::{ViewCubes, Warped, warp_view};
 use crate::{Error, Result};
 
@@ -48,6 +49,8 @@ const BIN_FACE: u32 = 16;
 #[derive(Clone, Debug)]
 pub struct VolumeIndex {
     blocks: Vec<Arc<BlockBins>>,
+    /// Which of a sample's colours a lookup returns.
+    channel: Channel,
     t: f32,
     eps: f32,
 }
@@ -131,6 +134,7 @@ impl VolumeIndex {
         rec: &Reconstructor,
         view: usize,
         t: f32,
+        channel: Channel,
         missing: &mut Vec<String>,
     ) -> Option<Self> {
         let m = rec.pack().manifest();
@@ -144,7 +148,12 @@ impl VolumeIndex {
                 blocks.push(bins);
             }
         }
-        (!blocks.is_empty()).then_some(VolumeIndex { blocks, t, eps })
+        (!blocks.is_empty()).then_some(VolumeIndex {
+            blocks,
+            channel,
+            t,
+            eps,
+        })
     }
 
     /// Number of samples in the window.
@@ -161,7 +170,8 @@ impl VolumeIndex {
         self.len() == 0
     }
 
-    /// The filtered radiance of object `object`'s samples whose cone contains direction `d`
+    /// The filtered colour (radiance, or the index's channel) of object `object`'s samples
+    /// whose cone contains direction `d`
     /// (from the base view; its length is the expected distance) and whose distance agrees
     /// within `tol` (relative): `(radiance, total weight)`. Samples weigh by the tent filter
     /// `1 − |t_s − t|/tε` times their cone's falloff.
@@ -188,7 +198,7 @@ impl VolumeIndex {
                 let r = s.radius.max(bin_angle * 0.5);
                 if angle < r {
                     let w = tw * (1.0 - angle / r).max(1e-3);
-                    sum += s.radiance * w;
+                    sum += self.channel.of_sample(s) * w;
                     ws += w;
                 }
             }

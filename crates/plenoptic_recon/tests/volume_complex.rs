@@ -53,6 +53,8 @@ fn write_pack(path: &Path, complex: bool) {
                     direction: cube::oct_decode(Vec2::new(x, y)),
                     t,
                     radiance: radiance(x, y, t),
+                    lighting: radiance(x, y, t),
+                    non_diffuse: Vec3::ZERO,
                     distance: distance(x, y, t),
                     normal: Vec3::Z,
                     object_id: 1,

@@ -70,6 +70,7 @@ use plenoptic_trace::{Image, RadianceSample};
 use serde::{Deserialize, Serialize};
 
 use crate::render::pack_object_id;
+use cube::CubeGrid;
 
 pub use atrous::denoise;
 
@@ -188,16 +189,75 @@ impl LightingCube {
         (self.albedo[i] * self.lighting[i] + self.residual[i]).max(Vec3::ZERO)
     }
 
-    /// The range image of the records: radiance re-modulated, the guides as they are.
+    /// The range image of the records (pack v2): radiance re-modulated, the lighting with
+    /// [`fill_lighting`] applied, the residual as the non-diffuse part, the guides as they are.
     pub fn to_range_image(&self) -> RangeImage {
         let n = self.face_size;
+        let lighting = self.filled_lighting();
         RangeImage {
             radiance: CubeImage::from_fn(n, |i, _| self.radiance(i)),
+            lighting: CubeImage {
+                face_size: n,
+                texels: lighting,
+            },
+            non_diffuse: CubeImage::from_fn(n, |i, _| self.residual[i].max(Vec3::ZERO)),
             distance: CubeImage::from_fn(n, |i, _| self.distance[i]),
             object_id: CubeImage::from_fn(n, |i, _| self.object[i]),
             normal: CubeImage::from_fn(n, |i, _| self.normal[i]),
         }
     }
+
+    /// The lighting, where texels of an object without diffuse albedo (black, metal, clear
+    /// glass) take the mean lighting of their filterable 8-neighbours on the same object,
+    /// grown ring by ring ([`FILL_RINGS`] at most; then zero). The runtime filters the lighting
+    /// bilinearly and multiplies it by the albedo at the pixel, which may be bright where the
+    /// texel centre was dark (a grout line, a dark fleck in a texture); a zero there would
+    /// darken its neighbours.
+    pub fn filled_lighting(&self) -> Vec<Vec3> {
+        let grid = CubeGrid::new(self.face_size);
+        let mut lighting = self.lighting.clone();
+        let mut known: Vec<bool> = (0..self.len()).map(|i| self.filterable(i)).collect();
+        for _ in 0..FILL_RINGS {
+            let mut grown = Vec::new();
+            for i in 0..self.len() {
+                if known[i] || self.object[i] == 0 {
+                    continue;
+                }
+                let (face, x, y) = grid.coords(i);
+                let (mut sum, mut count) = (Vec3::ZERO, 0u32);
+                for dj in -1..=1 {
+                    for di in -1..=1 {
+                        let q = grid.offset(face, x, y, di, dj);
+                        if q != i && known[q] && self.object[q] == self.object[i] {
+                            sum += lighting[q];
+                            count += 1;
+                        }
+                    }
+                }
+                if count > 0 {
+                    grown.push((i, sum / count as f32));
+                }
+            }
+            if grown.is_empty() {
+                break;
+            }
+            for (i, l) in grown {
+                lighting[i] = l;
+                known[i] = true;
+            }
+        }
+        lighting
+    }
+}
+
+/// Most rings [`LightingCube::filled_lighting`] grows the known lighting by.
+pub const FILL_RINGS: usize = 8;
+
+/// `(lighting, non-diffuse)` of one rendered sample (a temporal-volume sample: pack v2 stores
+/// them beside its radiance), as a range-image texel splits them.
+pub fn split_sample(s: &RadianceSample) -> (Vec3, Vec3) {
+    let (lighting, _, residual) = split(s.radiance.max(Vec3::ZERO), s.diffuse, s.albedo);
+    (lighting, residual.max(Vec3::ZERO))
 }
 
 /// `(lighting, albedo, residual)` of a texel with `radiance`, of which `diffuse` is the

@@ -134,6 +134,8 @@ pub fn room_image(n: u32, phase: f32) -> RangeImage {
     let mut ids = Vec::new();
     let mut normals = Vec::new();
     let mut rad = Vec::new();
+    let mut lighting = Vec::new();
+    let mut non_diffuse = Vec::new();
     for i in 0..6 * (n as usize).pow(2) {
         let d = plenoptic_pack::cube::texel_direction(n, i);
         // Distance to the room's walls along d.
@@ -164,17 +166,24 @@ pub fn room_image(n: u32, phase: f32) -> RangeImage {
         let falloff = 2.0 / (1.0 + (hit - light).length_squared());
         let albedo = Vec3::new(0.6 + 0.05 * id as f32, 0.55, 0.5 - 0.03 * id as f32);
         let mut r = albedo * falloff;
+        let mut l = Vec3::splat(falloff);
+        let mut e = Vec3::ZERO;
         // A bright window on the +X wall.
         if axis == 0 && d.x > 0.0 && p.y.abs() < 0.5 && p.z.abs() < 1.0 {
             r = Vec3::new(40.0, 38.0, 35.0);
+            (l, e) = (Vec3::ZERO, r);
             id = 20;
         }
+        lighting.push(l);
+        non_diffuse.push(e);
         dist.push(dist_v);
         ids.push(id);
         normals.push(normal);
         rad.push(r);
     }
     img.radiance.texels = rad;
+    img.lighting.texels = lighting;
+    img.non_diffuse.texels = non_diffuse;
     img.distance.texels = dist;
     img.object_id.texels = ids;
     img.normal.texels = normals;
@@ -188,6 +197,8 @@ pub fn volume_samples(count: usize, t0: f32, t1: f32, seed: u64) -> Vec<VolumeSa
             direction: rng.direction(),
             t: t0 + (t1 - t0) * rng.unit(),
             radiance: Vec3::new(rng.unit() * 10.0, rng.unit(), rng.unit() * 0.1),
+            lighting: Vec3::new(rng.unit() * 4.0, rng.unit(), rng.unit() * 0.5),
+            non_diffuse: Vec3::new(rng.unit() * 0.2, 0.0, rng.unit()),
             distance: 0.5 + rng.unit() * 8.0,
             normal: rng.direction(),
             object_id: (i % 7) as u32,

@@ -173,9 +173,26 @@ fn object_colour(id: u32) -> Vec3 {
     )
 }
 
+/// One analytic hit as a pack stores it.
+#[derive(Clone, Copy, Debug)]
+pub struct Shaded {
+    /// Radiance: `albedo · lighting + non_diffuse`.
+    pub radiance: Vec3,
+    /// Diffuse lighting (pack v2).
+    pub lighting: Vec3,
+    /// The view-dependent highlight (pack v2's non-diffuse part).
+    pub non_diffuse: Vec3,
+    /// Distance along the ray.
+    pub distance: f32,
+    /// Pack object id.
+    pub object: u32,
+    /// Normal facing the ray.
+    pub normal: Vec3,
+}
+
 /// Deterministic shading of a hit seen along `ray`: object colour × object-space checker ×
 /// (ambient + shadowed diffuse) + a view-dependent highlight.
-pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<(Vec3, f32, u32, Vec3)> {
+pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<Shaded> {
     let hit = placed.intersect(ray)?;
     let local = placed
         .object_transform(hit.object)
@@ -202,12 +219,16 @@ pub fn shade(placed: &PlacedScene<'_>, ray: &Ray) -> Option<(Vec3, f32, u32, Vec
     } else {
         0.0
     };
-    Some((
-        albedo * (0.15 + diffuse) + Vec3::splat(spec),
-        hit.distance,
-        hit.object + 1,
-        n,
-    ))
+    let lighting = Vec3::splat(0.15 + diffuse);
+    let non_diffuse = Vec3::splat(spec);
+    Some(Shaded {
+        radiance: albedo * lighting + non_diffuse,
+        lighting,
+        non_diffuse,
+        distance: hit.distance,
+        object: hit.object + 1,
+        normal: n,
+    })
 }
 
 /// Range image of face size `n` from `position` with the scene placed at `placed`.
@@ -219,11 +240,13 @@ pub fn range_image(placed: &PlacedScene<'_>, position: Vec3, n: u32) -> RangeIma
     });
     let mut r = RangeImage::new(n);
     for (i, s) in img.pixels.into_iter().enumerate() {
-        if let Some((c, d, o, nn)) = s {
-            r.radiance.texels[i] = c;
-            r.distance.texels[i] = d;
-            r.object_id.texels[i] = o;
-            r.normal.texels[i] = nn;
+        if let Some(s) = s {
+            r.radiance.texels[i] = s.radiance;
+            r.lighting.texels[i] = s.lighting;
+            r.non_diffuse.texels[i] = s.non_diffuse;
+            r.distance.texels[i] = s.distance;
+            r.object_id.texels[i] = s.object;
+            r.normal.texels[i] = s.normal;
         }
     }
     r
@@ -243,7 +266,7 @@ pub fn reference(placed: &PlacedScene<'_>, camera: &plenoptic_recon::Camera) -> 
     let b = camera.basis();
     Image::render(camera.width, camera.height, |x, y| {
         let dir = b.direction(x as f32 + 0.5, y as f32 + 0.5);
-        shade(placed, &Ray::new(camera.position, dir)).map_or(Vec3::ZERO, |s| s.0)
+        shade(placed, &Ray::new(camera.position, dir)).map_or(Vec3::ZERO, |s| s.radiance)
     })
 }
 
@@ -391,13 +414,15 @@ pub fn write_pack_with(
                 let samples: Vec<VolumeSample> = (0..m)
                     .filter_map(|i| {
                         let p = accel.at_time(times[i]);
-                        shade(&p, &Ray::new(pos, dirs[i])).map(|(c, d, o, n)| VolumeSample {
+                        shade(&p, &Ray::new(pos, dirs[i])).map(|s| VolumeSample {
                             direction: dirs[i],
                             t: times[i],
-                            radiance: c,
-                            distance: d,
-                            normal: n,
-                            object_id: o,
+                            radiance: s.radiance,
+                            lighting: s.lighting,
+                            non_diffuse: s.non_diffuse,
+                            distance: s.distance,
+                            normal: s.normal,
+                            object_id: s.object,
                             radius,
                         })
                     })

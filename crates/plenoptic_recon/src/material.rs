@@ -1,0 +1,257 @@
+//! The pack's materials at screen resolution (docs/architecture.md, "Pack v2"; design.md:
+//! "albedo(uv, mip chosen by screen-space footprint) × lighting"): per object its glTF
+//! material and proxy UVs, and the diffuse albedo at any UV, sampled from the material's
+//! mipmapped textures with trilinear filtering.
+//!
+//! The albedo is the one the bake divided the lighting by ([`plenoptic_pack::RangeImage`]):
+//! `(1 − metallic)(1 − transmission) · base colour`, with the base-colour texture in sRGB
+//! decoded to linear and metallic multiplied by the metallic-roughness texture's blue channel.
+//! UVs pass through the binding's `KHR_texture_transform` and wrap modes first.
+//!
+//! Textures are decoded from the pack on first use and kept (their size is bounded by the
+//! pack's `MAX_TEXTURE_SIDE`); one that cannot be read is reported once and treated as white.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use glam::{Vec2, Vec3, Vec4};
+use plenoptic_pack::{
+    ColourSpace, MaterialEntry, PackReader, TextureBinding, TextureImage, UvTransform, WrapMode,
+};
+
+/// One object's material and the UVs of its proxy vertices (empty: none).
+pub(crate) struct ObjectMaterial {
+    pub material: MaterialEntry,
+    pub uvs: Vec<Vec2>,
+}
+
+/// The materials of a pack's objects, with their textures decoded on first use.
+pub(crate) struct Materials {
+    objects: HashMap<u32, ObjectMaterial>,
+    textures: Vec<OnceLock<Option<Arc<TextureImage>>>>,
+    /// Messages about textures or attributes that could not be read.
+    pub missing: Mutex<Vec<String>>,
+}
+
+/// sRGB-encoded byte → linear value.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|i| plenoptic_pack::texture::srgb_to_linear(i as f32 / 255.0))
+    })
+}
+
+impl Materials {
+    /// Reads the material table, each object's material and its proxy's UVs (whose vertex
+    /// count the pack reader checked against the proxy mesh).
+    pub fn load(pack: &PackReader) -> Self {
+        let mut objects = HashMap::new();
+        let mut missing = Vec::new();
+        for o in &pack.manifest().objects {
+            let Some(material) = pack.object_material(o.id) else {
+                continue;
+            };
+            let uvs = match pack.proxy_attributes(o.id) {
+                Ok(a) => a.map(|a| a.uvs).unwrap_or_default(),
+                Err(e) => {
+                    missing.push(format!("UVs of object {}: {e}", o.id));
+                    Vec::new()
+                }
+            };
+            objects.insert(
+                o.id,
+                ObjectMaterial {
+                    material: material.clone(),
+                    uvs,
+                },
+            );
+        }
+        Materials {
+            objects,
+            textures: (0..pack.textures().len())
+                .map(|_| OnceLock::new())
+                .collect(),
+            missing: Mutex::new(missing),
+        }
+    }
+
+    /// The material of pack object `id`, if it has one.
+    pub fn object(&self, id: u32) -> Option<&ObjectMaterial> {
+        self.objects.get(&id)
+    }
+
+    /// The messages about what could not be read so far.
+    pub fn messages(&self) -> Vec<String> {
+        self.missing.lock().map(|m| m.clone()).unwrap_or_default()
+    }
+
+    /// Whether no object has a material.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+
+    fn texture(&self, pack: &PackReader, index: u32) -> Option<&TextureImage> {
+        let slot = self.textures.get(index as usize)?;
+        slot.get_or_init(|| match pack.texture(index) {
+            Ok(t) => Some(Arc::new(t)),
+            Err(e) => {
+                if let Ok(mut m) = self.missing.lock() {
+                    m.push(format!("material texture {index}: {e}"));
+                }
+                None
+            }
+        })
+        .as_deref()
+    }
+
+    /// The diffuse albedo of `m` at `uv`, with the texture's mip chosen from `footprint`: the
+    /// pixel's size in UV units (before the binding's transform).
+    pub fn albedo(&self, pack: &PackReader, m: &MaterialEntry, uv: Vec2, footprint: f32) -> Vec3 {
+        let mut base = m.base_colour.truncate();
+        if let Some(b) = m.base_colour_texture
+            && let Some(t) = self.texture(pack, b.texture)
+        {
+            base *= sample(t, b, uv, footprint).truncate();
+        }
+        let mut metallic = m.metallic;
+        if let Some(b) = m.metallic_roughness_texture
+            && let Some(t) = self.texture(pack, b.texture)
+        {
+            metallic *= sample(t, b, uv, footprint).z;
+        }
+        base * ((1.0 - metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission.clamp(0.0, 1.0)))
+    }
+}
+
+/// `KHR_texture_transform` applied to `uv`.
+fn transform(t: &UvTransform, uv: Vec2) -> Vec2 {
+    let s = uv * t.scale;
+    let (sin, cos) = t.rotation.sin_cos();
+    t.offset + Vec2::new(cos * s.x + sin * s.y, -sin * s.x + cos * s.y)
+}
+
+/// Wraps texel coordinate `i` of a side of `n` texels.
+fn wrap(i: i64, n: i64, mode: WrapMode) -> usize {
+    let n = n.max(1);
+    (match mode {
+        WrapMode::Repeat => i.rem_euclid(n),
+        WrapMode::ClampToEdge => i.clamp(0, n - 1),
+        WrapMode::MirroredRepeat => {
+            let p = i.rem_euclid(2 * n);
+            if p < n { p } else { 2 * n - 1 - p }
+        }
+    }) as usize
+}
+
+/// Trilinear sample of `texture` through binding `b` at `uv`, linear RGBA. `footprint` is
+/// the pixel's size in UV units; the level is `log₂(footprint · size)` (the transform's scale
+/// included).
+pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footprint: f32) -> Vec4 {
+    let Some(top) = texture.levels.first() else {
+        return Vec4::ONE;
+    };
+    let (uv, scale) = match &b.transform {
+        Some(t) => (transform(t, uv), t.scale.abs().max_element()),
+        None => (uv, 1.0),
+    };
+    let texels = footprint * scale * top.width.max(top.height) as f32;
+    let lod = if texels > 1.0 { texels.log2() } else { 0.0 };
+    let last = texture.levels.len() - 1;
+    let l0 = (lod.floor() as usize).min(last);
+    let l1 = (l0 + 1).min(last);
+    let f = (lod - l0 as f32).clamp(0.0, 1.0);
+    let a = bilinear(texture, l0, b, uv);
+    if l1 == l0 || f <= 0.0 {
+        return a;
+    }
+    a.lerp(bilinear(texture, l1, b, uv), f)
+}
+
+fn bilinear(texture: &TextureImage, level: usize, b: TextureBinding, uv: Vec2) -> Vec4 {
+    let l = &texture.levels[level];
+    let (w, h) = (l.width as i64, l.height as i64);
+    let x = uv.x * w as f32 - 0.5;
+    let y = uv.y * h as f32 - 0.5;
+    if !(x.is_finite() && y.is_finite()) {
+        return Vec4::ONE;
+    }
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let srgb = texture.colour_space == ColourSpace::Srgb;
+    let table = srgb_table();
+    let texel = |i: i64, j: i64| {
+        let (i, j) = (wrap(i, w, b.wrap_s), wrap(j, h, b.wrap_t));
+        let k = 4 * (j * w as usize + i);
+        let Some(p) = l.texels.get(k..k + 4) else {
+            return Vec4::ONE;
+        };
+        let c = |v: u8| {
+            if srgb {
+                table[v as usize]
+            } else {
+                v as f32 / 255.0
+            }
+        };
+        Vec4::new(c(p[0]), c(p[1]), c(p[2]), p[3] as f32 / 255.0)
+    };
+    let top = texel(x0, y0).lerp(texel(x0 + 1, y0), fx);
+    let bottom = texel(x0, y0 + 1).lerp(texel(x0 + 1, y0 + 1), fx);
+    top.lerp(bottom, fy)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4×4 linear texture: a black and white checker of 2×2 blocks.
+    fn checker() -> TextureImage {
+        let mut texels = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                let v = if (i / 2 + j / 2) % 2 == 0 { 255 } else { 0 };
+                texels.extend_from_slice(&[v, v, v, 255]);
+            }
+        }
+        TextureImage::with_mips(ColourSpace::Linear, 4, 4, texels).unwrap()
+    }
+
+    fn binding() -> TextureBinding {
+        TextureBinding {
+            texture: 0,
+            wrap_s: WrapMode::Repeat,
+            wrap_t: WrapMode::Repeat,
+            transform: None,
+        }
+    }
+
+    #[test]
+    fn texel_centres_are_exact_and_far_pixels_average_the_checker() {
+        let t = checker();
+        let at = |u: f32, v: f32, fp: f32| sample(&t, binding(), Vec2::new(u, v), fp).x;
+        assert!((at(0.125, 0.125, 0.0) - 1.0).abs() < 1e-6);
+        assert!(at(0.625, 0.125, 0.0).abs() < 1e-6);
+        // A pixel covering the whole texture reads the 1×1 level: the mean (to 8 bits).
+        assert!((at(0.3, 0.7, 1.0) - 0.5).abs() < 3e-3);
+        // Repeat wraps; the transform's scale tiles.
+        assert!((at(1.125, -0.875, 0.0) - 1.0).abs() < 1e-6);
+        let scaled = TextureBinding {
+            transform: Some(UvTransform {
+                offset: Vec2::ZERO,
+                rotation: 0.0,
+                scale: Vec2::splat(2.0),
+            }),
+            ..binding()
+        };
+        assert!(sample(&t, scaled, Vec2::new(0.3125, 0.0625), 0.0).x.abs() < 1e-6);
+    }
+
+    #[test]
+    fn wrap_modes() {
+        assert_eq!(wrap(-1, 4, WrapMode::Repeat), 3);
+        assert_eq!(wrap(-1, 4, WrapMode::ClampToEdge), 0);
+        assert_eq!(wrap(5, 4, WrapMode::ClampToEdge), 3);
+        assert_eq!(wrap(4, 4, WrapMode::MirroredRepeat), 3);
+        assert_eq!(wrap(-1, 4, WrapMode::MirroredRepeat), 0);
+    }
+}

@@ -1,0 +1,236 @@
+//! Geometry-assisted frames from pack v2 (docs/architecture.md, "Pack v2"; thesis ch. 8:
+//! separating illumination quality from image quality): a pixel on an object with a material
+//! is
+//!
+//! `albedo(uv) · lighting + non-diffuse`
+//!
+//! where the *lighting* and the *non-diffuse radiance* (emission plus the specular part as
+//! the base views saw it) are looked up in the range images exactly as the radiance was
+//! (motion-compensated, view- and time-blended, with the volume and hole-fill fallbacks of
+//! [`crate::geometry`]), and the *albedo* comes from the object's material at the pixel's own
+//! UV, with the texture's mip chosen by the pixel's footprint ([`crate::material`]). Texture
+//! detail is therefore at screen resolution whatever the cube size; only the lighting is at
+//! cube resolution.
+//!
+//! One geometry pass runs per channel: radiance for objects without a material (and for the
+//! environment where nothing is), lighting and non-diffuse for the others, each skipping the
+//! objects another pass shades. A separate raster pass gives each pixel its triangle, from
+//! which the UV is interpolated (barycentric coordinates of the pixel's point on the placed
+//! triangle) and the footprint computed (the pixel's size on the surface, `distance · pixel
+//! angle / √|cos θ|`, times the triangle's UV-per-metre scale).
+//!
+//! Not yet built: normal maps (the stored lighting is for the texel's normal only), runtime
+//! specular for the actual camera (the non-diffuse part is the base views'), emissive
+//! textures (emission is in the non-diffuse cube at cube resolution).
+
+use glam::{Vec2, Vec3};
+use plenoptic_pack::{ChunkKind, VolumeSample};
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::frame::{Frame, Report};
+use crate::geometry::{self, Layer, Pass};
+use crate::material::Materials;
+use crate::proxy::GeometryMask;
+use crate::settings::Shading;
+use crate::{Reconstructor, Result};
+
+/// Which colour a geometry-assisted pass looks up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Channel {
+    /// Outgoing radiance (version 1's only colour; image and volume modes).
+    Radiance,
+    /// Diffuse lighting: what the diffuse albedo multiplies.
+    Lighting,
+    /// Emission plus the specular part.
+    NonDiffuse,
+}
+
+impl Channel {
+    /// The cube chunk kind holding the channel.
+    pub fn kind(self) -> ChunkKind {
+        match self {
+            Channel::Radiance => ChunkKind::RadianceCube,
+            Channel::Lighting => ChunkKind::LightingCube,
+            Channel::NonDiffuse => ChunkKind::NonDiffuseCube,
+        }
+    }
+
+    /// The channel's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Radiance => "radiance",
+            Channel::Lighting => "lighting",
+            Channel::NonDiffuse => "non-diffuse",
+        }
+    }
+
+    /// The channel's value in a temporal-volume sample.
+    pub fn of_sample(self, s: &VolumeSample) -> Vec3 {
+        match self {
+            Channel::Radiance => s.radiance,
+            Channel::Lighting => s.lighting,
+            Channel::NonDiffuse => s.non_diffuse,
+        }
+    }
+}
+
+/// Renders a geometry-assisted frame of the proxies of `layer`: with materials as the module
+/// doc says when the settings ask for it and the pack has materials, else from the radiance.
+pub(crate) fn render(
+    rec: &Reconstructor,
+    camera: &Camera,
+    t: f32,
+    mask: Option<&GeometryMask>,
+    layer: Layer<'_>,
+    report: &mut Report,
+) -> Result<Frame> {
+    let materials = rec.materials();
+    if rec.settings.shading == Shading::Radiance || materials.is_empty() {
+        return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+    }
+    let Some(proxy) = rec.proxy() else {
+        return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+    };
+    let ids = proxy.object_ids();
+    let (lit, unlit): (Vec<u32>, Vec<u32>) =
+        ids.iter().partition(|&&o| materials.object(o).is_some());
+    let pass = |channel, skip| Pass {
+        layer,
+        channel,
+        skip,
+    };
+    let start = std::time::Instant::now();
+    let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
+    let mut side = Report::default();
+    let lighting = geometry::render(
+        rec,
+        camera,
+        t,
+        mask,
+        pass(Channel::Lighting, &unlit),
+        &mut side,
+    );
+    let non_diffuse = geometry::render(
+        rec,
+        camera,
+        t,
+        mask,
+        pass(Channel::NonDiffuse, &unlit),
+        &mut side,
+    );
+    // A pack v2 always has both; a damaged one falls back to the radiance frame.
+    let (lighting, non_diffuse) = match (lighting, non_diffuse) {
+        (Ok(l), Ok(s)) => (l, s),
+        (Err(e), _) | (_, Err(e)) => {
+            report.missing.push(format!("materials not applied: {e}"));
+            return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+        }
+    };
+    let albedo = albedo_image(rec, materials, camera, t, layer);
+    frame
+        .radiance
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(j, c)| {
+            if let Some((o, a)) = albedo[j]
+                && lighting.object[j] == o
+            {
+                *c = a * lighting.radiance[j] + non_diffuse.radiance[j];
+            }
+        });
+    report.fallback = side.fallback;
+    for m in side.missing.into_iter().chain(materials.messages()) {
+        if !report.missing.contains(&m) {
+            report.missing.push(m);
+        }
+    }
+    report
+        .stage_ms
+        .push(("materials".into(), start.elapsed().as_secs_f64() * 1e3));
+    Ok(frame)
+}
+
+/// Per pixel, the object seen there and the diffuse albedo of its material (`None` where no
+/// object with a material is).
+fn albedo_image(
+    rec: &Reconstructor,
+    materials: &Materials,
+    camera: &Camera,
+    t: f32,
+    layer: Layer<'_>,
+) -> Vec<Option<(u32, Vec3)>> {
+    let n = camera.pixel_count();
+    let Some(proxy) = rec.proxy() else {
+        return vec![None; n];
+    };
+    let mut placed = proxy.placed_meshes(t);
+    match layer {
+        Layer::All => {}
+        Layer::Without(ids) => placed.retain(|o| !ids.contains(&o.0)),
+        Layer::Only(ids) => placed.retain(|o| ids.contains(&o.0)),
+    }
+    let projected = crate::raster::project(camera, &placed);
+    let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
+    let basis = camera.basis();
+    let w = camera.width as usize;
+    // The angle one pixel subtends at the image centre.
+    let pixel_angle = 2.0 * basis.tan_y / basis.height;
+    (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let o = object[j];
+            let m = materials.object(o)?;
+            let &(oi, ti) = projected.sources.get(prim[j] as usize)?;
+            let (id, xf, mesh) = placed.get(oi as usize)?;
+            debug_assert_eq!(*id, o);
+            let tri = mesh.triangles.get(ti as usize)?;
+            let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+            let p = basis.position + dir * depth[j];
+            let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
+            let uvs = tri.map(|i| m.uvs.get(i as usize).copied());
+            let (uv, footprint) = match uvs {
+                [Some(a), Some(b), Some(c)] => {
+                    let bary = barycentric(p, v)?;
+                    let uv = a * bary.x + b * bary.y + c * bary.z;
+                    let world = (v[1] - v[0]).cross(v[2] - v[0]);
+                    let area_uv = (b - a).perp_dot(c - a).abs();
+                    let scale = (area_uv / world.length().max(1e-12)).sqrt();
+                    let cos = world.normalize_or_zero().dot(dir).abs().max(0.05);
+                    (uv, scale * depth[j] * pixel_angle / cos.sqrt())
+                }
+                _ => (Vec2::ZERO, f32::INFINITY),
+            };
+            Some((o, materials.albedo(rec.pack(), &m.material, uv, footprint)))
+        })
+        .collect()
+}
+
+/// Barycentric coordinates of `p` (on or near the triangle's plane) in triangle `v`.
+fn barycentric(p: Vec3, v: [Vec3; 3]) -> Option<Vec3> {
+    let (e0, e1, e2) = (v[1] - v[0], v[2] - v[0], p - v[0]);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (e2.dot(e0), e2.dot(e1));
+    let den = d00 * d11 - d01 * d01;
+    if den.abs() <= 1e-20 {
+        return None;
+    }
+    let b1 = (d11 * d20 - d01 * d21) / den;
+    let b2 = (d00 * d21 - d01 * d20) / den;
+    Some(Vec3::new(1.0 - b1 - b2, b1, b2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn barycentric_coordinates_recover_the_point() {
+        let v = [Vec3::ZERO, Vec3::X * 2.0, Vec3::new(0.0, 3.0, 1.0)];
+        let b = barycentric(Vec3::new(0.5, 0.75, 0.25), v).unwrap();
+        let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
+        assert!((p - Vec3::new(0.5, 0.75, 0.25)).length() < 1e-5);
+        assert!((b.x + b.y + b.z - 1.0).abs() < 1e-6);
+        assert!(barycentric(Vec3::ONE, [Vec3::ZERO; 3]).is_none());
+    }
+}
