@@ -73,15 +73,18 @@ pub(crate) struct Pass<'a> {
     pub channel: Channel,
     /// Pack ids whose pixels are left black and unfilled (another pass shades them).
     pub skip: &'a [u32],
+    /// How the cubes are read.
+    pub filter: CubeFilter,
 }
 
 impl<'a> Pass<'a> {
-    /// Radiance of every proxy of `layer`.
-    pub fn radiance(layer: Layer<'a>) -> Self {
+    /// Radiance of every proxy of `layer`, read as the settings say.
+    pub fn radiance(layer: Layer<'a>, filter: CubeFilter) -> Self {
         Pass {
             layer,
             channel: Channel::Radiance,
             skip: &[],
+            filter,
         }
     }
 }
@@ -100,6 +103,7 @@ pub(crate) fn render(
         layer,
         channel,
         skip,
+        filter,
     } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
@@ -248,7 +252,7 @@ pub(crate) fn render(
         .iter()
         .max_by(|a, b| a.weight.total_cmp(&b.weight))
         .map(|k| (k.base, k.cubes.radiance.clone()));
-    let bilinear = rec.settings.cube_filter == CubeFilter::Bilinear;
+    let bilinear = filter == CubeFilter::Bilinear;
     let shade = Shade {
         fast: &fast,
         tol,

@@ -12,6 +12,9 @@
 //! detail is therefore at screen resolution whatever the cube size; only the lighting is at
 //! cube resolution.
 //!
+//! The lighting and non-diffuse lookups are always seam-aware bilinear
+//! ([`CubeFilter::Bilinear`]): at cube resolution, nearest texels show as blocks.
+//!
 //! One geometry pass runs per channel: radiance for objects without a material (and for the
 //! environment where nothing is), lighting and non-diffuse for the others, each skipping the
 //! objects another pass shades. A separate raster pass gives each pixel its triangle, from
@@ -32,7 +35,7 @@ use crate::frame::{Frame, Report};
 use crate::geometry::{self, Layer, Pass};
 use crate::material::Materials;
 use crate::proxy::GeometryMask;
-use crate::settings::Shading;
+use crate::settings::{CubeFilter, Shading};
 use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
@@ -87,18 +90,39 @@ pub(crate) fn render(
 ) -> Result<Frame> {
     let materials = rec.materials();
     if rec.settings.shading == Shading::Radiance || materials.is_empty() {
-        return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+        return geometry::render(
+            rec,
+            camera,
+            t,
+            mask,
+            Pass::radiance(layer, rec.settings.cube_filter),
+            report,
+        );
     }
     let Some(proxy) = rec.proxy() else {
-        return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+        return geometry::render(
+            rec,
+            camera,
+            t,
+            mask,
+            Pass::radiance(layer, rec.settings.cube_filter),
+            report,
+        );
     };
     let ids = proxy.object_ids();
     let (lit, unlit): (Vec<u32>, Vec<u32>) =
         ids.iter().partition(|&&o| materials.object(o).is_some());
+    // The lighting is smooth and at cube resolution: always filtered (seam-aware bilinear,
+    // restricted to texels of the same object and distance), whatever the radiance uses.
     let pass = |channel, skip| Pass {
         layer,
         channel,
         skip,
+        filter: if channel == Channel::Radiance {
+            rec.settings.cube_filter
+        } else {
+            CubeFilter::Bilinear
+        },
     };
     let start = std::time::Instant::now();
     let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
@@ -124,7 +148,14 @@ pub(crate) fn render(
         (Ok(l), Ok(s)) => (l, s),
         (Err(e), _) | (_, Err(e)) => {
             report.missing.push(format!("materials not applied: {e}"));
-            return geometry::render(rec, camera, t, mask, Pass::radiance(layer), report);
+            return geometry::render(
+                rec,
+                camera,
+                t,
+                mask,
+                Pass::radiance(layer, rec.settings.cube_filter),
+                report,
+            );
         }
     };
     let albedo = albedo_image(rec, materials, camera, t, layer);
