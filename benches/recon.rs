@@ -2,7 +2,9 @@
 //! four base views (face size 128, five time keys, temporal volumes), on a synthetic pack
 //! built in the setup; the geometry-assisted mode also with seamless bilinear cube filtering
 //! (`geometry_bilinear`, `ReconSettings::cube_filter`; the other cases use the default,
-//! nearest texel); and the reference path tracer's time for the same frame, as a ratio
+//! nearest texel) and with materials (`geometry_textured`: pack 2.0's albedo from a 256²
+//! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`); and
+//! the reference path tracer's time for the same frame, as a ratio
 //! measured in the same run. The chunk cache is warm (decoded cubes, interleaved texels and
 //! binned volume blocks are built on the first frame), as in a walk-through.
 //!
@@ -45,6 +47,17 @@ fn bench(c: &mut Criterion) {
     let rec = Reconstructor::open(&path).unwrap();
     let mut bilinear = Reconstructor::open(&path).unwrap();
     bilinear.settings.cube_filter = CubeFilter::Bilinear;
+    // The same scene with materials: textured albedo × lighting + non-diffuse (pack 2.0).
+    let textured_path = dir.path().join("textured.pack");
+    write_pack(
+        &scene,
+        &PackSpec {
+            materials: Materials::Textured,
+            ..spec.clone()
+        },
+        &textured_path,
+    );
+    let textured = Reconstructor::open(&textured_path).unwrap();
     let mut group = c.benchmark_group("recon");
     group.sample_size(10);
     for (w, h) in [(640, 360), (1280, 720)] {
@@ -59,6 +72,10 @@ fn bench(c: &mut Criterion) {
         let _ = bilinear.render(&cam, T, mode).unwrap();
         group.bench_function(format!("geometry_bilinear/{w}x{h}"), |b| {
             b.iter(|| black_box(bilinear.render(black_box(&cam), T, mode).unwrap()))
+        });
+        let _ = textured.render(&cam, T, mode).unwrap();
+        group.bench_function(format!("geometry_textured/{w}x{h}"), |b| {
+            b.iter(|| black_box(textured.render(black_box(&cam), T, mode).unwrap()))
         });
     }
     let accel = SceneAccel::new(&scene).unwrap();

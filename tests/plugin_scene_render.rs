@@ -17,7 +17,7 @@ use bevy_plenoptic::proxy::ProxyOf;
 use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
 use bevy_plenoptic::streaming::{StreamState, StreamingStats, key_bytes};
 use common::*;
-use pack::{PackSpec, room, write_pack};
+use pack::{Materials, PackSpec, room, write_pack};
 
 fn room_pack(dir: &std::path::Path, views: usize) {
     write_pack(
@@ -235,6 +235,25 @@ fn plugin_and_cpu_frames_from(
     view: (Vec3, Vec3),
     mode: ReconMode,
 ) -> Frames {
+    plugin_and_cpu_frames_with(
+        backend,
+        volume_samples,
+        budget_keys,
+        view,
+        mode,
+        Materials::None,
+    )
+}
+
+/// [`plugin_and_cpu_frames_from`] of a pack whose objects have `materials`.
+fn plugin_and_cpu_frames_with(
+    backend: Backend,
+    volume_samples: usize,
+    budget_keys: Option<u64>,
+    view: (Vec3, Vec3),
+    mode: ReconMode,
+    materials: Materials,
+) -> Frames {
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::Reconstructor;
@@ -245,6 +264,7 @@ fn plugin_and_cpu_frames_from(
         &room(true),
         &PackSpec {
             volume_samples,
+            materials,
             ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
         },
         &path,
@@ -391,6 +411,27 @@ fn gpu_frame_matches_cpu_reconstruction() {
     );
 }
 
+/// Pack 2.0 on the GPU: objects with a material (base-colour factors, no textures) are shaded
+/// as albedo · lighting + non-diffuse, both looked up bilinearly, with the volume fallback and
+/// the hole fill in the same terms, as `plenoptic_recon` does. The frame differs from the
+/// radiance frame (the analytic shading's checker is in the radiance, not in the factors).
+#[test]
+fn gpu_frame_from_materials_matches_cpu() {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let mode = ReconMode::GeometryAssisted;
+    let f = plugin_and_cpu_frames_with(Backend::Gpu, 3000, None, view, mode, Materials::Factors);
+    assert!(f.fallback.volume > 0.02, "{:?}", f.fallback);
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+    let radiance = plugin_and_cpu_frames_from(Backend::Gpu, 3000, None, view, mode);
+    let (apart, same, _) = compare(&f.cpu, &radiance.cpu);
+    eprintln!("materials against radiance: mean {apart:.3}, within 5 % {same:.3}");
+    assert!(apart > 0.05 && same < 0.8, "{apart} {same}");
+}
+
 /// As above with temporal volumes in the pack: pixels that no time key sees take the volume
 /// samples of their object (on the GPU from the streamed, binned volume blocks).
 #[test]
@@ -413,12 +454,13 @@ fn gpu_frame_is_right_after_evictions_and_partial_uploads() {
     eprintln!("{:?}; {:?}", f.stats, f.uploads);
     assert!(f.stats.evictions >= 2, "{:?}", f.stats);
     assert!(f.stats.decoded_keys >= 6, "{:?}", f.stats);
-    // Only the keys' own layers travel: 6 faces of 8² texels of 16 bytes per key, one
-    // upload per decoded key (not the whole 4-slot texture per arrival).
+    // Only the keys' own layers travel: 6 faces of 8² texels of 16 + 8 bytes per key (key
+    // and shading textures), one upload per decoded key (not the whole 4-slot texture per
+    // arrival).
     assert_eq!(f.uploads.keys, f.stats.decoded_keys, "{:?}", f.uploads);
     assert_eq!(
         f.uploads.bytes,
-        f.uploads.keys * 6 * 64 * 16,
+        f.uploads.keys * 6 * 64 * (16 + 8),
         "{:?}",
         f.uploads
     );

@@ -1,6 +1,8 @@
 // Geometry-assisted reconstruction (thesis §8.2.3), per fragment of a proxy mesh.
 // Same lookups and weights as plenoptic_recon::geometry (nearest or seamless bilinear texel, id + distance test,
-// w_view · w_time · ((1 + cos θ)/2)^p); no volume fallback or hole fill.
+// w_view · w_time · ((1 + cos θ)/2)^p), with its volume fallback and hole fill. An object with a
+// material in a 2.0 pack is shaded as plenoptic_recon's shading module does it without textures:
+// albedo (the material's factors) · lighting + non-diffuse, both looked up bilinearly.
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
@@ -24,8 +26,11 @@ struct ReconParams {
     // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
     // frame, w: coverage of glazing.
     fill: vec4<f32>,
-    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter).
+    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
+    // y: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
     flags: vec4<f32>,
+    // xyz: the object's diffuse albedo when flags.y is 1.
+    albedo: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -40,11 +45,24 @@ struct ReconParams {
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ReconParams;
-// Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object, -, -).
+// Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object,
+// lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
 // The image-mode frame (image.wgsl), shown when params.fill.z is 1.
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
+// Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
+@group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
+
+// Whether this object is shaded from its material (albedo · lighting + non-diffuse).
+fn lit() -> bool {
+    return params.flags.y == 1.0;
+}
+
+// The shaded colour of a shading texel: albedo · lighting + non-diffuse.
+fn shaded(s: vec2<u32>) -> vec3<f32> {
+    return params.albedo.xyz * rgb9e5_decode(s.x) + rgb9e5_decode(s.y);
+}
 
 // plenoptic_pack::cube::oct_decode.
 fn oct_decode(e: vec2<f32>) -> vec3<f32> {
@@ -72,13 +90,22 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32
         let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
         let nearest = all(c == t);
         if nearest || (texel.z == object && abs(bitcast<f32>(texel.y) - l) <= tol * l) {
-            acc += vec4<f32>(rgb9e5_decode(texel.x), 1.0) * tap.w;
+            acc += vec4<f32>(colour(c, layer0, texel), 1.0) * tap.w;
         }
     }
     if acc.w > 0.0 {
         return acc.rgb / acc.w;
     }
-    return rgb9e5_decode(textureLoad(cubes, t.xy, layer0 + t.z, 0).x);
+    return colour(t, layer0, textureLoad(cubes, t.xy, layer0 + t.z, 0));
+}
+
+// The colour of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`):
+// its radiance, or its shaded lighting for an object shaded from its material.
+fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
+    if lit() {
+        return shaded(textureLoad(shading_cubes, c.xy, layer0 + c.z, 0).xy);
+    }
+    return rgb9e5_decode(texel.x);
 }
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
@@ -127,7 +154,8 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         }
         let w = params.weight[k].x * wa;
         var radiance = rgb9e5_decode(texel.x);
-        if params.flags.x == 1.0 {
+        // Lighting is always filtered (plenoptic_recon's shading module).
+        if params.flags.x == 1.0 || lit() {
             radiance = filtered(u32(params.base[k].w), n, d, t, object, dist, tol);
         }
         sum += radiance * w;
@@ -179,7 +207,11 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
             let r = max(a.w, half_bin);
             if angle < r {
                 let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
-                sum += b.rgb * w;
+                var value = b.rgb;
+                if lit() {
+                    value = shaded(c.zw);
+                }
+                sum += value * w;
                 ws += w;
             }
         }
@@ -325,8 +357,9 @@ fn radiance(in: VertexOutput) -> vec4<f32> {
     let h = u32(params.fill.y);
     if h < min(u32(params.header.x), MAX_LOOKUPS) {
         let t = cube_texel(p - params.base[h].xyz, n);
-        let layer = u32(params.base[h].w) + t.z;
-        return vec4<f32>(rgb9e5_decode(textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0).x), 1.0);
+        let layer0 = u32(params.base[h].w);
+        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
+        return vec4<f32>(colour(t, layer0, texel), 1.0);
     }
     return vec4<f32>(0.0, 0.0, 0.0, 1.0);
 }

@@ -166,6 +166,13 @@ pub struct PlenopticMaterial {
     /// camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
+    /// The resident keys' lighting and non-diffuse radiance ([`KeyTexture::shading`]).
+    #[texture(5, dimension = "2d_array", sample_type = "u_int")]
+    pub shading_cubes: Handle<Image>,
+    /// The object's diffuse albedo from its material in the pack: base-colour factor ×
+    /// (1 − metallic)(1 − transmission) (textures are not sampled on the GPU yet); `None`
+    /// for an object without a material, which shows its radiance.
+    pub albedo: Option<Vec3>,
     /// The object's coverage when it is see-through glazing (the pack's
     /// [`plenoptic_pack::ObjectEntry::coverage`]), else 1. Glazing is drawn in Bevy's
     /// transparent pass, blended over what lies behind it with this alpha in
@@ -200,8 +207,11 @@ pub struct ReconParams {
     /// (its output alpha in geometry-assisted mode; 1 or 0 for opaque objects).
     pub fill: Vec4,
     /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
-    /// `CubeFilter::Bilinear` (0: the nearest texel).
+    /// `CubeFilter::Bilinear` (0: the nearest texel); y: 1 to shade as albedo · lighting +
+    /// non-diffuse (`Shading::Materials`; those lookups are always bilinear).
     pub flags: Vec4,
+    /// The object's diffuse albedo (xyz) when `flags.y` is 1.
+    pub albedo: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -223,6 +233,9 @@ pub struct KeyTextures(pub HashMap<AssetId<RadiancePack>, KeyTexture>);
 pub struct KeyTexture {
     /// The texture.
     pub image: Handle<Image>,
+    /// The shading texture beside it, same layers: per texel the lighting and the non-diffuse
+    /// radiance (RGB9E5 each) of pack 2.0.
+    pub shading: Handle<Image>,
     /// Face size.
     pub face: u32,
     /// Slots it has room for.
@@ -266,6 +279,8 @@ fn attach_materials(
             volume_samples: vol.samples.clone(),
             volume_bins: vol.bins.clone(),
             image_frame: image_frame.0.clone(),
+            shading_cubes: tex.shading.clone(),
+            albedo: object_albedo(pack, of.id),
             coverage: object_coverage(pack, of.id),
         });
         commands
@@ -285,6 +300,15 @@ fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
         .find(|o| o.id == id)
         .and_then(|o| o.coverage)
         .map_or(1.0, |c| c.clamp(1e-3, 1.0))
+}
+
+/// The diffuse albedo of the pack's object `id` from its material's factors, as
+/// `plenoptic_recon`'s material module computes it without textures; `None` without a
+/// material or in a pack without lighting (before 2.0 no pack reads).
+fn object_albedo(pack: &RadiancePack, id: u32) -> Option<Vec3> {
+    let m = pack.reader.object_material(id)?;
+    let diffuse = (1.0 - m.metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission.clamp(0.0, 1.0));
+    Some(m.base_colour.truncate() * diffuse)
 }
 
 /// One lookup of a frame: a resident, uploaded (base view, time key).
@@ -484,6 +508,12 @@ fn update_materials(
         if let Some(mut mat) = materials.get_mut(&handle.0) {
             // Looked up in the manifest once, when the material was attached.
             params.fill.w = mat.coverage;
+            if let Some(a) = mat.albedo
+                && cam.settings.shading == plenoptic_recon::Shading::Materials
+            {
+                params.flags.y = 1.0;
+                params.albedo = a.extend(1.0);
+            }
             mat.params = params;
         }
     }

@@ -28,6 +28,8 @@ use crate::streaming::{DecodedKey, StreamCache, key_bytes};
 
 /// Bytes per texel of the key texture (`Rgba32Uint`).
 const TEXEL_BYTES: usize = 16;
+/// Bytes per texel of the shading texture (`Rg32Uint`: lighting, non-diffuse radiance).
+const SHADING_BYTES: usize = 8;
 
 /// One key's texels, interleaved, waiting to be written into its slot.
 #[derive(Debug, Clone)]
@@ -40,6 +42,10 @@ pub struct KeyUpload {
     pub face: u32,
     /// Six faces of `face`² texels of 16 bytes (`Rgba32Uint`).
     pub data: Vec<u8>,
+    /// The pack's shading texture ([`KeyTexture::shading`]).
+    pub shading_image: AssetId<Image>,
+    /// Six faces of `face`² texels of 8 bytes (`Rg32Uint`).
+    pub shading_data: Vec<u8>,
 }
 
 /// Key uploads queued this frame (main world; taken by the render world at extraction).
@@ -95,20 +101,24 @@ pub(super) fn upload_keys(
             let per_key = key_bytes(&pack.reader, (0, 0)).max(1);
             let slots =
                 (settings.memory_budget_bytes / per_key).clamp(1, (MAX_LAYERS / 6) as u64) as u32;
-            let mut image = Image::new_uninit(
-                Extent3d {
-                    width: face,
-                    height: face,
-                    depth_or_array_layers: 6 * slots,
-                },
-                TextureDimension::D2,
-                TextureFormat::Rgba32Uint,
-                // GPU only: keys are written into it in place (wgpu zero-initialises it).
-                RenderAssetUsages::RENDER_WORLD,
-            );
-            image.texture_view_descriptor = None;
+            let texture = |format| {
+                let mut image = Image::new_uninit(
+                    Extent3d {
+                        width: face,
+                        height: face,
+                        depth_or_array_layers: 6 * slots,
+                    },
+                    TextureDimension::D2,
+                    format,
+                    // GPU only: keys are written into it in place (wgpu zero-initialises it).
+                    RenderAssetUsages::RENDER_WORLD,
+                );
+                image.texture_view_descriptor = None;
+                image
+            };
             KeyTexture {
-                image: images.add(image),
+                image: images.add(texture(TextureFormat::Rgba32Uint)),
+                shading: images.add(texture(TextureFormat::Rg32Uint)),
                 face,
                 slots,
                 uploaded: HashMap::new(),
@@ -125,7 +135,7 @@ pub(super) fn upload_keys(
             .collect();
         fresh.sort_by_key(|f| f.1.slot);
         for (vk, r) in fresh {
-            let Some((data, normals)) = interleave(&r.data, tex.face) else {
+            let Some((data, shading_data, normals)) = interleave(&r.data, tex.face) else {
                 warn_once!(
                     "plenoptic: GPU reconstruction needs RGB9E5 radiance, R32F distance and \
                      R32Uint ids at face size {}; key {vk:?} not shown",
@@ -134,12 +144,14 @@ pub(super) fn upload_keys(
                 continue;
             };
             stats.keys += 1;
-            stats.bytes += data.len() as u64;
+            stats.bytes += (data.len() + shading_data.len()) as u64;
             uploads.0.push(KeyUpload {
                 image: tex.image.id(),
                 first_layer: 6 * r.slot,
                 face: tex.face,
                 data,
+                shading_image: tex.shading.id(),
+                shading_data,
             });
             tex.uploaded.insert(r.slot, vk);
             if normals {
@@ -152,9 +164,10 @@ pub(super) fn upload_keys(
 }
 
 /// A key's texels in the key texture's layout: per texel (radiance RGB9E5, distance f32 bits,
-/// object id, oct-encoded RG16Snorm normal or 0), and whether it had normals. `None` when
-/// its formats or face size do not fit.
-pub fn interleave(d: &DecodedKey, face: u32) -> Option<(Vec<u8>, bool)> {
+/// object id, oct-encoded RG16Snorm normal or 0); in the shading texture's layout: per texel
+/// (lighting RGB9E5, non-diffuse RGB9E5), zero for a pack without them; and whether it had
+/// normals. `None` when its formats or face size do not fit.
+pub fn interleave(d: &DecodedKey, face: u32) -> Option<(Vec<u8>, Vec<u8>, bool)> {
     let texels = (6 * d.face_size * d.face_size) as usize;
     if d.face_size != face
         || d.radiance.len() != texels * 4
@@ -175,7 +188,19 @@ pub fn interleave(d: &DecodedKey, face: u32) -> Option<(Vec<u8>, bool)> {
             o[12..16].copy_from_slice(&n[src]);
         }
     }
-    Some((data, normals.is_some()))
+    let rgb9e5 = |c: &Option<Vec<u8>>| c.as_ref().filter(|c| c.len() == texels * 4).cloned();
+    let (lighting, non_diffuse) = (rgb9e5(&d.lighting), rgb9e5(&d.non_diffuse));
+    let mut shading = vec![0u8; texels * SHADING_BYTES];
+    for (i, o) in shading.chunks_exact_mut(SHADING_BYTES).enumerate() {
+        let src = i * 4..i * 4 + 4;
+        if let Some(l) = &lighting {
+            o[0..4].copy_from_slice(&l[src.clone()]);
+        }
+        if let Some(s) = &non_diffuse {
+            o[4..8].copy_from_slice(&s[src]);
+        }
+    }
+    Some((data, shading, normals.is_some()))
 }
 
 fn extract_key_uploads(mut main: ResMut<MainWorld>, mut pending: ResMut<PendingKeyUploads>) {
@@ -193,32 +218,37 @@ fn write_key_uploads(
     queue: Res<RenderQueue>,
 ) {
     pending.0.retain(|u| {
-        let Some(gpu) = images.get(u.image) else {
+        let (Some(gpu), Some(shading)) = (images.get(u.image), images.get(u.shading_image)) else {
             return true;
         };
-        queue.write_texture(
-            TexelCopyTextureInfo {
-                texture: &gpu.texture,
-                mip_level: 0,
-                origin: Origin3d {
-                    x: 0,
-                    y: 0,
-                    z: u.first_layer,
+        for (texture, data, bytes) in [
+            (&gpu.texture, &u.data, TEXEL_BYTES),
+            (&shading.texture, &u.shading_data, SHADING_BYTES),
+        ] {
+            queue.write_texture(
+                TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: u.first_layer,
+                    },
+                    aspect: TextureAspect::All,
                 },
-                aspect: TextureAspect::All,
-            },
-            &u.data,
-            TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(u.face * TEXEL_BYTES as u32),
-                rows_per_image: Some(u.face),
-            },
-            Extent3d {
-                width: u.face,
-                height: u.face,
-                depth_or_array_layers: 6,
-            },
-        );
+                data,
+                TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(u.face * bytes as u32),
+                    rows_per_image: Some(u.face),
+                },
+                Extent3d {
+                    width: u.face,
+                    height: u.face,
+                    depth_or_array_layers: 6,
+                },
+            );
+        }
         false
     });
 }

@@ -116,6 +116,10 @@ pub struct DecodedKey {
     pub object_id: Vec<u8>,
     /// Normal texels, when the pack has them.
     pub normal: Option<Vec<u8>>,
+    /// Diffuse-lighting texels (pack 2.0; the radiance formats).
+    pub lighting: Option<Vec<u8>>,
+    /// Non-diffuse radiance texels (pack 2.0; the radiance formats).
+    pub non_diffuse: Option<Vec<u8>>,
 }
 
 impl DecodedKey {
@@ -124,11 +128,14 @@ impl DecodedKey {
         (self.radiance.len()
             + self.distance.len()
             + self.object_id.len()
-            + self.normal.as_ref().map_or(0, Vec::len)) as u64
+            + self.normal.as_ref().map_or(0, Vec::len)
+            + self.lighting.as_ref().map_or(0, Vec::len)
+            + self.non_diffuse.as_ref().map_or(0, Vec::len)) as u64
     }
 }
 
-/// Reads and decodes one key: its radiance, distance, object-id (and normal) cubes to
+/// Reads and decodes one key: its radiance, distance, object-id (and normal, lighting and
+/// non-diffuse) cubes to
 /// GPU-ready texel bytes. The error names the failing chunk.
 pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, (String, String)> {
     let name = |kind: ChunkKind| format!("{kind:?} view {view} key {key}");
@@ -140,7 +147,9 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
         let fail = |e: plenoptic_pack::PackError| (name(kind), e.to_string());
         let bytes = pack.chunk_bytes(i).map_err(fail)?;
         let formats = match kind {
-            ChunkKind::RadianceCube => &range_image::RADIANCE_FORMATS[..],
+            ChunkKind::RadianceCube | ChunkKind::LightingCube | ChunkKind::NonDiffuseCube => {
+                &range_image::RADIANCE_FORMATS[..]
+            }
             ChunkKind::DistanceCube => &range_image::DISTANCE_FORMATS[..],
             ChunkKind::ObjectIdCube => &range_image::OBJECT_ID_FORMATS[..],
             _ => &range_image::NORMAL_FORMATS[..],
@@ -154,12 +163,16 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
     let distance = required(ChunkKind::DistanceCube)?.1;
     let object_id = required(ChunkKind::ObjectIdCube)?.1;
     let normal = read(ChunkKind::NormalCube)?.map(|n| n.1);
+    let lighting = read(ChunkKind::LightingCube)?.map(|n| n.1);
+    let non_diffuse = read(ChunkKind::NonDiffuseCube)?.map(|n| n.1);
     Ok(DecodedKey {
         face_size,
         radiance,
         distance,
         object_id,
         normal,
+        lighting,
+        non_diffuse,
     })
 }
 
@@ -170,6 +183,8 @@ pub fn key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
         ChunkKind::DistanceCube,
         ChunkKind::ObjectIdCube,
         ChunkKind::NormalCube,
+        ChunkKind::LightingCube,
+        ChunkKind::NonDiffuseCube,
     ]
     .into_iter()
     .filter_map(|k| pack.find(k, view, key))
@@ -188,7 +203,8 @@ pub const VOLUME_SAMPLE_WORDS: usize = 12;
 /// A temporal-volume block ready for the GPU: its samples sorted by direction bin (a cube of
 /// [`VOLUME_BIN_FACE`]² texels per face, bin = `cube::direction_to_texel`), each as
 /// [`VOLUME_SAMPLE_WORDS`] words `(direction.xyz, radius, radiance.rgb, distance, t, object
-/// id, 0, 0)` (floats as their bits), and the offset of each bin's first sample.
+/// id, lighting, non-diffuse)` (floats as their bits, the last two RGB9E5), and the offset of
+/// each bin's first sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BinnedVolume {
     /// Sample words, bin by bin.
@@ -257,15 +273,20 @@ pub fn decode_volume(
             *w = x.to_bits();
         }
         words[o + 9] = s.object_id;
+        words[o + 10] = cube::rgb9e5_pack(s.lighting);
+        words[o + 11] = cube::rgb9e5_pack(s.non_diffuse);
     }
     Ok(BinnedVolume { words, bins })
 }
 
 /// Bytes a volume block will occupy once binned, from the directory (known before reading):
-/// twice its stored sample bytes (48 against 24 per sample) plus the bin offsets.
+/// its samples at 48 bytes (against [`plenoptic_pack::volume::SAMPLE_BYTES`] stored) plus the
+/// bin offsets.
 pub fn volume_bytes(pack: &PackReader, (view, bucket): BlockRef) -> Option<u64> {
     let i = pack.find(ChunkKind::VolumeBlock, view, bucket)?;
-    Some(2 * pack.entries()[i].uncompressed_length + 4 * VOLUME_BIN_OFFSETS as u64)
+    let samples =
+        pack.entries()[i].uncompressed_length / plenoptic_pack::volume::SAMPLE_BYTES as u64;
+    Some(samples * 4 * VOLUME_SAMPLE_WORDS as u64 + 4 * VOLUME_BIN_OFFSETS as u64)
 }
 
 /// A resident key.

@@ -290,6 +290,21 @@ pub struct PackSpec {
     /// Whether `BLEND` objects are written with their coverage (see-through at runtime, as
     /// the baker writes them) or without it (opaque proxies showing their baked texels).
     pub glazing: bool,
+    /// Which materials the objects get.
+    pub materials: Materials,
+}
+
+/// The materials of a test pack's objects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Materials {
+    /// None: every object shows its radiance.
+    None,
+    /// Each object's colour as its base-colour factor: the geometry-assisted mode shades it
+    /// as that albedo × lighting + non-diffuse ([`plenoptic_recon::Shading::Materials`]).
+    Factors,
+    /// The factors times a 256 × 256 sRGB checker texture on planar proxy UVs. The analytic
+    /// shading's own checker is not the texture's: for speed, not accuracy.
+    Textured,
 }
 
 impl PackSpec {
@@ -317,6 +332,7 @@ impl PackSpec {
             bucket: 0.25,
             skip: Vec::new(),
             glazing: true,
+            materials: Materials::None,
         }
     }
 }
@@ -448,7 +464,7 @@ pub fn write_pack_with(
         };
         w.add_proxy_mesh(&ProxyMesh {
             object_id: id,
-            positions,
+            positions: positions.clone(),
             indices: mesh.triangles.iter().flatten().copied().collect(),
             normals: None,
         })
@@ -472,6 +488,32 @@ pub fn write_pack_with(
                 scale: None,
             });
         }
+        if spec.materials != Materials::None {
+            let uvs = positions
+                .iter()
+                .map(|p: &Vec3| Vec2::new(p.x + 0.5 * p.z, p.y - 0.5 * p.z))
+                .collect();
+            w.add_proxy_attributes(&plenoptic_pack::ProxyAttributes {
+                object_id: id,
+                uvs,
+                tangents: Vec::new(),
+            })
+            .unwrap();
+            manifest.materials.push(plenoptic_pack::MaterialEntry {
+                base_colour: object_colour(i as u32).extend(1.0),
+                base_colour_texture: (spec.materials == Materials::Textured).then_some(
+                    plenoptic_pack::TextureBinding {
+                        texture: 0,
+                        wrap_s: Default::default(),
+                        wrap_t: Default::default(),
+                        transform: None,
+                    },
+                ),
+                metallic: 0.0,
+                roughness: 0.5,
+                ..Default::default()
+            });
+        }
         manifest.objects.push(ObjectEntry {
             id,
             name: obj.name.clone(),
@@ -482,7 +524,7 @@ pub fn write_pack_with(
                 Motion::Static
             },
             proxy_mesh: Some(id),
-            material: None,
+            material: (spec.materials != Materials::None).then_some(i as u32),
             // BLEND objects of the test scenes are untextured: their coverage is the factor's.
             coverage: {
                 let m = &scene.materials[obj.material];
@@ -492,6 +534,33 @@ pub fn write_pack_with(
         });
     }
     w.add_tracks(&tracks).unwrap();
+    if spec.materials == Materials::Textured {
+        let n = 256u32;
+        let texels: Vec<u8> = (0..n * n)
+            .flat_map(|i| {
+                let v = if ((i % n) / 8 + (i / n) / 8).is_multiple_of(2) {
+                    230
+                } else {
+                    90
+                };
+                [v, v, v, 255]
+            })
+            .collect();
+        let texture = plenoptic_pack::TextureImage::with_mips(
+            plenoptic_pack::ColourSpace::Srgb,
+            n,
+            n,
+            texels,
+        )
+        .unwrap();
+        w.add_texture(0, &texture).unwrap();
+        manifest.textures.push(plenoptic_pack::TextureEntry {
+            width: n,
+            height: n,
+            levels: texture.levels.len() as u32,
+            colour_space: plenoptic_pack::ColourSpace::Srgb,
+        });
+    }
     let (a, b) = segment_ends();
     manifest.view_space = ViewSpace::Segment { a, b };
     manifest.base_views = spec
