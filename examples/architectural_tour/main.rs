@@ -223,7 +223,17 @@ fn run(options: &Options) -> Result<(), BoxError> {
         return print_plan(&recipe_path);
     }
     let mut pack = options.pack.clone().unwrap_or(recipe.output.clone());
-    if !pack.exists() {
+    // A pack of an older format (version 1) is baked again; the new pack replaces it only
+    // once it is complete.
+    let outdated = pack.exists()
+        && matches!(
+            plenoptic_pack::PackReader::open(&pack),
+            Err(plenoptic_pack::PackError::NeedsRebake { .. })
+        );
+    if outdated {
+        println!("{} is a version-1 pack: baking it again", pack.display());
+    }
+    if !pack.exists() || outdated {
         if let Some(dir) = pack.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)?;
             if let (Ok(dir), Some(name)) = (dir.canonicalize(), pack.file_name()) {

@@ -48,7 +48,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &recipe,
     )?;
     let pack = dir.join("sun_study.pack");
-    if !pack.exists() {
+    // A pack of an older format (version 1) is baked again.
+    let outdated = matches!(
+        plenoptic_pack::PackReader::open(&pack),
+        Err(plenoptic_pack::PackError::NeedsRebake { .. })
+    );
+    if !pack.exists() || outdated {
         let start = std::time::Instant::now();
         bake_recipe(
             &recipe,
