@@ -19,8 +19,10 @@
 //! environment where nothing is), lighting and non-diffuse for the others, each skipping the
 //! objects another pass shades. A separate raster pass gives each pixel its triangle, from
 //! which the UV is interpolated (barycentric coordinates of the pixel's point on the placed
-//! triangle) and the footprint computed (the pixel's size on the surface, `distance · pixel
-//! angle / √|cos θ|`, times the triangle's UV-per-metre scale).
+//! triangle) and the footprint computed (the square root of the surface area the pixel
+//! covers, `distance · pixel angle · cos^1.5 α / √|cos θ|` for a pixel whose ray is at α
+//! to the axis and meets the surface at θ, times the triangle's UV-per-metre scale: the
+//! `√|det ∂uv/∂(x, y)|` a GPU's derivatives give).
 //!
 //! Not yet built: normal maps (the stored lighting is for the texel's normal only), runtime
 //! specular for the actual camera (the non-diffuse part is the base views'), emissive
@@ -228,7 +230,9 @@ fn albedo_image(
                     let area_uv = (b - a).perp_dot(c - a).abs();
                     let scale = (area_uv / world.length().max(1e-12)).sqrt();
                     let cos = world.normalize_or_zero().dot(dir).abs().max(0.05);
-                    (uv, scale * depth[j] * pixel_angle / cos.sqrt())
+                    // A pixel off the axis subtends cos³α of the central pixel's solid angle.
+                    let off_axis = dir.dot(basis.forward).max(0.0).powf(1.5);
+                    (uv, scale * depth[j] * pixel_angle * off_axis / cos.sqrt())
                 }
                 _ => (Vec2::ZERO, f32::INFINITY),
             };

@@ -86,7 +86,15 @@ impl AssetLoader for RadiancePackLoader {
         failed.extend(env_error.map(|e| ("environment".to_string(), e)));
         let mut proxies = Vec::new();
         for proxy in read {
-            let mesh = proxy_to_mesh(&proxy.mesh);
+            // The proxy's UVs (pack 1.2+), for the material textures.
+            let uvs = match pack.proxy_attributes(proxy.id) {
+                Ok(a) => a.map(|a| a.uvs).unwrap_or_default(),
+                Err(e) => {
+                    failed.push((format!("UVs of object {}", proxy.id), e.to_string()));
+                    Vec::new()
+                }
+            };
+            let mesh = proxy_to_mesh(&proxy.mesh, &uvs);
             let handle = load_context.add_labeled_asset(format!("proxy{}", proxy.id), mesh);
             proxies.push(ProxyObject {
                 id: proxy.id,
@@ -96,7 +104,33 @@ impl AssetLoader for RadiancePackLoader {
             });
         }
         let usable_views = super::usable_views(&pack);
+        // The material textures, as Bevy loads KTX2 (base colour and emissive sRGB).
+        let mut textures = Vec::new();
+        for (i, entry) in pack.textures().iter().enumerate() {
+            let image = pack
+                .texture_ktx2(i as u32)
+                .map_err(|e| e.to_string())
+                .and_then(|bytes| {
+                    Image::from_buffer(
+                        &bytes,
+                        bevy::image::ImageType::Extension("ktx2"),
+                        bevy::image::CompressedImageFormats::NONE,
+                        entry.colour_space.is_srgb(),
+                        texture_sampler(&pack, i as u32),
+                        RenderAssetUsages::RENDER_WORLD,
+                    )
+                    .map_err(|e| e.to_string())
+                });
+            textures.push(match image {
+                Ok(image) => Some(load_context.add_labeled_asset(format!("texture{i}"), image)),
+                Err(e) => {
+                    failed.push((format!("material texture {i}"), e));
+                    None
+                }
+            });
+        }
         Ok(RadiancePack {
+            textures,
             reader: Arc::new(pack),
             proxies,
             failed,
@@ -111,20 +145,61 @@ impl AssetLoader for RadiancePackLoader {
     }
 }
 
-/// A proxy mesh as a flat-shaded Bevy triangle mesh (vertices duplicated per face).
-pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh) -> Mesh {
-    let positions: Vec<[f32; 3]> = proxy
+/// The sampler of pack texture `index`: trilinear, wrapping as the first material binding
+/// that uses it says (`plenoptic_recon` wraps per binding; two bindings of one texture with
+/// different wrap modes get the first one's here).
+fn texture_sampler(pack: &PackReader, index: u32) -> bevy::image::ImageSampler {
+    use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
+    use plenoptic_pack::WrapMode;
+    let binding = pack.materials().iter().find_map(|m| {
+        [m.base_colour_texture, m.metallic_roughness_texture]
+            .into_iter()
+            .flatten()
+            .find(|b| b.texture == index)
+    });
+    let mode = |w: WrapMode| match w {
+        WrapMode::Repeat => ImageAddressMode::Repeat,
+        WrapMode::ClampToEdge => ImageAddressMode::ClampToEdge,
+        WrapMode::MirroredRepeat => ImageAddressMode::MirrorRepeat,
+    };
+    let (s, t) = binding.map_or((WrapMode::Repeat, WrapMode::Repeat), |b| {
+        (b.wrap_s, b.wrap_t)
+    });
+    ImageSampler::Descriptor(ImageSamplerDescriptor {
+        address_mode_u: mode(s),
+        address_mode_v: mode(t),
+        mag_filter: ImageFilterMode::Linear,
+        min_filter: ImageFilterMode::Linear,
+        mipmap_filter: ImageFilterMode::Linear,
+        ..default()
+    })
+}
+
+/// A proxy mesh as a flat-shaded Bevy triangle mesh (vertices duplicated per face), with
+/// TEXCOORD_0 when `uvs` has one per proxy vertex. Triangles with an index outside the
+/// positions are dropped whole, as `plenoptic_recon` drops them.
+pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh, uvs: &[Vec2]) -> Mesh {
+    let n = proxy.positions.len();
+    let corners: Vec<usize> = proxy
         .indices
-        .iter()
-        .filter_map(|&i| proxy.positions.get(i as usize))
-        .map(|p| p.to_array())
+        .chunks_exact(3)
+        .filter(|t| t.iter().all(|&i| (i as usize) < n))
+        .flatten()
+        .map(|&i| i as usize)
         .collect();
-    let n = positions.len() / 3 * 3;
+    let positions: Vec<[f32; 3]> = corners
+        .iter()
+        .map(|&i| proxy.positions[i].to_array())
+        .collect();
     let mut mesh = Mesh::new(
         PrimitiveTopology::TriangleList,
         RenderAssetUsages::default(),
     )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions[..n].to_vec());
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions);
+    if uvs.len() == n && n > 0 {
+        let uv: Vec<[f32; 2]> = corners.iter().map(|&i| uvs[i].to_array()).collect();
+        mesh.insert_attribute(Mesh::ATTRIBUTE_UV_0, uv);
+    }
     mesh.compute_flat_normals();
     mesh
 }

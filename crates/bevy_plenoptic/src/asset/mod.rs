@@ -41,6 +41,9 @@ pub struct RadiancePack {
     /// The environment behind the proxies (sky, image, colour) and the sun's track; none when
     /// the pack has none or it could not be read (then in [`RadiancePack::failed`]).
     pub environment: plenoptic_recon::background::PackEnvironment,
+    /// The pack's material textures by index (pack 1.2+), mipmapped as stored; `None` for
+    /// one that could not be read (then in [`RadiancePack::failed`]).
+    pub textures: Vec<Option<Handle<Image>>>,
 }
 
 /// Per base view of `pack`: whether the directory has a radiance cube of it at some time key

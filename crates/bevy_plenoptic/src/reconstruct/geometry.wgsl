@@ -29,8 +29,16 @@ struct ReconParams {
     // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
     // y: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
     flags: vec4<f32>,
-    // xyz: the object's diffuse albedo when flags.y is 1.
+    // The object's base-colour factor (xyz) and metallic factor (w) when flags.y is 1.
     albedo: vec4<f32>,
+    // x: transmission factor; y, z: largest side of the base-colour and metallic-roughness
+    // textures (0: none).
+    material: vec4<f32>,
+    // KHR_texture_transform of the two textures: offset (xy), scale (zw); rotations in
+    // uv_rotation.xy.
+    base_uv: vec4<f32>,
+    mr_uv: vec4<f32>,
+    uv_rotation: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -54,14 +62,56 @@ struct ReconParams {
 // Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
 
+@group(#{MATERIAL_BIND_GROUP}) @binding(6) var base_colour_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(7) var base_colour_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(8) var metallic_roughness_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(9) var metallic_roughness_sampler: sampler;
+
+// The fragment's diffuse albedo (set once per fragment, before any lookup).
+var<private> pixel_albedo: vec3<f32>;
+
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
     return params.flags.y == 1.0;
 }
 
-// The shaded colour of a shading texel: albedo · lighting + non-diffuse.
+// The shaded colour of a shading texel: the fragment's albedo · lighting + non-diffuse (in the
+// hole fill, the neighbours' lighting times this fragment's own albedo, as on the CPU).
 fn shaded(s: vec2<u32>) -> vec3<f32> {
-    return params.albedo.xyz * rgb9e5_decode(s.x) + rgb9e5_decode(s.y);
+    return pixel_albedo * rgb9e5_decode(s.x) + rgb9e5_decode(s.y);
+}
+
+// KHR_texture_transform: offset + R(rotation) · (scale ∘ uv).
+fn uv_transform(uv: vec2<f32>, t: vec4<f32>, rotation: f32) -> vec2<f32> {
+    let s = uv * t.zw;
+    let c = cos(rotation);
+    let n = sin(rotation);
+    return t.xy + vec2<f32>(c * s.x + n * s.y, -n * s.x + c * s.y);
+}
+
+// The mip level plenoptic_recon's material module picks: log2 of the pixel's footprint in UV
+// units (√ of the UV area one pixel covers, `footprint`) × the transform's scale × the side.
+fn level(footprint: f32, t: vec4<f32>, side: f32) -> f32 {
+    let texels = footprint * max(abs(t.z), abs(t.w)) * side;
+    return select(0.0, log2(texels), texels > 1.0);
+}
+
+// The diffuse albedo at UV `uv`, whose pixel covers `footprint` UV units (√area):
+// (1 − metallic · mr.b)(1 − transmission) · base colour · texture.
+fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
+    var base = params.albedo.xyz;
+    var metallic = params.albedo.w;
+    if params.material.y > 0.0 {
+        let st = uv_transform(uv, params.base_uv, params.uv_rotation.x);
+        let lod = level(footprint, params.base_uv, params.material.y);
+        base *= textureSampleLevel(base_colour_texture, base_colour_sampler, st, lod).rgb;
+    }
+    if params.material.z > 0.0 {
+        let st = uv_transform(uv, params.mr_uv, params.uv_rotation.y);
+        let lod = level(footprint, params.mr_uv, params.material.z);
+        metallic *= textureSampleLevel(metallic_roughness_texture, metallic_roughness_sampler, st, lod).b;
+    }
+    return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.material.x));
 }
 
 // plenoptic_pack::cube::oct_decode.
@@ -302,7 +352,15 @@ fn radiance(in: VertexOutput) -> vec4<f32> {
     let n = u32(params.header.z);
     let p = in.world_position.xyz;
     let eye = view.world_position;
-    // The surface plane (derivatives are taken before any non-uniform branch).
+    // The material's albedo at the pixel (derivatives are taken before any non-uniform
+    // branch). Without UVs the smallest level: the texture's mean, as on the CPU.
+#ifdef VERTEX_UVS_A
+    let duv = abs(determinant(mat2x2<f32>(dpdx(in.uv), dpdy(in.uv))));
+    pixel_albedo = material_albedo(in.uv, sqrt(duv));
+#else
+    pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
+#endif
+    // The surface plane.
     var nrm = cross(dpdx(p), dpdy(p));
     if dot(nrm, nrm) < 1e-20 {
         nrm = in.world_normal;

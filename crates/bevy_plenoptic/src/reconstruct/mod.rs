@@ -169,10 +169,19 @@ pub struct PlenopticMaterial {
     /// The resident keys' lighting and non-diffuse radiance ([`KeyTexture::shading`]).
     #[texture(5, dimension = "2d_array", sample_type = "u_int")]
     pub shading_cubes: Handle<Image>,
-    /// The object's diffuse albedo from its material in the pack: base-colour factor ×
-    /// (1 − metallic)(1 − transmission) (textures are not sampled on the GPU yet); `None`
-    /// for an object without a material, which shows its radiance.
-    pub albedo: Option<Vec3>,
+    /// The object's base-colour texture from the pack (sRGB; white when it has none).
+    #[texture(6)]
+    #[sampler(7)]
+    pub base_colour_texture: Option<Handle<Image>>,
+    /// Its metallic-roughness texture (blue: metallic; white when it has none).
+    #[texture(8)]
+    #[sampler(9)]
+    pub metallic_roughness_texture: Option<Handle<Image>>,
+    /// The object's diffuse albedo factors from its material in the pack: base-colour factor
+    /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
+    /// (the textures multiply per pixel); `None` for an object without a material, which
+    /// shows its radiance.
+    pub albedo: Option<MaterialFactors>,
     /// The object's coverage when it is see-through glazing (the pack's
     /// [`plenoptic_pack::ObjectEntry::coverage`]), else 1. Glazing is drawn in Bevy's
     /// transparent pass, blended over what lies behind it with this alpha in
@@ -210,8 +219,17 @@ pub struct ReconParams {
     /// `CubeFilter::Bilinear` (0: the nearest texel); y: 1 to shade as albedo · lighting +
     /// non-diffuse (`Shading::Materials`; those lookups are always bilinear).
     pub flags: Vec4,
-    /// The object's diffuse albedo (xyz) when `flags.y` is 1.
+    /// The object's base-colour factor (xyz) and metallic factor (w) when `flags.y` is 1.
     pub albedo: Vec4,
+    /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
+    /// z: the metallic-roughness texture's (0: none); w: unused.
+    pub material: Vec4,
+    /// The base-colour texture's `KHR_texture_transform`: offset (xy), scale (zw).
+    pub base_uv: Vec4,
+    /// The metallic-roughness texture's: offset (xy), scale (zw).
+    pub mr_uv: Vec4,
+    /// The rotations of the two transforms (x, y), radians.
+    pub uv_rotation: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -273,6 +291,7 @@ fn attach_materials(
         ) else {
             continue;
         };
+        let factors = material_factors(pack, of.id);
         let m = materials.add(PlenopticMaterial {
             cubes: tex.image.clone(),
             params: ReconParams::default(),
@@ -280,7 +299,9 @@ fn attach_materials(
             volume_bins: vol.bins.clone(),
             image_frame: image_frame.0.clone(),
             shading_cubes: tex.shading.clone(),
-            albedo: object_albedo(pack, of.id),
+            base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
+            metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
+            albedo: factors,
             coverage: object_coverage(pack, of.id),
         });
         commands
@@ -302,13 +323,70 @@ fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
         .map_or(1.0, |c| c.clamp(1e-3, 1.0))
 }
 
-/// The diffuse albedo of the pack's object `id` from its material's factors, as
-/// `plenoptic_recon`'s material module computes it without textures; `None` without a
-/// material or in a pack without lighting (before 2.0 no pack reads).
-fn object_albedo(pack: &RadiancePack, id: u32) -> Option<Vec3> {
+/// What the shader needs of an object's material to compute its diffuse albedo per pixel as
+/// `plenoptic_recon`'s material module does: `(1 − metallic · mr.b)(1 − transmission) ·
+/// base colour · texture`.
+#[derive(Debug, Clone)]
+pub struct MaterialFactors {
+    /// The material.
+    pub material: plenoptic_pack::MaterialEntry,
+    /// Its base-colour texture, when it has one that loaded.
+    pub base_colour: Option<Handle<Image>>,
+    /// Its metallic-roughness texture, likewise.
+    pub metallic_roughness: Option<Handle<Image>>,
+    /// Largest sides of level 0 of the two (0: none).
+    pub sizes: (u32, u32),
+}
+
+impl MaterialFactors {
+    /// The uniform's material fields.
+    fn fill(&self, params: &mut ReconParams) {
+        let m = &self.material;
+        params.flags.y = 1.0;
+        params.albedo = m.base_colour.truncate().extend(m.metallic.clamp(0.0, 1.0));
+        params.material = Vec4::new(
+            m.transmission.clamp(0.0, 1.0),
+            self.sizes.0 as f32,
+            self.sizes.1 as f32,
+            0.0,
+        );
+        let uv = |b: Option<plenoptic_pack::TextureBinding>| {
+            b.and_then(|b| b.transform)
+                .map_or((Vec4::new(0.0, 0.0, 1.0, 1.0), 0.0), |t| {
+                    (
+                        Vec4::new(t.offset.x, t.offset.y, t.scale.x, t.scale.y),
+                        t.rotation,
+                    )
+                })
+        };
+        let (base, rb) = uv(m.base_colour_texture);
+        let (mr, rm) = uv(m.metallic_roughness_texture);
+        params.base_uv = base;
+        params.mr_uv = mr;
+        params.uv_rotation = Vec4::new(rb, rm, 0.0, 0.0);
+    }
+}
+
+/// The material of the pack's object `id` with its loaded textures; `None` without one.
+fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialFactors> {
     let m = pack.reader.object_material(id)?;
-    let diffuse = (1.0 - m.metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission.clamp(0.0, 1.0));
-    Some(m.base_colour.truncate() * diffuse)
+    let texture = |b: Option<plenoptic_pack::TextureBinding>| {
+        let b = b?;
+        let handle = pack.textures.get(b.texture as usize)?.clone()?;
+        let entry = pack.reader.textures().get(b.texture as usize)?;
+        Some((handle, entry.width.max(entry.height)))
+    };
+    let base = texture(m.base_colour_texture);
+    let mr = texture(m.metallic_roughness_texture);
+    Some(MaterialFactors {
+        material: m.clone(),
+        sizes: (
+            base.as_ref().map_or(0, |t| t.1),
+            mr.as_ref().map_or(0, |t| t.1),
+        ),
+        base_colour: base.map(|t| t.0),
+        metallic_roughness: mr.map(|t| t.0),
+    })
 }
 
 /// One lookup of a frame: a resident, uploaded (base view, time key).
@@ -508,11 +586,10 @@ fn update_materials(
         if let Some(mut mat) = materials.get_mut(&handle.0) {
             // Looked up in the manifest once, when the material was attached.
             params.fill.w = mat.coverage;
-            if let Some(a) = mat.albedo
+            if let Some(f) = &mat.albedo
                 && cam.settings.shading == plenoptic_recon::Shading::Materials
             {
-                params.flags.y = 1.0;
-                params.albedo = a.extend(1.0);
+                f.fill(&mut params);
             }
             mat.params = params;
         }
