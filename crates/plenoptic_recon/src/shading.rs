@@ -126,9 +126,15 @@ pub(crate) fn render(
             CubeFilter::Bilinear
         },
     };
+    let mut stages = Vec::new();
+    let mut timed = |name: &str, start: std::time::Instant| {
+        stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
+    };
     let start = std::time::Instant::now();
     let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
+    timed("radiance_pass", start);
     let mut side = Report::default();
+    let start = std::time::Instant::now();
     let lighting = geometry::render(
         rec,
         camera,
@@ -137,6 +143,8 @@ pub(crate) fn render(
         pass(Channel::Lighting, &unlit),
         &mut side,
     );
+    timed("lighting_pass", start);
+    let start = std::time::Instant::now();
     let non_diffuse = geometry::render(
         rec,
         camera,
@@ -145,6 +153,7 @@ pub(crate) fn render(
         pass(Channel::NonDiffuse, &unlit),
         &mut side,
     );
+    timed("non_diffuse_pass", start);
     // A pack v2 always has both; a damaged one falls back to the radiance frame.
     let (lighting, non_diffuse) = match (lighting, non_diffuse) {
         (Ok(l), Ok(s)) => (l, s),
@@ -160,7 +169,10 @@ pub(crate) fn render(
             );
         }
     };
+    let start = std::time::Instant::now();
     let albedo = albedo_image(rec, materials, camera, t, layer);
+    timed("albedo", start);
+    let start = std::time::Instant::now();
     frame
         .radiance
         .par_iter_mut()
@@ -172,15 +184,14 @@ pub(crate) fn render(
                 *c = a * lighting.radiance[j] + non_diffuse.radiance[j];
             }
         });
+    timed("compose", start);
     report.fallback = side.fallback;
     for m in side.missing.into_iter().chain(materials.messages()) {
         if !report.missing.contains(&m) {
             report.missing.push(m);
         }
     }
-    report
-        .stage_ms
-        .push(("materials".into(), start.elapsed().as_secs_f64() * 1e3));
+    report.stage_ms = stages;
     Ok(frame)
 }
 
@@ -205,6 +216,22 @@ fn albedo_image(
     }
     let projected = crate::raster::project(camera, &placed);
     let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
+    // Per projected triangle, once: its placed corners, UVs and UV-per-metre scale.
+    let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
+        .sources
+        .par_iter()
+        .map(|&(oi, ti)| {
+            let (id, xf, mesh) = placed.get(oi as usize)?;
+            let m = materials.object(*id)?;
+            let tri = mesh.triangles.get(ti as usize)?;
+            let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
+            let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
+                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                _ => None,
+            };
+            SurfaceTriangle::new(*id, m, v, uv)
+        })
+        .collect();
     let basis = camera.basis();
     let w = camera.width as usize;
     // The angle one pixel subtends at the image centre.
@@ -212,47 +239,85 @@ fn albedo_image(
     (0..n)
         .into_par_iter()
         .map(|j| {
-            let o = object[j];
-            let m = materials.object(o)?;
-            let &(oi, ti) = projected.sources.get(prim[j] as usize)?;
-            let (id, xf, mesh) = placed.get(oi as usize)?;
-            debug_assert_eq!(*id, o);
-            let tri = mesh.triangles.get(ti as usize)?;
+            let t = triangles.get(prim[j] as usize)?.as_ref()?;
+            if t.object != object[j] {
+                return None;
+            }
             let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
-            let p = basis.position + dir * depth[j];
-            let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
-            let uvs = tri.map(|i| m.uvs.get(i as usize).copied());
-            let (uv, footprint) = match uvs {
-                [Some(a), Some(b), Some(c)] => {
-                    let bary = barycentric(p, v)?;
-                    let uv = a * bary.x + b * bary.y + c * bary.z;
-                    let world = (v[1] - v[0]).cross(v[2] - v[0]);
-                    let area_uv = (b - a).perp_dot(c - a).abs();
-                    let scale = (area_uv / world.length().max(1e-12)).sqrt();
-                    let cos = world.normalize_or_zero().dot(dir).abs().max(0.05);
+            let (uv, footprint) = match &t.uv {
+                Some(uv) => {
+                    let b = t.barycentric(basis.position + dir * depth[j]);
+                    let cos = t.normal.dot(dir).abs().max(0.05);
                     // A pixel off the axis subtends cos³α of the central pixel's solid angle.
                     let off_axis = dir.dot(basis.forward).max(0.0).powf(1.5);
-                    (uv, scale * depth[j] * pixel_angle * off_axis / cos.sqrt())
+                    (
+                        uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
+                        t.scale * depth[j] * pixel_angle * off_axis / cos.sqrt(),
+                    )
                 }
-                _ => (Vec2::ZERO, f32::INFINITY),
+                None => (Vec2::ZERO, f32::INFINITY),
             };
-            Some((o, materials.albedo(rec.pack(), &m.material, uv, footprint)))
+            Some((
+                t.object,
+                materials.albedo(rec.pack(), &t.material.material, uv, footprint),
+            ))
         })
         .collect()
 }
 
-/// Barycentric coordinates of `p` (on or near the triangle's plane) in triangle `v`.
-fn barycentric(p: Vec3, v: [Vec3; 3]) -> Option<Vec3> {
-    let (e0, e1, e2) = (v[1] - v[0], v[2] - v[0], p - v[0]);
-    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
-    let (d20, d21) = (e2.dot(e0), e2.dot(e1));
-    let den = d00 * d11 - d01 * d01;
-    if den.abs() <= 1e-20 {
-        return None;
+/// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
+struct SurfaceTriangle<'m> {
+    object: u32,
+    material: &'m crate::material::ObjectMaterial,
+    origin: Vec3,
+    e0: Vec3,
+    e1: Vec3,
+    /// The inverse Gram matrix of (e0, e1): barycentrics from dot products.
+    inv: [f32; 3],
+    normal: Vec3,
+    uv: Option<[Vec2; 3]>,
+    /// √(UV area / world area).
+    scale: f32,
+}
+
+impl<'m> SurfaceTriangle<'m> {
+    fn new(
+        object: u32,
+        material: &'m crate::material::ObjectMaterial,
+        v: [Vec3; 3],
+        uv: Option<[Vec2; 3]>,
+    ) -> Option<Self> {
+        let (e0, e1) = (v[1] - v[0], v[2] - v[0]);
+        let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+        let den = d00 * d11 - d01 * d01;
+        if den.is_nan() || den.abs() <= 1e-20 {
+            return None;
+        }
+        let world = e0.cross(e1);
+        let scale = uv.map_or(0.0, |[a, b, c]| {
+            ((b - a).perp_dot(c - a).abs() / world.length().max(1e-12)).sqrt()
+        });
+        Some(SurfaceTriangle {
+            object,
+            material,
+            origin: v[0],
+            e0,
+            e1,
+            inv: [d11 / den, -d01 / den, d00 / den],
+            normal: world.normalize_or_zero(),
+            uv,
+            scale,
+        })
     }
-    let b1 = (d11 * d20 - d01 * d21) / den;
-    let b2 = (d00 * d21 - d01 * d20) / den;
-    Some(Vec3::new(1.0 - b1 - b2, b1, b2))
+
+    /// Barycentric coordinates of `p` (on or near the triangle's plane).
+    fn barycentric(&self, p: Vec3) -> Vec3 {
+        let e2 = p - self.origin;
+        let (d20, d21) = (e2.dot(self.e0), e2.dot(self.e1));
+        let b1 = self.inv[0] * d20 + self.inv[1] * d21;
+        let b2 = self.inv[1] * d20 + self.inv[2] * d21;
+        Vec3::new(1.0 - b1 - b2, b1, b2)
+    }
 }
 
 #[cfg(test)]
@@ -261,11 +326,15 @@ mod tests {
 
     #[test]
     fn barycentric_coordinates_recover_the_point() {
+        let m = crate::material::ObjectMaterial {
+            material: Default::default(),
+            uvs: Vec::new(),
+        };
         let v = [Vec3::ZERO, Vec3::X * 2.0, Vec3::new(0.0, 3.0, 1.0)];
-        let b = barycentric(Vec3::new(0.5, 0.75, 0.25), v).unwrap();
-        let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
-        assert!((p - Vec3::new(0.5, 0.75, 0.25)).length() < 1e-5);
-        assert!((b.x + b.y + b.z - 1.0).abs() < 1e-6);
-        assert!(barycentric(Vec3::ONE, [Vec3::ZERO; 3]).is_none());
+        let t = SurfaceTriangle::new(1, &m, v, None).unwrap();
+        let q = v[0] * 0.2 + v[1] * 0.5 + v[2] * 0.3;
+        let b = t.barycentric(q);
+        assert!((b - Vec3::new(0.2, 0.5, 0.3)).length() < 1e-5, "{b}");
+        assert!(SurfaceTriangle::new(1, &m, [Vec3::ZERO; 3], None).is_none());
     }
 }
