@@ -21,9 +21,17 @@
 //! ([`DURATION`] seconds): it climbs from the south-east and sets towards the south-west, so
 //! the patches of sunlight from the windows and the skylight travel across the floors.
 //!
+//! Materials are textured in code ([`textures`]): oak planks in room A, tiles in the
+//! atrium, stone slabs in room B and on the stairs, plaster on the walls, brick on the
+//! atrium's north wall, fabric on the atrium's benches, brushed steel. Every mesh has UVs in
+//! metres (box-mapped), and each texture's transform sets how many metres it repeats over.
+//!
 //! Object names follow `Part_Thing` (`RoomA_Mirror`, `Atrium_Column_2`, `RoomB_Cart`, …) so
 //! tests and tools can find them. The scene is deterministic: the same code writes the same
 //! bytes.
+
+#[path = "textures.rs"]
+mod textures;
 
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
@@ -106,6 +114,42 @@ impl Compound {
 
     fn into_mesh(self) -> Mesh {
         self.mesh
+    }
+}
+
+/// Adds an object whose mesh gets UVs in metres ([`metric_uvs`]), so that the textured
+/// materials' transforms give every surface the same texel density.
+fn add_object(
+    b: &mut SceneBuilder,
+    name: impl Into<String>,
+    mut mesh: Mesh,
+    material: MaterialHandle,
+    trs: Trs,
+) -> NodeHandle {
+    metric_uvs(&mut mesh);
+    b.add_object(name, mesh, material, trs)
+}
+
+/// Box mapping in metres: each vertex's UV is its position projected along the dominant
+/// axis of its normal (x-facing: (z, −y); y-facing: (x, z); z-facing: (x, −y)).
+fn metric_uvs(mesh: &mut Mesh) {
+    mesh.uvs = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| {
+            let a = n.abs();
+            if a.x >= a.y && a.x >= a.z {
+                Vec2::new(p.z, -p.y)
+            } else if a.y >= a.z {
+                Vec2::new(p.x, p.z)
+            } else {
+                Vec2::new(p.x, -p.y)
+            }
+        })
+        .collect();
+    if mesh.uvs.len() != mesh.positions.len() {
+        mesh.uvs.clear();
     }
 }
 
@@ -229,28 +273,62 @@ pub fn sun_direction(t: f32) -> Vec3 {
 pub fn build() -> SceneBuilder {
     let mut b = SceneBuilder::new();
 
-    // Materials.
-    let plaster =
-        b.add_material(MaterialDesc::diffuse(Vec3::new(0.82, 0.80, 0.76)).named("plaster"));
-    let plaster_warm =
-        b.add_material(MaterialDesc::diffuse(Vec3::new(0.85, 0.72, 0.58)).named("plaster_warm"));
-    let plaster_blue =
-        b.add_material(MaterialDesc::diffuse(Vec3::new(0.55, 0.65, 0.78)).named("plaster_blue"));
-    let oak = b.add_material(
-        MaterialDesc::diffuse(Vec3::new(0.55, 0.36, 0.20))
-            .roughness(0.6)
-            .named("oak"),
+    // Materials: the textured ones get a texture made in code (textures.rs) whose mean is
+    // their colour, repeating every `metres` of the meshes' metric UVs.
+    let textured = |b: &mut SceneBuilder, desc: MaterialDesc, t: textures::Texture| {
+        let tex = b.add_texture_rgba8(t.size, t.size, t.rgba8);
+        b.add_material(desc.base_color_texture(tex).texture_transform(
+            plenoptic_scene::UvTransform {
+                offset: Vec2::ZERO,
+                rotation: 0.0,
+                scale: Vec2::splat(1.0 / t.metres),
+            },
+        ))
+    };
+    let white = Vec3::ONE;
+    let plaster = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).named("plaster"),
+        textures::plaster(Vec3::new(0.82, 0.80, 0.76)),
+    );
+    let plaster_warm = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).named("plaster_warm"),
+        textures::plaster(Vec3::new(0.85, 0.72, 0.58)),
+    );
+    let plaster_blue = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).named("plaster_blue"),
+        textures::plaster(Vec3::new(0.55, 0.65, 0.78)),
+    );
+    let oak = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).roughness(0.6).named("oak"),
+        textures::oak_planks(Vec3::new(0.55, 0.36, 0.20)),
     );
     let walnut = b.add_material(MaterialDesc::diffuse(Vec3::new(0.30, 0.18, 0.10)).named("walnut"));
-    let stone = b.add_material(
-        MaterialDesc::diffuse(Vec3::new(0.70, 0.68, 0.64))
-            .roughness(0.8)
-            .named("stone"),
+    let stone = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).roughness(0.8).named("stone"),
+        textures::stone_slabs(Vec3::new(0.70, 0.68, 0.64)),
+    );
+    let brick = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).roughness(0.9).named("brick"),
+        textures::brick(Vec3::new(0.62, 0.30, 0.20)),
+    );
+    let fabric = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).named("fabric"),
+        textures::fabric(Vec3::new(0.25, 0.32, 0.45)),
     );
     let terracotta =
         b.add_material(MaterialDesc::diffuse(Vec3::new(0.70, 0.35, 0.22)).named("terracotta"));
-    let floor_tiles =
-        b.add_material(MaterialDesc::diffuse(Vec3::new(0.45, 0.42, 0.40)).named("floor_tiles"));
+    let floor_tiles = textured(
+        &mut b,
+        MaterialDesc::diffuse(white).named("floor_tiles"),
+        textures::floor_tiles(Vec3::new(0.45, 0.42, 0.40)),
+    );
     let mirror = b.add_material(MaterialDesc::metal(Vec3::splat(0.95), 0.0).named("mirror"));
     let glass = b.add_material(
         MaterialDesc::glass(1.5)
@@ -260,7 +338,11 @@ pub fn build() -> SceneBuilder {
     let brass =
         b.add_material(MaterialDesc::metal(Vec3::new(0.90, 0.70, 0.35), 0.25).named("brass"));
     let red = b.add_material(MaterialDesc::diffuse(Vec3::new(0.75, 0.12, 0.10)).named("red_paint"));
-    let steel = b.add_material(MaterialDesc::metal(Vec3::splat(0.6), 0.4).named("steel"));
+    let steel = textured(
+        &mut b,
+        MaterialDesc::metal(white, 0.4).named("steel"),
+        textures::brushed_steel(Vec3::splat(0.6)),
+    );
     let lamp_shade = b.add_material(
         MaterialDesc::diffuse(Vec3::splat(0.9))
             .emissive(Vec3::new(1.0, 0.85, 0.6), 0.6)
@@ -268,7 +350,7 @@ pub fn build() -> SceneBuilder {
     );
 
     fn object(b: &mut SceneBuilder, name: &str, mesh: Mesh, mat: MaterialHandle) -> NodeHandle {
-        b.add_object(name, mesh, mat, Trs::default())
+        add_object(b, name, mesh, mat, Trs::default())
     }
 
     // --- Floors and ceilings.
@@ -374,7 +456,7 @@ pub fn build() -> SceneBuilder {
             ATRIUM_HEIGHT,
             &[],
         ),
-        plaster,
+        brick,
     );
     object(
         &mut b,
@@ -460,7 +542,8 @@ pub fn build() -> SceneBuilder {
     }
 
     // --- Room A: mirror, table, benches, bookshelf, ceiling fan.
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomA_Mirror",
         shapes::cuboid(Vec3::new(3.0, 2.0, 0.03)),
         mirror,
@@ -474,22 +557,31 @@ pub fn build() -> SceneBuilder {
         c.cuboid(Vec3::new(1.5, -1.0, -0.04), Vec3::new(1.6, 1.0, 0.04));
         c.into_mesh()
     };
-    b.add_object("RoomA_Mirror_Frame", frame, brass, at(landmarks::MIRROR));
-    b.add_object(
+    add_object(
+        &mut b,
+        "RoomA_Mirror_Frame",
+        frame,
+        brass,
+        at(landmarks::MIRROR),
+    );
+    add_object(
+        &mut b,
         "RoomA_Table",
         table(2.2, 1.0, 0.75),
         oak,
         at(Vec3::new(-8.0, 0.0, 1.5)),
     );
     for (k, z) in [(0, 0.6), (1, 2.4)] {
-        b.add_object(
+        add_object(
+            &mut b,
             format!("RoomA_Bench_{k}"),
             bench(2.0),
             walnut,
             at(Vec3::new(-8.0, 0.0, z)),
         );
     }
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomA_Bookshelf",
         shelf(3.0, 2.2, 0.35, 5),
         walnut,
@@ -515,13 +607,14 @@ pub fn build() -> SceneBuilder {
         }
         c.into_mesh()
     };
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomA_CeilingFan_Rod",
         cylinder(0.02, ROOM_HEIGHT - landmarks::FAN.y, 6),
         steel,
         at(landmarks::FAN),
     );
-    let fan = b.add_object("RoomA_CeilingFan", fan, brass, at(landmarks::FAN));
+    let fan = add_object(&mut b, "RoomA_CeilingFan", fan, brass, at(landmarks::FAN));
     // One and a half turns per second, as keys every 60°.
     b.animate_rotation(fan, turning(DURATION, 1.5 * TAU, Quat::IDENTITY));
 
@@ -537,7 +630,8 @@ pub fn build() -> SceneBuilder {
             Vec3::new(-0.35, ATRIUM_HEIGHT - 0.3, -0.35),
             Vec3::new(0.35, ATRIUM_HEIGHT, 0.35),
         );
-        b.add_object(
+        add_object(
+            &mut b,
             format!("Atrium_Column_{k}"),
             c.into_mesh(),
             stone,
@@ -561,10 +655,11 @@ pub fn build() -> SceneBuilder {
         object(&mut b, "Atrium_Stairs_Balustrade", r.into_mesh(), glass);
     }
     for (k, x) in [(0, -2.6), (1, 2.6)] {
-        b.add_object(
+        add_object(
+            &mut b,
             format!("Atrium_Bench_{k}"),
             bench(1.6),
-            oak,
+            fabric,
             Trs {
                 translation: Vec3::new(x, 0.0, 0.0),
                 rotation: Quat::from_rotation_y(FRAC_PI_2),
@@ -572,7 +667,8 @@ pub fn build() -> SceneBuilder {
             },
         );
     }
-    b.add_object(
+    add_object(
+        &mut b,
         "Atrium_Pedestal",
         cylinder(0.6, 0.9, 24),
         stone,
@@ -593,7 +689,13 @@ pub fn build() -> SceneBuilder {
         }
         c.into_mesh()
     };
-    let sculpture = b.add_object("Atrium_Sculpture", sculpture, red, at(landmarks::SCULPTURE));
+    let sculpture = add_object(
+        &mut b,
+        "Atrium_Sculpture",
+        sculpture,
+        red,
+        at(landmarks::SCULPTURE),
+    );
     b.animate_rotation(
         sculpture,
         turning(DURATION, TAU * DURATION / 10.0, Quat::IDENTITY),
@@ -608,39 +710,45 @@ pub fn build() -> SceneBuilder {
 
     // --- Room B: glass vitrine, shelves, table, lamp, cart, sliding door. The lamp is faint
     // (1.5 cd against the sun's 6 lx-like units) so that daylight dominates the tour.
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomB_Plinth",
         shapes::cuboid(Vec3::new(1.2, 0.8, 1.2)),
         stone,
         at(Vec3::new(landmarks::VITRINE.x, 0.4, landmarks::VITRINE.z)),
     );
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomB_GlassVitrine",
         shapes::cuboid(Vec3::new(1.0, 1.0, 1.0)),
         glass,
         at(landmarks::VITRINE),
     );
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomB_Vase",
         cylinder(0.15, 0.5, 16),
         terracotta,
         at(Vec3::new(landmarks::VITRINE.x, 0.8, landmarks::VITRINE.z)),
     );
     for (k, x) in [(0, 6.0), (1, 9.5)] {
-        b.add_object(
+        add_object(
+            &mut b,
             format!("RoomB_Shelf_{k}"),
             shelf(2.4, 2.0, 0.4, 4),
             oak,
             at(Vec3::new(x, 0.0, -5.65)),
         );
     }
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomB_Table",
         table(1.6, 0.9, 0.75),
         walnut,
         at(Vec3::new(9.0, 0.0, 3.0)),
     );
-    b.add_object(
+    add_object(
+        &mut b,
         "RoomB_Lamp",
         cylinder(0.25, 0.3, 16),
         lamp_shade,
@@ -667,7 +775,7 @@ pub fn build() -> SceneBuilder {
         }
         c.into_mesh()
     };
-    let cart = b.add_object("RoomB_Cart", cart, red, Trs::default());
+    let cart = add_object(&mut b, "RoomB_Cart", cart, red, Trs::default());
     // From the north-east corner across the room to the south-west and back, with smooth
     // starts and stops (cubic spline; tangents in metres per second).
     let (p0, p1, p2) = (
@@ -695,7 +803,8 @@ pub fn build() -> SceneBuilder {
             (DURATION, Quat::from_rotation_y(-0.6)),
         ]),
     );
-    let door = b.add_object(
+    let door = add_object(
+        &mut b,
         "RoomB_SlidingDoor",
         {
             let mut c = Compound::default();

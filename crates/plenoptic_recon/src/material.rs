@@ -172,31 +172,34 @@ fn bilinear(texture: &TextureImage, level: usize, b: TextureBinding, uv: Vec2) -
     let (w, h) = (l.width as i64, l.height as i64);
     let x = uv.x * w as f32 - 0.5;
     let y = uv.y * h as f32 - 0.5;
-    if !(x.is_finite() && y.is_finite()) {
+    if !(x.is_finite() && y.is_finite()) || l.texels.len() < 4 * (w * h) as usize {
         return Vec4::ONE;
     }
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0 as i64, y0 as i64);
+    // The two columns and rows of the footprint, wrapped once each.
+    let (i0, i1) = (wrap(x0, w, b.wrap_s), wrap(x0 + 1, w, b.wrap_s));
+    let (j0, j1) = (wrap(y0, h, b.wrap_t), wrap(y0 + 1, h, b.wrap_t));
     let srgb = texture.colour_space == ColourSpace::Srgb;
     let table = srgb_table();
-    let texel = |i: i64, j: i64| {
-        let (i, j) = (wrap(i, w, b.wrap_s), wrap(j, h, b.wrap_t));
-        let k = 4 * (j * w as usize + i);
-        let Some(p) = l.texels.get(k..k + 4) else {
-            return Vec4::ONE;
-        };
-        let c = |v: u8| {
-            if srgb {
-                table[v as usize]
-            } else {
-                v as f32 / 255.0
-            }
-        };
-        Vec4::new(c(p[0]), c(p[1]), c(p[2]), p[3] as f32 / 255.0)
+    let row = w as usize;
+    let texel = |i: usize, j: usize| {
+        let k = 4 * (j * row + i);
+        let p = &l.texels[k..k + 4];
+        if srgb {
+            Vec4::new(
+                table[p[0] as usize],
+                table[p[1] as usize],
+                table[p[2] as usize],
+                p[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
+        }
     };
-    let top = texel(x0, y0).lerp(texel(x0 + 1, y0), fx);
-    let bottom = texel(x0, y0 + 1).lerp(texel(x0 + 1, y0 + 1), fx);
+    let top = texel(i0, j0).lerp(texel(i1, j0), fx);
+    let bottom = texel(i0, j1).lerp(texel(i1, j1), fx);
     top.lerp(bottom, fy)
 }
 

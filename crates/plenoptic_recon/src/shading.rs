@@ -249,7 +249,8 @@ fn albedo_image(
                     let b = t.barycentric(basis.position + dir * depth[j]);
                     let cos = t.normal.dot(dir).abs().max(0.05);
                     // A pixel off the axis subtends cos³α of the central pixel's solid angle.
-                    let off_axis = dir.dot(basis.forward).max(0.0).powf(1.5);
+                    let c = dir.dot(basis.forward).max(0.0);
+                    let off_axis = c * c.sqrt();
                     (
                         uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
                         t.scale * depth[j] * pixel_angle * off_axis / cos.sqrt(),
