@@ -76,6 +76,20 @@ fn scene_has_the_promised_elements() {
     has("RoomB_GlassVitrine");
     let g = material("RoomB_GlassVitrine");
     assert!(g.transmission > 0.99 && (g.ior - 1.5).abs() < 1e-3, "{g:?}");
+    // Textures made in code on the floors, the walls, the benches and the steel.
+    for name in [
+        "RoomA_Floor",
+        "Atrium_Floor",
+        "RoomB_Floor",
+        "Atrium_Wall_North",
+        "RoomA_Wall_South",
+        "Atrium_Bench_0",
+        "Atrium_Skylight_Frame",
+    ] {
+        let m = material(name);
+        assert!(m.base_color_texture.is_some(), "{name} is untextured: {m:?}");
+    }
+    assert!(scene.textures.len() >= 7, "{} textures", scene.textures.len());
     // Columns and stairs.
     assert_eq!(count("Atrium_Column_"), 4);
     has("Atrium_Stairs");
