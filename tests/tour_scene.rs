@@ -87,9 +87,16 @@ fn scene_has_the_promised_elements() {
         "Atrium_Skylight_Frame",
     ] {
         let m = material(name);
-        assert!(m.base_color_texture.is_some(), "{name} is untextured: {m:?}");
+        assert!(
+            m.base_color_texture.is_some(),
+            "{name} is untextured: {m:?}"
+        );
     }
-    assert!(scene.textures.len() >= 7, "{} textures", scene.textures.len());
+    assert!(
+        scene.textures.len() >= 7,
+        "{} textures",
+        scene.textures.len()
+    );
     // Columns and stairs.
     assert_eq!(count("Atrium_Column_"), 4);
     has("Atrium_Stairs");

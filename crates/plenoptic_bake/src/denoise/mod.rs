@@ -200,7 +200,10 @@ impl LightingCube {
                 face_size: n,
                 texels: lighting,
             },
-            non_diffuse: CubeImage::from_fn(n, |i, _| self.residual[i].max(Vec3::ZERO)),
+            non_diffuse: CubeImage {
+                face_size: n,
+                texels: self.clamped_residual(),
+            },
             distance: CubeImage::from_fn(n, |i, _| self.distance[i]),
             object_id: CubeImage::from_fn(n, |i, _| self.object[i]),
             normal: CubeImage::from_fn(n, |i, _| self.normal[i]),
@@ -252,6 +255,49 @@ impl LightingCube {
 
 /// Most rings [`LightingCube::filled_lighting`] grows the known lighting by.
 pub const FILL_RINGS: usize = 8;
+
+/// How far above the brightest of its same-object 3 × 3 neighbours a texel's non-diffuse
+/// luminance may be before [`LightingCube::clamped_residual`] scales it down.
+pub const FIREFLY_RATIO: f32 = 4.0;
+
+impl LightingCube {
+    /// The residual (emission and the specular part, never negative) with fireflies clamped:
+    /// a texel whose luminance is more than [`FIREFLY_RATIO`] times that of the brightest of
+    /// its same-object 8-neighbours is scaled down to that, keeping its colour. A few glossy
+    /// samples per texel find a bright window or sun patch rarely, and such a texel shows at
+    /// runtime as a speck the size of a cube texel; a highlight that spans two neighbouring
+    /// texels or more (a mirror's reflection, a lamp) is kept. The radiance keeps the
+    /// unclamped value.
+    pub fn clamped_residual(&self) -> Vec<Vec3> {
+        let grid = CubeGrid::new(self.face_size);
+        let lum = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        (0..self.len())
+            .map(|i| {
+                let r = self.residual[i].max(Vec3::ZERO);
+                let l = lum(r);
+                if self.object[i] == 0 || l <= 0.0 {
+                    return r;
+                }
+                let (face, x, y) = grid.coords(i);
+                let (mut brightest, mut count) = (0.0f32, 0);
+                for dj in -1..=1 {
+                    for di in -1..=1 {
+                        let q = grid.offset(face, x, y, di, dj);
+                        if q != i && self.object[q] == self.object[i] {
+                            brightest = brightest.max(lum(self.residual[q].max(Vec3::ZERO)));
+                            count += 1;
+                        }
+                    }
+                }
+                if count < 3 {
+                    return r;
+                }
+                let limit = FIREFLY_RATIO * brightest;
+                if l > limit { r * (limit / l) } else { r }
+            })
+            .collect()
+    }
+}
 
 /// `(lighting, non-diffuse)` of one rendered sample (a temporal-volume sample: pack v2 stores
 /// them beside its radiance), as a range-image texel splits them.

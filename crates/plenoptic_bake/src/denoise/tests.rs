@@ -4,7 +4,7 @@ use glam::Vec3;
 use plenoptic_trace::RadianceSample;
 
 use super::cube::CubeGrid;
-use super::{DenoiseSettings, LightingCube, denoise};
+use super::{DenoiseSettings, FIREFLY_RATIO, LightingCube, denoise};
 
 /// Deterministic standard normal numbers (splitmix64 + Box–Muller).
 struct Gauss(u64);
@@ -347,4 +347,32 @@ fn two_keys_of_a_static_scene_come_out_closer() {
     let after = diff(&a, &b);
     println!("keys: RMS difference {before:.4} → {after:.4}");
     assert!(after < 0.2 * before, "{before} → {after}");
+}
+
+#[test]
+fn an_isolated_firefly_in_the_non_diffuse_part_is_clamped_and_a_patch_is_kept() {
+    let mut c = cube(16, &room, |_, _| 1.0, 0.0, 1);
+    let grid = CubeGrid::new(16);
+    // Face 4 (+Z): one bright texel at (3, 3), a 3 × 3 bright patch around (10, 10).
+    let at = |i: usize, j: usize| grid.offset(4, i, j, 0, 0);
+    c.residual[at(3, 3)] = Vec3::splat(5.0);
+    for j in 9..=11 {
+        for i in 9..=11 {
+            c.residual[at(i, j)] = Vec3::splat(5.0);
+        }
+    }
+    let clamped = c.clamped_residual();
+    // The speck falls to FIREFLY_RATIO × its neighbours' 0.01.
+    assert!(
+        (clamped[at(3, 3)].x - FIREFLY_RATIO * 0.01).abs() < 1e-4,
+        "{}",
+        clamped[at(3, 3)]
+    );
+    // The patch keeps its value, corners included (each has a bright neighbour).
+    for (i, j) in [(10, 10), (9, 10), (9, 9), (11, 11)] {
+        assert_eq!(clamped[at(i, j)], Vec3::splat(5.0), "({i}, {j})");
+    }
+    // Elsewhere nothing changes, and the radiance keeps the unclamped speck.
+    assert_eq!(clamped[at(6, 6)], c.residual[at(6, 6)]);
+    assert!(c.to_range_image().radiance.texels[at(3, 3)].x > 5.0);
 }
