@@ -240,19 +240,36 @@ fn malformed_ktx2_inside_a_good_chunk() {
     let mut level = good.clone();
     level[80 + 8..80 + 16].copy_from_slice(&u64::MAX.to_le_bytes());
     cases.push(("level length", level));
-    for (what, bytes) in cases {
-        let r = pack_with_raw(ChunkKind::RadianceCube, &bytes);
-        match r.chunk(0).unwrap_err() {
-            PackError::MalformedKtx2 { chunk, reason } => {
-                assert_eq!(
-                    chunk.unwrap().kind,
-                    ChunkKind::RadianceCube,
-                    "{what}: {reason}"
-                )
+    // Version 2's lighting and non-diffuse cubes are checked like the radiance.
+    for kind in [
+        ChunkKind::RadianceCube,
+        ChunkKind::LightingCube,
+        ChunkKind::NonDiffuseCube,
+    ] {
+        for (what, bytes) in &cases {
+            let r = pack_with_raw(kind, bytes);
+            match r.chunk(0).unwrap_err() {
+                PackError::MalformedKtx2 { chunk, reason } => {
+                    assert_eq!(chunk.unwrap().kind, kind, "{what}: {reason}")
+                }
+                e => panic!("{kind:?} {what}: {e}"),
             }
-            e => panic!("{what}: {e}"),
         }
+        // A distance cube is not a lighting cube.
+        let d = room_image(8, 0.0);
+        let wrong = encode_distance(&d.distance, DistanceFormat::R32Float).unwrap();
+        let r = pack_with_raw(kind, &wrong);
+        assert!(
+            matches!(r.chunk(0).unwrap_err(), PackError::MalformedKtx2 { .. }),
+            "{kind:?}"
+        );
     }
+    let r = pack_with_raw(ChunkKind::LightingCube, &good);
+    assert_eq!(r.lighting(0, 0).unwrap().face_size, 8);
+    assert!(matches!(
+        r.non_diffuse(0, 0).unwrap_err(),
+        PackError::ChunkNotFound { .. }
+    ));
     // A good KTX2 of the wrong kind's format is malformed for that kind, too.
     let r = pack_with_raw(ChunkKind::DistanceCube, &good);
     assert!(matches!(
