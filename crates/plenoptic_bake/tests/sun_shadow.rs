@@ -1,0 +1,158 @@
+//! A sun-shadow edge on a floor (issue: pack v2, "Sun shadows"): the error of the
+//! geometry-assisted frame against the path tracer in a 4-pixel band along the edge, against
+//! the error elsewhere on the floor. Pack 2.0 keeps the sun's direct light in the stored
+//! lighting, so the edge is at lighting-cube resolution; this measures by how much. Frames go
+//! to `target/tmp/sun_shadow/`.
+
+mod common;
+
+use std::path::Path;
+
+use glam::{Quat, Vec2, Vec3};
+use plenoptic_eval::camera::to_pinhole;
+use plenoptic_recon::{Camera, Mode, Reconstructor};
+use plenoptic_scene::builder::{LightDesc, MaterialDesc, NodeDesc, SceneBuilder};
+use plenoptic_trace::image::luminance;
+use plenoptic_trace::{Image, PathTracer, PathTracerSettings, SceneAccel};
+
+/// Where the sunlight travels.
+fn sun_direction() -> Vec3 {
+    Vec3::new(0.5, -1.0, 0.3).normalize()
+}
+
+/// A 6 m floor under a sun, with a box on a post casting a shadow onto it.
+fn scene() -> SceneBuilder {
+    let mut b = SceneBuilder::new();
+    let grey = b.add_material(MaterialDesc::diffuse(Vec3::splat(0.6)));
+    let floor = b.add_plane("floor", Vec2::splat(6.0), 1, grey);
+    b.add_node(NodeDesc::new("floor").mesh(floor));
+    let block = b.add_box("block", Vec3::new(1.0, 0.2, 1.0), grey);
+    b.add_node(
+        NodeDesc::new("block")
+            .mesh(block)
+            .translation(Vec3::new(-0.5, 1.2, 0.0)),
+    );
+    b.add_node(
+        NodeDesc::new("sun")
+            .light(LightDesc::directional(Vec3::ONE, 3.0))
+            .rotation(Quat::from_rotation_arc(Vec3::NEG_Z, sun_direction())),
+    );
+    b
+}
+
+/// Mean relative absolute error in the band along the shadow edge and elsewhere on the floor.
+fn measure(face: u32, width: u32, height: u32, spp: u32) -> (f64, f64) {
+    let dir = tempfile::tempdir().unwrap();
+    let quality = format!(
+        "range_image_size = {face}\nsamples_per_pixel = 4\nambient_samples = 64\nambient_rms = 0.1"
+    );
+    let view = "kind = \"segment\"\na = [-1.0, 1.0, -1.5]\nb = [1.0, 1.0, -1.5]";
+    let recipe = common::write_recipe(dir.path(), &scene(), view, &quality);
+    plenoptic_bake::bake_recipe(&recipe, &plenoptic_bake::BakeOptions::default()).unwrap();
+    let scene = plenoptic_scene::load(&dir.path().join("scene.glb")).unwrap();
+    let camera = Camera::look_at(
+        Vec3::new(0.3, 1.4, -2.0),
+        Vec3::new(0.3, 0.0, 0.2),
+        Vec3::Y,
+        50f32.to_radians(),
+        width,
+        height,
+    )
+    .unwrap();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let placed = accel.at_time(0.5);
+    let pinhole = to_pinhole(&camera).unwrap();
+    let half = |seed| {
+        PathTracer::new(PathTracerSettings {
+            samples_per_pixel: spp / 2,
+            max_depth: 8,
+            rr_start_depth: 4,
+            seed,
+            environment_sampling: true,
+        })
+        .render(&placed, &pinhole)
+        .radiance()
+    };
+    let (a, b) = (half(31), half(32));
+    let rec = Reconstructor::open(dir.path().join("out/scene.pack")).unwrap();
+    let (frame, _) = rec.render(&camera, 0.5, Mode::GeometryAssisted).unwrap();
+    // Floor pixels and whether the sun reaches their point.
+    let floor = rec
+        .pack()
+        .manifest()
+        .objects
+        .iter()
+        .find(|o| o.name == "floor")
+        .unwrap()
+        .id;
+    let (w, h) = (width as usize, height as usize);
+    let basis = camera.basis();
+    let lit: Vec<Option<bool>> = (0..w * h)
+        .map(|j| {
+            (frame.object[j] == floor).then(|| {
+                let d = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+                let p = basis.position + d * frame.depth[j] + Vec3::Y * 1e-3;
+                !placed.segment_occluded(p, p - sun_direction() * 100.0)
+            })
+        })
+        .collect();
+    // The band: floor pixels within 2 pixels of one whose sunlight differs.
+    let near_edge = |j: usize| {
+        let (x, y) = ((j % w) as i64, (j / w) as i64);
+        let here = lit[j];
+        (-2..=2i64).any(|dy| {
+            (-2..=2i64).any(|dx| {
+                let (nx, ny) = (x + dx, y + dy);
+                nx >= 0
+                    && ny >= 0
+                    && (nx as usize) < w
+                    && (ny as usize) < h
+                    && lit[ny as usize * w + nx as usize].is_some_and(|l| Some(l) != here)
+            })
+        })
+    };
+    let reference: Vec<f64> = (0..w * h)
+        .map(|j| 0.5 * f64::from(luminance(a.pixels[j]) + luminance(b.pixels[j])))
+        .collect();
+    let floor_px: Vec<usize> = (0..w * h).filter(|&j| lit[j].is_some()).collect();
+    let mean_ref = floor_px.iter().map(|&j| reference[j]).sum::<f64>() / floor_px.len() as f64;
+    let (mut band, mut rest) = ((0.0, 0usize), (0.0, 0usize));
+    for &j in &floor_px {
+        let e = (f64::from(luminance(frame.radiance[j])) - reference[j]).abs() / mean_ref;
+        let bucket = if near_edge(j) { &mut band } else { &mut rest };
+        bucket.0 += e;
+        bucket.1 += 1;
+    }
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sun_shadow");
+    std::fs::create_dir_all(&out).unwrap();
+    let exposure = 0.5 / a.mean_luminance() as f32;
+    a.save_png(out.join(format!("{width}_reference.png")), exposure)
+        .unwrap();
+    Image {
+        width,
+        height,
+        pixels: frame.radiance.clone(),
+    }
+    .save_png(out.join(format!("{width}_recon_{face}.png")), exposure)
+    .unwrap();
+    let (eb, er) = (band.0 / band.1.max(1) as f64, rest.0 / rest.1.max(1) as f64);
+    println!(
+        "{face}-px cubes at {width}×{height}: edge band ({} px) {eb:.3}, rest of the floor ({} px) \
+         {er:.3}: {:.2}× (target ≤ 2×)",
+        band.1,
+        rest.1,
+        eb / er
+    );
+    assert!(band.1 > 0 && rest.1 > 0);
+    // Away from the edge the bake's floor agrees with the path tracer.
+    assert!(er < 0.15, "{er}");
+    (eb, er)
+}
+
+/// The issue's size (release, minutes): 64-px cubes at 1280 × 720. Not asserted against the
+/// 2× target, which pack 2.0 does not meet yet (the sun is in the stored lighting).
+#[test]
+#[ignore]
+fn sun_shadow_edge_at_1280x720() {
+    measure(64, 1280, 720, 64);
+}
