@@ -245,15 +245,9 @@ fn figures(
     let manifest = reader.manifest();
     let face = f64::from(manifest.bake.cube_face_size);
     let range_images: usize = manifest.base_views.iter().map(|v| v.time_keys.len()).sum();
-    let cube_chunks = |e: &&plenoptic_pack::ChunkEntry| {
-        matches!(
-            e.kind,
-            ChunkKind::RadianceCube
-                | ChunkKind::DistanceCube
-                | ChunkKind::ObjectIdCube
-                | ChunkKind::NormalCube
-        )
-    };
+    // Every range-image cube: radiance, lighting and non-diffuse (pack 2.0), distance, id,
+    // normal.
+    let cube_chunks = |e: &&plenoptic_pack::ChunkEntry| e.kind.is_cube();
     let stored: u64 = reader
         .entries()
         .iter()
@@ -266,8 +260,9 @@ fn figures(
         .filter(cube_chunks)
         .map(|e| e.uncompressed_length)
         .sum();
-    // A range image as rendered: RGB f32 radiance + f32 distance + u32 id + RGB f32 normal.
-    let raw = range_images as f64 * 6.0 * face * face * 32.0;
+    // A range image as rendered: RGB f32 radiance, lighting and non-diffuse + f32 distance +
+    // u32 id + RGB f32 normal.
+    let raw = range_images as f64 * 6.0 * face * face * 56.0;
     let file = reader.file_length() as f64;
 
     let mut s = String::new();
@@ -303,8 +298,8 @@ fn figures(
     writeln!(
         s,
         "Pack: {:.1} MiB; range-image chunks {:.1} MiB stored, {:.1} MiB as texels \
-         (RGB9E5 / R32F / R32Uint / RG16Snorm, {:.2} : 1 by zstd), {:.1} MiB as rendered \
-         (f32 radiance, distance, id, normal: {:.1} : 1 overall).\n",
+         (RGB9E5 ×3 / R32F / R32Uint / RG16Snorm, {:.2} : 1 by zstd), {:.1} MiB as rendered \
+         (f32 radiance, lighting, non-diffuse, distance, id, normal: {:.1} : 1 overall).\n",
         file / MIB,
         stored as f64 / MIB,
         texel_bytes as f64 / MIB,
