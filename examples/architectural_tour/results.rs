@@ -23,7 +23,7 @@ use std::time::Instant;
 use image::{Rgb, RgbImage};
 use plenoptic_bake::progress::Progress;
 use plenoptic_eval::tools::{compare, frame_name, write_frame_files};
-use plenoptic_pack::{ChunkKind, PackReader};
+use plenoptic_pack::PackReader;
 use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor};
 
 use crate::BoxError;
