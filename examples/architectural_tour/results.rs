@@ -9,7 +9,8 @@
 //!    (`tour_error.csv`) and the error-along-the-tour plot (`tour_error.png`, thesis
 //!    figures 6.29 and 6.31).
 //! 4. `montage.png`: three frames, one per row; columns reference, geometry-assisted, image,
-//!    volume.
+//!    volume. Beside them, `geometry_radiance`: geometry-assisted mode showing the pack's
+//!    radiance as version-1 packs were shown, from the same bake (equal bake time).
 //! 5. `figures.md`: bake time per phase, pack size and its ratio to the raw range images,
 //!    error per mode, CPU reconstruction time per frame at the path's own 640 × 360, the
 //!    streaming working set along the whole tour (with the `bevy` feature; `--streaming`
@@ -24,12 +25,26 @@ use image::{Rgb, RgbImage};
 use plenoptic_bake::progress::Progress;
 use plenoptic_eval::tools::{compare, frame_name, write_frame_files};
 use plenoptic_pack::PackReader;
-use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor};
+use plenoptic_recon::{CameraPath, Mode, PathSample, Reconstructor, Shading};
 
 use crate::BoxError;
 
-/// Modes in the order of the montage's columns (after the reference).
-const MODES: [Mode; 3] = [Mode::GeometryAssisted, Mode::Image, Mode::Volume];
+/// The compared reconstructions: name, mode, how geometry-assisted mode shades. The first
+/// three are the montage's columns (after the reference); the last is geometry-assisted mode
+/// showing the baked radiance, as version-1 packs were shown, from the same bake (so at equal
+/// bake time).
+const CANDIDATES: [(&str, Mode, Shading); 4] = [
+    ("geometry", Mode::GeometryAssisted, Shading::Materials),
+    ("image", Mode::Image, Shading::Materials),
+    ("volume", Mode::Volume, Shading::Materials),
+    (
+        "geometry_radiance",
+        Mode::GeometryAssisted,
+        Shading::Radiance,
+    ),
+];
+/// How many of [`CANDIDATES`] the montage shows.
+const MONTAGE_COLUMNS: usize = 3;
 
 /// What `--results` renders.
 #[derive(Debug, Clone)]
@@ -46,9 +61,9 @@ pub struct ResultsOptions {
     pub progress: bool,
 }
 
-/// Per-mode outcome.
+/// Per-candidate outcome.
 struct ModeResult {
-    mode: Mode,
+    name: &'static str,
     lrms: Vec<f64>,
     psnr: Vec<f64>,
     /// Mean CPU ms per frame at the compared size.
@@ -99,12 +114,13 @@ pub fn run(
         &progress,
     )?;
 
-    // 2. Each mode, at the compared size (files) and at the path's size (time only).
-    let rec = Reconstructor::open(pack)?;
+    // 2. Each candidate, at the compared size (files) and at the path's size (time only).
     let mut results = Vec::new();
     let mut candidates = Vec::new();
-    for mode in MODES {
-        let out = frames_dir.join(mode.name());
+    for (name, mode, shading) in CANDIDATES {
+        let mut rec = Reconstructor::open(pack)?;
+        rec.settings.shading = shading;
+        let out = frames_dir.join(name);
         std::fs::create_dir_all(&out)?;
         // Untimed: decodes every cube these frames need into the reconstructor's cache, so
         // that the times below are reconstruction only.
@@ -132,17 +148,16 @@ pub fn run(
         }
         let ms_full = clock.elapsed().as_secs_f64() * 1e3 / full.len().max(1) as f64;
         println!(
-            "{:>9}: {:.1} ms per frame at {}×{}, {ms_full:.1} ms at {}×{}",
-            mode.name(),
+            "{name:>17}: {:.1} ms per frame at {}×{}, {ms_full:.1} ms at {}×{}",
             ms / small.len().max(1) as f64,
             o.width,
             o.height,
             path.width,
             path.height
         );
-        candidates.push((mode.name().to_owned(), out));
+        candidates.push((name.to_owned(), out));
         results.push(ModeResult {
-            mode,
+            name,
             lrms: Vec::new(),
             psnr: Vec::new(),
             ms_small: ms / small.len().max(1) as f64,
@@ -166,7 +181,12 @@ pub fn run(
     }
 
     // 4. The montage.
-    montage(&ref_dir, &candidates, &small, &dir.join("montage.png"))?;
+    montage(
+        &ref_dir,
+        &candidates[..MONTAGE_COLUMNS],
+        &small,
+        &dir.join("montage.png"),
+    )?;
 
     // 5. Figures.
     let text = figures(pack, path, &small, o, &reference, &results, &floor)?;
@@ -317,7 +337,7 @@ fn figures(
         writeln!(
             s,
             "| {} | {:.3} ({:.3}) | {:.1} | {:.1} | {:.1} |",
-            r.mode.name(),
+            r.name,
             mean(&r.lrms),
             min(&r.lrms),
             mean(&r.psnr),
@@ -339,7 +359,7 @@ fn figures(
     let path_traced = tour_frames * reference.seconds_per_frame * scale;
     let geometry_ms = results
         .iter()
-        .find(|r| r.mode == Mode::GeometryAssisted)
+        .find(|r| r.name == "geometry")
         .map_or(0.0, |r| r.ms_full);
     let walkthrough = bake_total + tour_frames * geometry_ms / 1e3;
     writeln!(
@@ -368,7 +388,7 @@ fn figures(
         .fold(f64::INFINITY, f64::min);
     let geometry = results
         .iter()
-        .find(|r| r.mode == Mode::GeometryAssisted)
+        .find(|r| r.name == "geometry")
         .map_or(f64::NAN, |r| mean(&r.lrms));
     writeln!(
         s,

@@ -124,15 +124,23 @@ impl Materials {
 }
 
 /// `KHR_texture_transform` applied to `uv`.
+#[inline]
 fn transform(t: &UvTransform, uv: Vec2) -> Vec2 {
     let s = uv * t.scale;
+    if t.rotation == 0.0 {
+        return t.offset + s;
+    }
     let (sin, cos) = t.rotation.sin_cos();
     t.offset + Vec2::new(cos * s.x + sin * s.y, -sin * s.x + cos * s.y)
 }
 
 /// Wraps texel coordinate `i` of a side of `n` texels.
+#[inline]
 fn wrap(i: i64, n: i64, mode: WrapMode) -> usize {
     let n = n.max(1);
+    if (0..n).contains(&i) {
+        return i as usize;
+    }
     (match mode {
         WrapMode::Repeat => i.rem_euclid(n),
         WrapMode::ClampToEdge => i.clamp(0, n - 1),
@@ -161,7 +169,8 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
     let l1 = (l0 + 1).min(last);
     let f = (lod - l0 as f32).clamp(0.0, 1.0);
     let a = bilinear(texture, l0, b, uv);
-    if l1 == l0 || f <= 0.0 {
+    // Below one 8-bit step of the blend the second level cannot change the result.
+    if l1 == l0 || f < 1.0 / 512.0 {
         return a;
     }
     a.lerp(bilinear(texture, l1, b, uv), f)
