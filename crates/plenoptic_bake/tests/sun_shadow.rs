@@ -9,11 +9,10 @@ mod common;
 use std::path::Path;
 
 use glam::{Quat, Vec2, Vec3};
-use plenoptic_eval::camera::to_pinhole;
 use plenoptic_recon::{Camera, Mode, Reconstructor};
 use plenoptic_scene::builder::{LightDesc, MaterialDesc, NodeDesc, SceneBuilder};
 use plenoptic_trace::image::luminance;
-use plenoptic_trace::{Image, PathTracer, PathTracerSettings, SceneAccel};
+use plenoptic_trace::{Image, SceneAccel};
 
 /// Where the sunlight travels.
 fn sun_direction() -> Vec3 {
@@ -59,21 +58,9 @@ fn measure(face: u32, width: u32, height: u32, spp: u32) -> (f64, f64) {
         height,
     )
     .unwrap();
+    let (a, b) = common::reference_halves(&scene, &camera, 0.5, spp, 31);
     let accel = SceneAccel::new(&scene).unwrap();
     let placed = accel.at_time(0.5);
-    let pinhole = to_pinhole(&camera).unwrap();
-    let half = |seed| {
-        PathTracer::new(PathTracerSettings {
-            samples_per_pixel: spp / 2,
-            max_depth: 8,
-            rr_start_depth: 4,
-            seed,
-            environment_sampling: true,
-        })
-        .render(&placed, &pinhole)
-        .radiance()
-    };
-    let (a, b) = (half(31), half(32));
     let rec = Reconstructor::open(dir.path().join("out/scene.pack")).unwrap();
     let (frame, _) = rec.render(&camera, 0.5, Mode::GeometryAssisted).unwrap();
     // Floor pixels and whether the sun reaches their point.

@@ -11,11 +11,10 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use plenoptic_eval::camera::to_pinhole;
 use plenoptic_eval::metrics::corrected_relative_lrms;
 use plenoptic_recon::{Camera, Mode, Reconstructor, Shading};
 use plenoptic_scene::builder::{MaterialDesc, NodeDesc, SceneBuilder};
-use plenoptic_trace::{Image, PathTracer, PathTracerSettings, SceneAccel};
+use plenoptic_trace::Image;
 
 /// A `n × n` checker, black and near-white squares of one texel.
 fn checker(n: u32) -> Vec<u8> {
@@ -82,21 +81,7 @@ fn measure(small: u32, large: u32, width: u32, height: u32, spp: u32) -> Vec<(St
         height,
     )
     .unwrap();
-    let accel = SceneAccel::new(&scene).unwrap();
-    let placed = accel.at_time(0.5);
-    let pinhole = to_pinhole(&camera).unwrap();
-    let half = |seed| {
-        PathTracer::new(PathTracerSettings {
-            samples_per_pixel: spp / 2,
-            max_depth: 16,
-            rr_start_depth: 5,
-            seed,
-            environment_sampling: true,
-        })
-        .render(&placed, &pinhole)
-        .radiance()
-    };
-    let (a, b) = (half(21), half(22));
+    let (a, b) = common::reference_halves(&scene, &camera, 0.5, spp, 21);
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("textures");
     std::fs::create_dir_all(&out).unwrap();
     let exposure = 0.5 / a.mean_luminance() as f32;

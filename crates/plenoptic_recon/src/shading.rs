@@ -127,33 +127,17 @@ pub(crate) fn render(
         },
     };
     let mut stages = Vec::new();
-    let mut timed = |name: &str, start: std::time::Instant| {
+    // One geometry pass, timed as stage `name`.
+    let mut run = |name: &str, channel, skip, report: &mut Report| {
+        let start = std::time::Instant::now();
+        let frame = geometry::render(rec, camera, t, mask, pass(channel, skip), report);
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
+        frame
     };
-    let start = std::time::Instant::now();
-    let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
-    timed("radiance_pass", start);
+    let mut frame = run("radiance_pass", Channel::Radiance, &lit, report)?;
     let mut side = Report::default();
-    let start = std::time::Instant::now();
-    let lighting = geometry::render(
-        rec,
-        camera,
-        t,
-        mask,
-        pass(Channel::Lighting, &unlit),
-        &mut side,
-    );
-    timed("lighting_pass", start);
-    let start = std::time::Instant::now();
-    let non_diffuse = geometry::render(
-        rec,
-        camera,
-        t,
-        mask,
-        pass(Channel::NonDiffuse, &unlit),
-        &mut side,
-    );
-    timed("non_diffuse_pass", start);
+    let lighting = run("lighting_pass", Channel::Lighting, &unlit, &mut side);
+    let non_diffuse = run("non_diffuse_pass", Channel::NonDiffuse, &unlit, &mut side);
     // A pack v2 always has both; a damaged one falls back to the radiance frame.
     let (lighting, non_diffuse) = match (lighting, non_diffuse) {
         (Ok(l), Ok(s)) => (l, s),
@@ -168,6 +152,9 @@ pub(crate) fn render(
                 report,
             );
         }
+    };
+    let mut timed = |name: &str, start: std::time::Instant| {
+        stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
     let start = std::time::Instant::now();
     let albedo = albedo_image(rec, materials, camera, t, layer);

@@ -133,3 +133,30 @@ pub const ROOM_A_RECT: &str =
 
 /// A segment inside the static room.
 pub const STATIC_SEGMENT: &str = "kind = \"segment\"\na = [-1.0, 0.5, -1.0]\nb = [1.0, 0.5, 1.0]";
+
+/// A path-traced reference of `camera` over `scene` at time `t` as two independent halves of
+/// `spp / 2` samples each (seeds `seed` and `seed + 1`), for variance-corrected comparisons.
+pub fn reference_halves(
+    scene: &plenoptic_scene::Scene,
+    camera: &plenoptic_recon::Camera,
+    t: f32,
+    spp: u32,
+    seed: u64,
+) -> (plenoptic_trace::Image<Vec3>, plenoptic_trace::Image<Vec3>) {
+    use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
+    let accel = SceneAccel::new(scene).unwrap();
+    let placed = accel.at_time(t);
+    let pinhole = plenoptic_eval::camera::to_pinhole(camera).unwrap();
+    let half = |seed| {
+        PathTracer::new(PathTracerSettings {
+            samples_per_pixel: (spp / 2).max(1),
+            max_depth: 16,
+            rr_start_depth: 5,
+            seed,
+            environment_sampling: true,
+        })
+        .render(&placed, &pinhole)
+        .radiance()
+    };
+    (half(seed), half(seed + 1))
+}
