@@ -292,6 +292,9 @@ pub struct PackSpec {
     pub glazing: bool,
     /// Which materials the objects get.
     pub materials: Materials,
+    /// Whether range images carry pack 2.0's lighting and non-diffuse cubes (false: only
+    /// radiance, distance, id and normal, as a damaged pack might).
+    pub lighting_chunks: bool,
 }
 
 /// The materials of a test pack's objects.
@@ -333,6 +336,7 @@ impl PackSpec {
             skip: Vec::new(),
             glazing: true,
             materials: Materials::None,
+            lighting_chunks: true,
         }
     }
 }
@@ -395,13 +399,23 @@ pub fn write_pack_with(
             if spec.skip.contains(&(v, k)) {
                 continue;
             }
-            w.add_range_image(
-                v as u32,
-                k as u32,
-                &range_image(p, pos, spec.face),
-                CubeFormats::default(),
-            )
-            .unwrap();
+            let image = range_image(p, pos, spec.face);
+            if spec.lighting_chunks {
+                w.add_range_image(v as u32, k as u32, &image, CubeFormats::default())
+                    .unwrap();
+            } else {
+                use plenoptic_pack::*;
+                let f = CubeFormats::default();
+                let (v, k) = (v as u32, k as u32);
+                let r = encode_radiance(&image.radiance, f.radiance).unwrap();
+                w.add_chunk(ChunkKind::RadianceCube, v, k, &r).unwrap();
+                let d = encode_distance(&image.distance, f.distance).unwrap();
+                w.add_chunk(ChunkKind::DistanceCube, v, k, &d).unwrap();
+                let o = encode_object_id(&image.object_id, f.object_id).unwrap();
+                w.add_chunk(ChunkKind::ObjectIdCube, v, k, &o).unwrap();
+                let n = encode_normal(&image.normal, f.normal).unwrap();
+                w.add_chunk(ChunkKind::NormalCube, v, k, &n).unwrap();
+            }
         }
     }
     let mut manifest = Manifest::new(
