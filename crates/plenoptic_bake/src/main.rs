@@ -7,7 +7,8 @@
 //! plenoptic inspect PACK [--chunks] [--extract N OUT]
 //! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
 //!                    [--exposure E]
-//! plenoptic render PACK --path PATH.json [--mode image|volume|geometry] --out DIR
+//! plenoptic render PACK --path PATH.json [--mode image|volume|geometry]
+//!     [--shading materials|radiance] --out DIR
 //! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
 //!                   [--plot OUT.svg]
 //! ```
@@ -110,6 +111,11 @@ enum Command {
         /// Reconstruction mode: image, volume or geometry (geometry-assisted, the default).
         #[arg(long, default_value = "geometry")]
         mode: String,
+        /// How geometry-assisted mode shows objects with a material: materials (albedo from
+        /// their textures × the baked lighting, the default) or radiance (the baked radiance,
+        /// as version-1 packs were shown).
+        #[arg(long, default_value = "materials")]
+        shading: String,
         /// Output directory.
         #[arg(long, default_value = "frames")]
         out: PathBuf,
@@ -248,13 +254,37 @@ fn run(command: Command) -> Result<()> {
             pack,
             path,
             mode,
+            shading,
             out,
         } => {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
                 BakeError::Invalid(format!("mode '{mode}': expected image, volume or geometry"))
             })?;
-            let summary = plenoptic_eval::tools::render_path(&pack, &path, mode, &out, true)
-                .map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
+            let shading = match shading.to_ascii_lowercase().as_str() {
+                "materials" => plenoptic_recon::Shading::Materials,
+                "radiance" => plenoptic_recon::Shading::Radiance,
+                other => {
+                    return Err(BakeError::Invalid(format!(
+                        "shading '{other}': expected materials or radiance"
+                    )));
+                }
+            };
+            let render = || -> std::result::Result<_, plenoptic_eval::EvalError> {
+                let camera_path = plenoptic_recon::CameraPath::load(&path)?;
+                let mut rec = plenoptic_recon::Reconstructor::open(&pack)?;
+                rec.settings.shading = shading;
+                plenoptic_eval::tools::render_path_with(
+                    &rec,
+                    &camera_path,
+                    &out,
+                    &plenoptic_eval::tools::RenderOptions {
+                        mode,
+                        progress: true,
+                        ..Default::default()
+                    },
+                )
+            };
+            let summary = render().map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
             println!(
                 "{} frames in {} ({:.1} ms per frame), report {}",
                 summary.frames,

@@ -451,6 +451,33 @@ fn reference_render_and_compare_commands() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(frames.join("frame_00001.exr").exists());
+    // Geometry-assisted with version 1's shading; a bad shading is a named error.
+    let radiance = dir.path().join("frames_radiance");
+    let render = |shading: &str, out: &std::path::Path| {
+        plenoptic(
+            &[
+                "render",
+                pack.to_str().unwrap(),
+                "--path",
+                p,
+                "--shading",
+                shading,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        )
+    };
+    let out = render("radiance", &radiance);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(radiance.join("frame_00001.exr").exists());
+    let out = render("glossy", &radiance);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("shading 'glossy'"));
     let csv = dir.path().join("compare.csv");
     let plot = dir.path().join("compare.png");
     let out = plenoptic(
