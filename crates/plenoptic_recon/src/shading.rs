@@ -157,7 +157,7 @@ pub(crate) fn render(
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
     let start = std::time::Instant::now();
-    let albedo = albedo_image(rec, materials, camera, t, layer);
+    let (albedo, raster_ms) = albedo_image(rec, materials, camera, t, layer);
     timed("albedo", start);
     let start = std::time::Instant::now();
     frame
@@ -178,23 +178,25 @@ pub(crate) fn render(
             report.missing.push(m);
         }
     }
+    stages.push(("albedo_raster".to_string(), raster_ms));
     report.stage_ms = stages;
     Ok(frame)
 }
 
 /// Per pixel, the object seen there and the diffuse albedo of its material (`None` where no
-/// object with a material is).
+/// object with a material is); and the milliseconds its raster pass took.
 fn albedo_image(
     rec: &Reconstructor,
     materials: &Materials,
     camera: &Camera,
     t: f32,
     layer: Layer<'_>,
-) -> Vec<Option<(u32, Vec3)>> {
+) -> (Vec<Option<(u32, Vec3)>>, f64) {
     let n = camera.pixel_count();
     let Some(proxy) = rec.proxy() else {
-        return vec![None; n];
+        return (vec![None; n], 0.0);
     };
+    let start = std::time::Instant::now();
     let mut placed = proxy.placed_meshes(t);
     match layer {
         Layer::All => {}
@@ -203,6 +205,7 @@ fn albedo_image(
     }
     let projected = crate::raster::project(camera, &placed);
     let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
+    let raster_ms = start.elapsed().as_secs_f64() * 1e3;
     // Per projected triangle, once: its placed corners, UVs and UV-per-metre scale.
     let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
         .sources
@@ -223,7 +226,7 @@ fn albedo_image(
     let w = camera.width as usize;
     // The angle one pixel subtends at the image centre.
     let pixel_angle = 2.0 * basis.tan_y / basis.height;
-    (0..n)
+    let albedo = (0..n)
         .into_par_iter()
         .map(|j| {
             let t = triangles.get(prim[j] as usize)?.as_ref()?;
@@ -250,7 +253,8 @@ fn albedo_image(
                 materials.albedo(rec.pack(), &t.material.material, uv, footprint),
             ))
         })
-        .collect()
+        .collect();
+    (albedo, raster_ms)
 }
 
 /// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
