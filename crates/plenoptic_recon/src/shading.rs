@@ -91,25 +91,13 @@ pub(crate) fn render(
     report: &mut Report,
 ) -> Result<Frame> {
     let materials = rec.materials();
-    if rec.settings.shading == Shading::Radiance || materials.is_empty() {
-        return geometry::render(
-            rec,
-            camera,
-            t,
-            mask,
-            Pass::radiance(layer, rec.settings.cube_filter),
-            report,
-        );
-    }
-    let Some(proxy) = rec.proxy() else {
-        return geometry::render(
-            rec,
-            camera,
-            t,
-            mask,
-            Pass::radiance(layer, rec.settings.cube_filter),
-            report,
-        );
+    let radiance_only = |report: &mut Report| {
+        let pass = Pass::radiance(layer, rec.settings.cube_filter);
+        geometry::render(rec, camera, t, mask, pass, report)
+    };
+    let proxy = match rec.proxy() {
+        Some(p) if rec.settings.shading == Shading::Materials && !materials.is_empty() => p,
+        _ => return radiance_only(report),
     };
     let ids = proxy.object_ids();
     let (lit, unlit): (Vec<u32>, Vec<u32>) =
@@ -134,25 +122,19 @@ pub(crate) fn render(
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
         frame
     };
-    let mut frame = run("radiance_pass", Channel::Radiance, &lit, report)?;
+    // The lighting first: a pack v2 always has it, and a damaged one is then shown from its
+    // radiance in one pass instead of two.
     let mut side = Report::default();
     let lighting = run("lighting_pass", Channel::Lighting, &unlit, &mut side);
     let non_diffuse = run("non_diffuse_pass", Channel::NonDiffuse, &unlit, &mut side);
-    // A pack v2 always has both; a damaged one falls back to the radiance frame.
     let (lighting, non_diffuse) = match (lighting, non_diffuse) {
         (Ok(l), Ok(s)) => (l, s),
         (Err(e), _) | (_, Err(e)) => {
             report.missing.push(format!("materials not applied: {e}"));
-            return geometry::render(
-                rec,
-                camera,
-                t,
-                mask,
-                Pass::radiance(layer, rec.settings.cube_filter),
-                report,
-            );
+            return radiance_only(report);
         }
     };
+    let mut frame = run("radiance_pass", Channel::Radiance, &lit, report)?;
     let mut timed = |name: &str, start: std::time::Instant| {
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
