@@ -70,7 +70,28 @@ pub fn apply(scene: &mut Scene, recipe: &BakeRecipe) -> Result<()> {
             Environment::Sky(*params)
         }
     };
+    // Without a sun study or a sky, the brightest directional light is the sun: the one whose
+    // direct light the runtime evaluates (pack 3). Other punctual lights stay in the bake.
+    if scene.sun.is_none()
+        && let Some(light) = brightest_directional(scene)
+    {
+        scene.sun = Some(Sun { light, track: None });
+    }
     Ok(())
+}
+
+/// The directional light with the largest luminous illuminance, if any.
+fn brightest_directional(scene: &Scene) -> Option<usize> {
+    let lux = |l: &plenoptic_scene::Light| {
+        l.intensity * (0.2126 * l.color.x + 0.7152 * l.color.y + 0.0722 * l.color.z)
+    };
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.kind == LightKind::Directional && lux(l) > 0.0)
+        .max_by(|a, b| lux(a.1).total_cmp(&lux(b.1)))
+        .map(|(i, _)| i)
 }
 
 fn directional_named(scene: &Scene, name: &str) -> std::result::Result<usize, String> {

@@ -16,8 +16,9 @@
 //! The work directory also holds `plan.json`: every process checks that its own plan is the
 //! same, so items of different inputs are never mixed.
 //!
-//! Item file layout (little endian): `b"PBW2"` (pack 2.0's chunks; a `PBW1` file of an
-//! older baker is not done and is rendered again), u32 chunk count, then per chunk u32 kind code,
+//! Item file layout (little endian): `b"PBW3"` (pack 3.0's chunks, whose lighting leaves the
+//! sun to the runtime; a `PBW1` or `PBW2` file of an older baker is not done and is rendered
+//! again), u32 chunk count, then per chunk u32 kind code,
 //! u32 base view, u32 key, u64 uncompressed length (0: take it from the chunk), u64 xxh3
 //! checksum, u64 length, the bytes.
 
@@ -138,7 +139,7 @@ pub struct ItemChunk {
     pub bytes: Vec<u8>,
 }
 
-const MAGIC: &[u8; 4] = b"PBW2";
+const MAGIC: &[u8; 4] = b"PBW3";
 
 /// The work directory of a bake.
 #[derive(Debug, Clone)]

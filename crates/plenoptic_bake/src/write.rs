@@ -23,11 +23,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use plenoptic_pack::{
-    Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, EnvironmentEntry,
-    Interpolation, Light, LightKind, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter,
-    ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block,
-    encode_connectivity, encode_distance, encode_normal, encode_object_id, encode_radiance,
-    encode_volume_block,
+    Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, DirectSun,
+    EnvironmentEntry, Interpolation, Light, LightKind, Manifest, Motion, ObjectEntry, ObjectTracks,
+    PackWriter, ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample,
+    decode_volume_block, encode_connectivity, encode_distance, encode_normal, encode_object_id,
+    encode_radiance, encode_volume_block,
 };
 use plenoptic_scene::Scene;
 use plenoptic_trace::SceneAccel;
@@ -389,8 +389,20 @@ pub const SUN_TRACK_SAMPLES: usize = 256;
 /// when the scene has neither.
 fn environment_entry(start: f32, end: f32, scene: &Scene) -> Option<EnvironmentEntry> {
     let sun = scene.sun_track(start, end, SUN_TRACK_SAMPLES);
-    (!scene.environment.is_none() || sun.is_some())
-        .then(|| EnvironmentEntry::new(&scene.environment, sun))
+    // The bake leaves the sun's direct light to the runtime whenever there is a sun
+    // (`RadianceSample::sun`, taken out of the lighting by the denoiser's split).
+    let direct_sun = scene
+        .sun
+        .as_ref()
+        .filter(|_| sun.is_some())
+        .and_then(|s| scene.lights.get(s.light))
+        .map(|l| DirectSun {
+            angular_radius: l.angular_radius.clamp(0.0, DirectSun::MAX_ANGULAR_RADIUS),
+        });
+    (!scene.environment.is_none() || sun.is_some()).then(|| EnvironmentEntry {
+        direct_sun,
+        ..EnvironmentEntry::new(&scene.environment, sun)
+    })
 }
 
 fn stat_name(kind: ChunkKind) -> &'static str {

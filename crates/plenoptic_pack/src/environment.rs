@@ -36,6 +36,25 @@ pub struct EnvironmentEntry {
     /// has a sun).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<SunTrack>,
+    /// Present when the sun's direct light is the runtime's (pack 3): the lighting and
+    /// non-diffuse cubes and the volume samples leave out the direct light of this sun at the
+    /// surfaces they store, and the runtime adds it with shadow rays against the proxies.
+    /// The radiance cubes keep it. Requires `sun`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direct_sun: Option<DirectSun>,
+}
+
+/// The sun whose direct light the runtime evaluates ([`EnvironmentEntry::direct_sun`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DirectSun {
+    /// Angular radius of the sun's disc, radians: 0 is a delta light with hard shadows (the
+    /// tracers sample the disc for soft ones). At most [`DirectSun::MAX_ANGULAR_RADIUS`].
+    pub angular_radius: f32,
+}
+
+impl DirectSun {
+    /// Largest angular radius a pack may give (the tracers clamp the disc there too).
+    pub const MAX_ANGULAR_RADIUS: f32 = 0.5;
 }
 
 /// The kind of environment and its parameters.
@@ -86,7 +105,11 @@ impl EnvironmentEntry {
                 rotation_deg: *rotation_deg,
             },
         };
-        EnvironmentEntry { source, sun }
+        EnvironmentEntry {
+            source,
+            sun,
+            direct_sun: None,
+        }
     }
 
     /// Checks what serde cannot: the sky's ranges, finite non-negative colours and intensity,
@@ -95,6 +118,18 @@ impl EnvironmentEntry {
     pub fn validate(&self) -> std::result::Result<(), String> {
         if let Some(sun) = &self.sun {
             sun.validate().map_err(|e| format!("sun track: {e}"))?;
+        }
+        if let Some(d) = &self.direct_sun {
+            if self.sun.is_none() {
+                return Err("direct_sun is given without a sun track".into());
+            }
+            if !(0.0..=DirectSun::MAX_ANGULAR_RADIUS).contains(&d.angular_radius) {
+                return Err(format!(
+                    "direct_sun: angular radius {} is not within [0, {}]",
+                    d.angular_radius,
+                    DirectSun::MAX_ANGULAR_RADIUS
+                ));
+            }
         }
         match &self.source {
             EnvironmentSource::None => Ok(()),
@@ -286,6 +321,13 @@ impl crate::PackReader {
     /// The sun's track, when the pack has one.
     pub fn sun_track(&self) -> Option<&SunTrack> {
         self.manifest().environment.as_ref()?.sun.as_ref()
+    }
+
+    /// The sun whose direct light the runtime adds, with its track, when the pack leaves it
+    /// out of the lighting ([`EnvironmentEntry::direct_sun`]; checked at open).
+    pub fn direct_sun(&self) -> Option<(&SunTrack, DirectSun)> {
+        let env = self.manifest().environment.as_ref()?;
+        Some((env.sun.as_ref()?, env.direct_sun?))
     }
 
     /// The environment-image chunk, decoded.

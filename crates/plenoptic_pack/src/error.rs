@@ -88,7 +88,7 @@ pub enum PackError {
         minor: u16,
     },
     /// The major version is one this reader does not know.
-    #[error("unsupported pack version {major}.{minor} (this reader reads {supported}.x)")]
+    #[error("unsupported pack version {major}.{minor} (this reader reads 2.x to {supported}.x)")]
     UnsupportedVersion {
         /// Major version in the file.
         major: u16,

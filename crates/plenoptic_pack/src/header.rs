@@ -5,8 +5,12 @@ use crate::error::{PackError, Result, Section};
 
 /// The 8 bytes every pack starts with.
 pub const MAGIC: [u8; 8] = *b"PLNPACK\0";
-/// The major format version this crate writes and reads.
-pub const VERSION_MAJOR: u16 = 2;
+/// The major format version this crate writes (and reads, with [`OLDEST_MAJOR`]).
+pub const VERSION_MAJOR: u16 = 3;
+/// The oldest major format version this crate reads: a 2.x pack is a 3.x pack without a
+/// runtime sun ([`crate::DirectSun`]); version 1 is refused with
+/// [`PackError::NeedsRebake`].
+pub const OLDEST_MAJOR: u16 = 2;
 /// The minor format version this crate writes. Readers accept any minor of their major.
 pub const VERSION_MINOR: u16 = 0;
 /// Size of the header in bytes.
@@ -76,7 +80,7 @@ impl Header {
                 minor: version_minor,
             });
         }
-        if version_major != VERSION_MAJOR {
+        if !(OLDEST_MAJOR..=VERSION_MAJOR).contains(&version_major) {
             return Err(PackError::UnsupportedVersion {
                 major: version_major,
                 minor: version_minor,

@@ -74,10 +74,11 @@ pub use attributes::{ProxyAttributes, decode_proxy_attributes, encode_proxy_attr
 pub use cube::{direction_to_face_uv, face_uv_to_direction};
 pub use directory::{ChunkEntry, ChunkKind, NO_BASE_VIEW};
 pub use environment::{
-    EnvironmentEntry, EnvironmentSource, decode_environment_image, encode_environment_image,
+    DirectSun, EnvironmentEntry, EnvironmentSource, decode_environment_image,
+    encode_environment_image,
 };
 pub use error::{ChunkRef, PackError, Result, Section};
-pub use header::{HEADER_LEN, Header, MAGIC, VERSION_MAJOR, VERSION_MINOR};
+pub use header::{HEADER_LEN, Header, MAGIC, OLDEST_MAJOR, VERSION_MAJOR, VERSION_MINOR};
 pub use manifest::{
     Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, Manifest, Motion, ObjectEntry,
     TimeRange, Units, ViewSpace,

@@ -69,15 +69,25 @@ fn wrong_magic() {
 #[test]
 fn unknown_major_version() {
     let mut b = small_pack();
-    rewrite_header(&mut b, |h| h.version_major = 3);
+    rewrite_header(&mut b, |h| h.version_major = 4);
     assert!(matches!(
         open(b).unwrap_err(),
         PackError::UnsupportedVersion {
-            major: 3,
-            supported: 2,
+            major: 4,
+            supported: 3,
             ..
         }
     ));
+}
+
+#[test]
+fn version_two_packs_still_open() {
+    // 2.x is 3.x without a runtime sun: its lighting holds all of the light.
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.version_major = 2);
+    let r = open(b).unwrap();
+    assert_eq!(r.header().version_major, 2);
+    assert!(r.direct_sun().is_none());
 }
 
 #[test]

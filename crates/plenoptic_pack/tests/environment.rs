@@ -128,6 +128,7 @@ fn write_image_pack(path: &Path, chunk: &[u8], width: u32, height: u32) {
             rotation_deg: 0.0,
         },
         sun: None,
+        direct_sun: None,
     });
     w.finish(&m).unwrap();
 }
@@ -174,6 +175,7 @@ fn truncated_or_inconsistent_image_chunks_are_named_errors() {
             rotation_deg: 0.0,
         },
         sun: None,
+        direct_sun: None,
     });
     w.finish(&m).unwrap();
     let msg = environment_error(&path);
@@ -245,4 +247,47 @@ fn environment_error(path: &std::path::Path) -> String {
         .environment()
         .unwrap_err()
         .to_string()
+}
+
+#[test]
+fn a_runtime_sun_round_trips_and_needs_its_track() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("direct.pack");
+    let mut w = PackWriter::create(&path).unwrap();
+    let mut m = manifest(1);
+    let mut entry = EnvironmentEntry::new(&Environment::None, Some(track()));
+    entry.direct_sun = Some(DirectSun {
+        angular_radius: 0.00465,
+    });
+    m.environment = Some(entry.clone());
+    w.finish(&m).unwrap();
+    let r = PackReader::open(&path).unwrap();
+    let (t, d) = r.direct_sun().unwrap();
+    assert_eq!(t, &track());
+    assert_eq!(d.angular_radius, 0.00465);
+
+    // Without a track, or with a disc past the limit, the writer refuses it (and so would
+    // the reader: both call the same check).
+    for (sun, radius, expect) in [
+        (None, 0.0, "without a sun track"),
+        (Some(track()), 0.7, "angular radius 0.7"),
+        (Some(track()), f32::NAN, "angular radius NaN"),
+    ] {
+        let w = PackWriter::create(dir.path().join("bad.pack")).unwrap();
+        let mut e = entry.clone();
+        e.sun = sun;
+        e.direct_sun = Some(DirectSun {
+            angular_radius: radius,
+        });
+        m.environment = Some(e);
+        let msg = w.finish(&m).unwrap_err().to_string();
+        assert!(msg.contains(expect), "{msg}");
+    }
+    // A pack without the entry has no runtime sun, even with a track.
+    let (_, r) = round_trip(
+        &dir.path().join("plain.pack"),
+        &Environment::None,
+        Some(track()),
+    );
+    assert!(r.direct_sun().is_none() && r.sun_track().is_some());
 }

@@ -76,6 +76,7 @@
 //! ```
 
 pub mod background;
+pub mod brdf;
 mod cache;
 pub mod camera;
 pub mod delaunay3;
@@ -92,6 +93,8 @@ pub mod reconstructor;
 mod sample;
 pub mod settings;
 mod shading;
+pub mod shadow;
+pub mod sun;
 pub mod temporal;
 pub mod viewspace;
 pub mod volume;

@@ -14,7 +14,8 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use glam::{Vec2, Vec3, Vec4};
+use crate::brdf::SurfaceMaterial;
+use glam::{Vec2, Vec4};
 use plenoptic_pack::{
     ColourSpace, MaterialEntry, PackReader, TextureBinding, TextureImage, UvTransform, WrapMode,
 };
@@ -104,22 +105,37 @@ impl Materials {
         .as_deref()
     }
 
-    /// The diffuse albedo of `m` at `uv`, with the texture's mip chosen from `footprint`: the
-    /// pixel's size in UV units (before the binding's transform).
-    pub fn albedo(&self, pack: &PackReader, m: &MaterialEntry, uv: Vec2, footprint: f32) -> Vec3 {
+    /// The material `m` at `uv` (base colour, metalness and roughness textured), with the
+    /// textures' mip chosen from `footprint`: the pixel's size in UV units (before the
+    /// binding's transform). Its [`SurfaceMaterial::albedo`] is the diffuse albedo.
+    pub fn surface(
+        &self,
+        pack: &PackReader,
+        m: &MaterialEntry,
+        uv: Vec2,
+        footprint: f32,
+    ) -> SurfaceMaterial {
         let mut base = m.base_colour.truncate();
         if let Some(b) = m.base_colour_texture
             && let Some(t) = self.texture(pack, b.texture)
         {
             base *= sample(t, b, uv, footprint).truncate();
         }
-        let mut metallic = m.metallic;
+        let (mut metallic, mut roughness) = (m.metallic, m.roughness);
         if let Some(b) = m.metallic_roughness_texture
             && let Some(t) = self.texture(pack, b.texture)
         {
-            metallic *= sample(t, b, uv, footprint).z;
+            let mr = sample(t, b, uv, footprint);
+            metallic *= mr.z;
+            roughness *= mr.y;
         }
-        base * ((1.0 - metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission.clamp(0.0, 1.0)))
+        SurfaceMaterial {
+            base,
+            metallic: metallic.clamp(0.0, 1.0),
+            roughness: roughness.clamp(0.0, 1.0),
+            transmission: m.transmission.clamp(0.0, 1.0),
+            ior: if m.ior > 0.0 { m.ior } else { 1.5 },
+        }
     }
 }
 

@@ -146,6 +146,18 @@ impl ObjectMotion {
         )
     }
 
+    /// Whether the transform may change over time: some channel has two stored values that
+    /// differ (conservative for cubic splines, whose tangents count as values).
+    pub fn is_animated(&self) -> bool {
+        fn moves<T: PartialEq>(t: &Track<T>) -> bool {
+            t.values.windows(2).any(|w| w[0] != w[1])
+        }
+        let t = self.tracks();
+        t.translation.is_some_and(moves)
+            || t.rotation.is_some_and(moves)
+            || t.scale.is_some_and(moves)
+    }
+
     /// The object-to-world transform T·R·S at time `t`.
     pub fn transform(&self, t: f32) -> Affine3A {
         let (translation, rotation, scale) = self.sample(t);

@@ -27,6 +27,9 @@ pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
     /// Triangles as vertex indices (checked against `positions` on construction).
     pub triangles: Vec<[u32; 3]>,
+    /// Vertex normals, object space (empty when the pack has none for the mesh, or a count
+    /// that disagrees with the positions).
+    pub normals: Vec<Vec3>,
 }
 
 impl TriangleMesh {
@@ -42,6 +45,12 @@ impl TriangleMesh {
                 .map(|c| [c[0], c[1], c[2]])
                 .filter(|t| t.iter().all(|&i| (i as usize) < n))
                 .collect(),
+            normals: mesh
+                .normals
+                .as_ref()
+                .filter(|v| v.len() == n)
+                .cloned()
+                .unwrap_or_default(),
         }
     }
 }

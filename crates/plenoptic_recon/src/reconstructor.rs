@@ -44,6 +44,8 @@ pub struct Reconstructor {
     packed: Mutex<HashMap<(u32, u32, Channel), Arc<PackedTexels>>>,
     /// The pack's materials, proxy UVs and decoded textures, loaded on first use.
     materials: std::sync::OnceLock<crate::material::Materials>,
+    /// The runtime sun and its shadow geometry, built on first use.
+    sun: std::sync::OnceLock<Option<crate::sun::RuntimeSun>>,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -89,6 +91,7 @@ impl Reconstructor {
             bins: Mutex::new(HashMap::new()),
             packed: Mutex::new(HashMap::new()),
             materials: std::sync::OnceLock::new(),
+            sun: std::sync::OnceLock::new(),
         }
     }
 
@@ -111,6 +114,14 @@ impl Reconstructor {
     pub(crate) fn materials(&self) -> &crate::material::Materials {
         self.materials
             .get_or_init(|| crate::material::Materials::load(&self.pack))
+    }
+
+    /// The pack's runtime sun, when its lighting leaves the sun's direct light out (pack 3)
+    /// and it has proxies to cast shadows; its shadow BVHs are built on first use.
+    pub fn runtime_sun(&self) -> Option<&crate::sun::RuntimeSun> {
+        self.sun
+            .get_or_init(|| crate::sun::RuntimeSun::load(&self.pack, self.proxy.as_ref()))
+            .as_ref()
     }
 
     /// The temporal filter half-width in use.

@@ -46,6 +46,10 @@ pub struct ReconSettings {
     pub max_splat_px: f32,
     /// What the geometry-assisted mode shows on objects that have a material in the pack.
     pub shading: Shading,
+    /// Shadow rays per pixel of the runtime sun ([`crate::sun`]), spread over the pixel's
+    /// footprint and the sun's disc. More: smoother shadow edges and penumbrae, linear cost;
+    /// 1 gives the pixel centre's hard shadow.
+    pub sun_shadow_rays: u32,
 }
 
 /// What the geometry-assisted mode shows on objects with a material ([`crate::shading`]).
@@ -92,6 +96,7 @@ impl Default for ReconSettings {
             same_surface: 0.03,
             max_splat_px: 8.0,
             shading: Shading::Materials,
+            sun_shadow_rays: 4,
         }
     }
 }

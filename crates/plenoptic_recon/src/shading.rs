@@ -32,6 +32,7 @@ use glam::{Vec2, Vec3};
 use plenoptic_pack::{ChunkKind, VolumeSample};
 use rayon::prelude::*;
 
+use crate::brdf::{Bsdf, SurfaceMaterial};
 use crate::camera::Camera;
 use crate::frame::{Frame, Report};
 use crate::geometry::{self, Layer, Pass};
@@ -139,21 +140,41 @@ pub(crate) fn render(
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
     let start = std::time::Instant::now();
-    let (albedo, raster_ms) = albedo_image(rec, materials, camera, t, layer);
+    let (surface, raster_ms) = surface_image(rec, materials, camera, t, layer);
     timed("albedo", start);
     let start = std::time::Instant::now();
+    let sun = rec
+        .runtime_sun()
+        .map(|s| s.at(proxy, t, rec.settings.sun_shadow_rays));
     frame
         .radiance
         .par_iter_mut()
         .enumerate()
         .for_each(|(j, c)| {
-            if let Some((o, a)) = albedo[j]
-                && lighting.object[j] == o
-            {
-                *c = a * lighting.radiance[j] + non_diffuse.radiance[j];
+            let Some(px) = &surface[j] else { return };
+            if lighting.object[j] != px.object {
+                return;
+            }
+            *c = px.material.albedo() * lighting.radiance[j] + non_diffuse.radiance[j];
+            if let Some(sun) = &sun {
+                let bsdf = Bsdf::new(
+                    px.material,
+                    px.ng,
+                    px.ns,
+                    -px.view,
+                    px.view.dot(px.ng) < 0.0,
+                );
+                *c += sun.radiance(px.position, px.ng, px.footprint, &bsdf, j as u32);
             }
         });
-    timed("compose", start);
+    timed(
+        if sun.is_some() {
+            "compose_sun"
+        } else {
+            "compose"
+        },
+        start,
+    );
     report.fallback = side.fallback;
     for m in side.missing.into_iter().chain(materials.messages()) {
         if !report.missing.contains(&m) {
@@ -165,18 +186,35 @@ pub(crate) fn render(
     Ok(frame)
 }
 
-/// Per pixel, the object seen there and the diffuse albedo of its material (`None` where no
-/// object with a material is); and the milliseconds its raster pass took.
-fn albedo_image(
+/// What the compose stage needs of the surface seen through one pixel.
+struct SurfacePixel {
+    object: u32,
+    material: SurfaceMaterial,
+    /// The point on the proxy (world).
+    position: Vec3,
+    /// Geometric normal as the mesh winds it (world, unit).
+    ng: Vec3,
+    /// Shading normal on `ng`'s side: the proxy's vertex normals interpolated, else `ng`.
+    ns: Vec3,
+    /// Unit direction of the pixel's ray.
+    view: Vec3,
+    /// How far the point moves on the surface's plane for a step of one pixel in x and in y
+    /// (the footprint the runtime sun's shadow rays spread over).
+    footprint: (Vec3, Vec3),
+}
+
+/// Per pixel, the surface of an object with a material seen there (`None` where there is
+/// none); and the milliseconds its raster pass took.
+fn surface_image(
     rec: &Reconstructor,
     materials: &Materials,
     camera: &Camera,
     t: f32,
     layer: Layer<'_>,
-) -> (Vec<Option<(u32, Vec3)>>, f64) {
+) -> (Vec<Option<SurfacePixel>>, f64) {
     let n = camera.pixel_count();
     let Some(proxy) = rec.proxy() else {
-        return (vec![None; n], 0.0);
+        return ((0..n).map(|_| None).collect(), 0.0);
     };
     let start = std::time::Instant::now();
     let mut placed = proxy.placed_meshes(t);
@@ -188,7 +226,7 @@ fn albedo_image(
     let projected = crate::raster::project(camera, &placed);
     let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
     let raster_ms = start.elapsed().as_secs_f64() * 1e3;
-    // Per projected triangle, once: its placed corners, UVs and UV-per-metre scale.
+    // Per projected triangle, once: its placed corners, normals, UVs and UV-per-metre scale.
     let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
         .sources
         .par_iter()
@@ -201,14 +239,25 @@ fn albedo_image(
                 [Some(a), Some(b), Some(c)] => Some([a, b, c]),
                 _ => None,
             };
-            SurfaceTriangle::new(*id, m, v, uv)
+            let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
+                let to_world = xf.matrix3.inverse().transpose();
+                tri.map(|i| Vec3::from(to_world * mesh.normals[i as usize]))
+            });
+            let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
+            if xf.matrix3.determinant() < 0.0 {
+                // The tracer's geometric normal is the object-space one carried by the normal
+                // matrix, which a mirroring transform turns against the placed winding.
+                t.normal = -t.normal;
+            }
+            t.normals = normals;
+            Some(t)
         })
         .collect();
     let basis = camera.basis();
     let w = camera.width as usize;
     // The angle one pixel subtends at the image centre.
     let pixel_angle = 2.0 * basis.tan_y / basis.height;
-    let albedo = (0..n)
+    let surface = (0..n)
         .into_par_iter()
         .map(|j| {
             let t = triangles.get(prim[j] as usize)?.as_ref()?;
@@ -216,27 +265,67 @@ fn albedo_image(
                 return None;
             }
             let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
-            let (uv, footprint) = match &t.uv {
+            let view = dir.normalize_or(basis.forward);
+            // The pixel's ray met on the triangle's plane: the raster's interpolated depth is
+            // off by ~10⁻⁴ of the distance, enough to put the point under the surface for a
+            // shadow ray.
+            let den = dir.dot(t.normal);
+            let along = if den.abs() > 1e-4 {
+                (t.origin - basis.position).dot(t.normal) / den
+            } else {
+                depth[j]
+            };
+            let position = basis.position + dir * along;
+            let b = t.barycentric(position);
+            let (uv, uv_footprint) = match &t.uv {
                 Some(uv) => {
-                    let b = t.barycentric(basis.position + dir * depth[j]);
                     let cos = t.normal.dot(dir).abs().max(0.05);
                     // A pixel off the axis subtends cos³α of the central pixel's solid angle.
                     let c = dir.dot(basis.forward).max(0.0);
                     let off_axis = c * c.sqrt();
                     (
                         uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
-                        t.scale * depth[j] * pixel_angle * off_axis / cos.sqrt(),
+                        t.scale * along * pixel_angle * off_axis / cos.sqrt(),
                     )
                 }
                 None => (Vec2::ZERO, f32::INFINITY),
             };
-            Some((
-                t.object,
-                materials.albedo(rec.pack(), &t.material.material, uv, footprint),
-            ))
+            let ng = t.normal;
+            let mut ns = t.normals.map_or(ng, |[a, c, d]| {
+                (a * b.x + c * b.y + d * b.z).normalize_or(ng)
+            });
+            if ns.dot(ng) < 0.0 {
+                ns = -ns;
+            }
+            // The neighbouring pixels' rays met on the triangle's plane; at most 4 pixels'
+            // worth of depth away, so that a grazing plane does not smear the footprint.
+            let (x, y) = ((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+            let limit = 4.0 * along * pixel_angle;
+            let step = |d: Vec3| {
+                let den = d.dot(ng);
+                let s = if den.abs() > 1e-6 {
+                    (position - basis.position).dot(ng) / den
+                } else {
+                    along
+                };
+                (basis.position + d * s - position).clamp_length_max(limit)
+            };
+            let footprint = (
+                step(basis.direction(x + 1.0, y)),
+                step(basis.direction(x, y + 1.0)),
+            );
+            Some(SurfacePixel {
+                object: t.object,
+                material: materials.surface(rec.pack(), &t.material.material, uv, uv_footprint),
+                position,
+                ng,
+                ns,
+                view,
+                footprint,
+            })
         })
         .collect();
-    (albedo, raster_ms)
+    (surface, raster_ms)
 }
 
 /// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
@@ -249,6 +338,8 @@ struct SurfaceTriangle<'m> {
     /// The inverse Gram matrix of (e0, e1): barycentrics from dot products.
     inv: [f32; 3],
     normal: Vec3,
+    /// Vertex normals placed in the world, when the proxy has them.
+    normals: Option<[Vec3; 3]>,
     uv: Option<[Vec2; 3]>,
     /// √(UV area / world area).
     scale: f32,
@@ -279,6 +370,7 @@ impl<'m> SurfaceTriangle<'m> {
             e1,
             inv: [d11 / den, -d01 / den, d00 / den],
             normal: world.normalize_or_zero(),
+            normals: None,
             uv,
             scale,
         })

@@ -58,6 +58,8 @@ pub struct LightSet {
     distribution: Distribution1d,
     index: HashMap<(ObjectId, u32), usize>,
     punctual: Vec<(Light, PlacedLight)>,
+    /// Index into `punctual` of the scene's sun.
+    sun: Option<usize>,
     env: EnvLight,
 }
 
@@ -114,6 +116,7 @@ impl LightSet {
             distribution: Distribution1d::new(weights),
             index,
             punctual,
+            sun: scene.sun.as_ref().map(|s| s.light),
             env: EnvLight::new(scene.environment_at(t)),
         }
     }
@@ -318,6 +321,10 @@ pub struct DirectLight {
     /// The part reflected by the Lambertian lobe, with its share of the MIS weights;
     /// `total − diffuse` is the specular/glossy part.
     pub diffuse: Vec3,
+    /// The part of `total` from the scene's sun ([`plenoptic_scene::Scene::sun`]).
+    pub sun: Vec3,
+    /// The Lambertian lobe's share of `sun`.
+    pub sun_diffuse: Vec3,
 }
 
 /// [`estimate_direct`] with the Lambertian lobe's share kept apart (the bake's denoiser
@@ -370,6 +377,7 @@ fn direct(
     let n = bsdf.normal();
     let mut total = Vec3::ZERO;
     let mut diffuse = Vec3::ZERO;
+    let (mut sun, mut sun_diffuse) = (Vec3::ZERO, Vec3::ZERO);
     for i in 0..lights.punctual_count() {
         let u = if lights.punctual[i].0.angular_radius > 0.0 {
             sampler.next_2d()
@@ -387,11 +395,17 @@ fn direct(
         if placed.segment_occluded(origin, ls.position) {
             continue;
         }
-        total += f * ls.value * ls.wi.dot(n).abs();
+        let value = f * ls.value * ls.wi.dot(n).abs();
+        total += value;
         if split {
-            diffuse += diffuse_part(bsdf, ls.wi, lobes, f32::INFINITY, &[])
+            let d = diffuse_part(bsdf, ls.wi, lobes, f32::INFINITY, &[])
                 * ls.value
                 * ls.wi.dot(n).abs();
+            diffuse += d;
+            if lights.sun == Some(i) {
+                sun += value;
+                sun_diffuse += d;
+            }
         }
     }
     if samples > 0 && lights.has_emissive() {
@@ -452,5 +466,10 @@ fn direct(
         total += sum / samples as f32;
         diffuse += sum_d / samples as f32;
     }
-    DirectLight { total, diffuse }
+    DirectLight {
+        total,
+        diffuse,
+        sun,
+        sun_diffuse,
+    }
 }

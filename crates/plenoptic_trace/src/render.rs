@@ -35,6 +35,13 @@ pub struct RadianceSample {
     /// weighs luminance differences against. Zero with one sample per pixel (unknown) and
     /// where `diffuse` is zero.
     pub lighting_variance: f32,
+    /// The part of `radiance` that is the first hit's direct light from the scene's sun
+    /// ([`plenoptic_scene::Scene::sun`]) through all its lobes, shadow rays included: what
+    /// pack 3 leaves out of the stored lighting and non-diffuse radiance for the runtime to
+    /// evaluate at screen resolution. Zero without a sun and from the path tracer.
+    pub sun: Vec3,
+    /// The Lambertian lobe's share of `sun` (part of `diffuse`).
+    pub sun_diffuse: Vec3,
 }
 
 impl RadianceSample {
@@ -48,6 +55,8 @@ impl RadianceSample {
         diffuse: Vec3::ZERO,
         albedo: Vec3::ZERO,
         lighting_variance: 0.0,
+        sun: Vec3::ZERO,
+        sun_diffuse: Vec3::ZERO,
     };
 
     pub(crate) fn first_hit(hit: &Hit, ray: &Ray) -> Self {
@@ -64,6 +73,8 @@ impl RadianceSample {
             diffuse: Vec3::ZERO,
             albedo: Vec3::ZERO,
             lighting_variance: 0.0,
+            sun: Vec3::ZERO,
+            sun_diffuse: Vec3::ZERO,
         }
     }
 }
@@ -82,6 +93,7 @@ where
     Image::render(w, h, |x, y| {
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
         let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        let (mut sun, mut sun_diffuse) = (Vec3::ZERO, Vec3::ZERO);
         let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
@@ -103,9 +115,13 @@ where
             sum += r.radiance;
             diffuse += r.diffuse;
             albedo += r.albedo;
+            sun += r.sun;
+            sun_diffuse += r.sun_diffuse;
             let a = luminance(r.albedo);
+            // The variance of the lighting the bake stores and filters: without the sun's
+            // direct light, which the runtime evaluates.
             let l = if a > 1e-3 {
-                f64::from(luminance(r.diffuse) / a)
+                f64::from(luminance(r.diffuse - r.sun_diffuse) / a)
             } else {
                 0.0
             };
@@ -119,6 +135,8 @@ where
             radiance: sum / spp as f32,
             diffuse: diffuse / spp as f32,
             albedo: albedo / spp as f32,
+            sun: sun / spp as f32,
+            sun_diffuse: sun_diffuse / spp as f32,
             lighting_variance: if spp > 1 {
                 // Unbiased sample variance, over spp for the variance of the mean.
                 let n = f64::from(spp);

@@ -21,6 +21,11 @@
 //!   albedo is below [`MIN_ALBEDO`]. Not filtered: a reflection's detail is geometry seen in
 //!   another direction, not noise, and guides of the first hit cannot tell its edges.
 //!
+//! - `sun`: the first hit's direct light from the scene's sun (all lobes), which pack 3 leaves
+//!   to the runtime (shadow rays against the proxies at screen resolution). It is taken out of
+//!   the lighting and the residual before anything else, so the filter never sees sun-shadow
+//!   edges, and added back only into the radiance (image and volume modes warp that).
+//!
 //! This record is pack v2's "lighting apart from reflectance": the pack can store `lighting`
 //! (and `residual` as the view-dependent part) and the runtime multiply by `albedo(uv)`.
 //!
@@ -124,6 +129,8 @@ pub struct LightingCube {
     pub albedo: Vec<Vec3>,
     /// Emission, the specular/view-dependent part and undemodulated diffuse radiance.
     pub residual: Vec<Vec3>,
+    /// The first hit's direct sunlight, left to the runtime (see the module doc).
+    pub sun: Vec<Vec3>,
     /// Distance along the texel's centre ray; infinite for a miss.
     pub distance: Vec<f32>,
     /// Pack object id (0: none).
@@ -150,17 +157,18 @@ impl LightingCube {
             lighting: Vec::new(),
             albedo: Vec::new(),
             residual: Vec::new(),
+            sun: Vec::new(),
             distance: Vec::new(),
             object: Vec::new(),
             normal: Vec::new(),
             variance: Vec::new(),
         };
         for s in samples {
-            let radiance = s.radiance.max(Vec3::ZERO);
-            let (lighting, albedo, residual) = split(radiance, s.diffuse, s.albedo);
+            let (lighting, albedo, residual, sun) = split(s);
             c.lighting.push(lighting);
             c.albedo.push(albedo);
             c.residual.push(residual);
+            c.sun.push(sun);
             c.distance.push(s.distance);
             c.object.push(pack_object_id(s.object));
             c.normal.push(s.normal);
@@ -184,9 +192,9 @@ impl LightingCube {
         self.object[i] != 0 && self.albedo[i].max_element() > MIN_ALBEDO
     }
 
-    /// Radiance of texel `i`: `albedo ⊙ lighting + residual`, never negative.
+    /// Radiance of texel `i`: `albedo ⊙ lighting + residual + sun`, never negative.
     pub fn radiance(&self, i: usize) -> Vec3 {
-        (self.albedo[i] * self.lighting[i] + self.residual[i]).max(Vec3::ZERO)
+        (self.albedo[i] * self.lighting[i] + self.residual[i] + self.sun[i]).max(Vec3::ZERO)
     }
 
     /// The range image of the records (pack v2): radiance re-modulated, the lighting with
@@ -300,16 +308,23 @@ impl LightingCube {
 }
 
 /// `(lighting, non-diffuse)` of one rendered sample (a temporal-volume sample: pack v2 stores
-/// them beside its radiance), as a range-image texel splits them.
+/// them beside its radiance), as a range-image texel splits them: both without the sun's
+/// direct light.
 pub fn split_sample(s: &RadianceSample) -> (Vec3, Vec3) {
-    let (lighting, _, residual) = split(s.radiance.max(Vec3::ZERO), s.diffuse, s.albedo);
+    let (lighting, _, residual, _) = split(s);
     (lighting, residual.max(Vec3::ZERO))
 }
 
-/// `(lighting, albedo, residual)` of a texel with `radiance`, of which `diffuse` is the
-/// Lambertian part, over `albedo`.
-fn split(radiance: Vec3, diffuse: Vec3, albedo: Vec3) -> (Vec3, Vec3, Vec3) {
-    let diffuse = diffuse.max(Vec3::ZERO).min(radiance);
+/// `(lighting, albedo, residual, sun)` of a rendered sample: the sun's direct light is taken
+/// out first (clamped so that nothing goes negative), then the rest of the Lambertian part is
+/// demodulated by the albedo.
+fn split(s: &RadianceSample) -> (Vec3, Vec3, Vec3, Vec3) {
+    let radiance = s.radiance.max(Vec3::ZERO);
+    let sun = s.sun.max(Vec3::ZERO).min(radiance);
+    let sun_diffuse = s.sun_diffuse.max(Vec3::ZERO).min(sun);
+    let radiance = radiance - sun;
+    let albedo = s.albedo;
+    let diffuse = (s.diffuse - sun_diffuse).max(Vec3::ZERO).min(radiance);
     let mut lighting = Vec3::ZERO;
     let mut kept = Vec3::ZERO;
     for c in 0..3 {
@@ -320,5 +335,5 @@ fn split(radiance: Vec3, diffuse: Vec3, albedo: Vec3) -> (Vec3, Vec3, Vec3) {
     }
     // What is not demodulated stays in the residual, so radiance is exactly recovered.
     let albedo = Vec3::select(albedo.cmpgt(Vec3::splat(MIN_ALBEDO)), albedo, Vec3::ZERO);
-    (lighting, albedo, radiance - kept)
+    (lighting, albedo, radiance - kept, sun)
 }

@@ -70,6 +70,7 @@ fn cube(
                 albedo,
                 // The noise of the lighting's luminance, as the renderer would report it.
                 lighting_variance: sigma * sigma * LUMINANCE_NOISE,
+                ..RadianceSample::MISS
             }
         })
         .collect();

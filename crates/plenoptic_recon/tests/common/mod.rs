@@ -295,6 +295,11 @@ pub struct PackSpec {
     /// Whether range images carry pack 2.0's lighting and non-diffuse cubes (false: only
     /// radiance, distance, id and normal, as a damaged pack might).
     pub lighting_chunks: bool,
+    /// Whether the pack leaves the sun's direct light to the runtime (pack 3's
+    /// `direct_sun`, with [`moving_sun`] as the sun; a delta sun): the runtime adds it to the
+    /// stored lighting with shadow rays. The stored texels are not changed, so this tests
+    /// that both backends add the same light, not the physics.
+    pub direct_sun: bool,
 }
 
 /// The materials of a test pack's objects.
@@ -337,6 +342,7 @@ impl PackSpec {
             glazing: true,
             materials: Materials::None,
             lighting_chunks: true,
+            direct_sun: false,
         }
     }
 }
@@ -588,11 +594,24 @@ pub fn write_pack_with(
         })
         .collect();
     manifest.bake.cube_face_size = spec.face;
+    let environment = match environment {
+        None if spec.direct_sun => Some((
+            plenoptic_pack::plenoptic_sky::Environment::None,
+            Some(moving_sun()),
+        )),
+        e => e,
+    };
     if let Some((env, sun)) = environment {
         if let plenoptic_pack::plenoptic_sky::Environment::Image { image, .. } = &env {
             w.add_environment_image(image).unwrap();
         }
-        manifest.environment = Some(plenoptic_pack::EnvironmentEntry::new(&env, sun));
+        let mut entry = plenoptic_pack::EnvironmentEntry::new(&env, sun);
+        if spec.direct_sun {
+            entry.direct_sun = Some(plenoptic_pack::DirectSun {
+                angular_radius: 0.0,
+            });
+        }
+        manifest.environment = Some(entry);
     }
     w.finish(&manifest).unwrap();
 }

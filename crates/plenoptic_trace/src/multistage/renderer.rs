@@ -15,8 +15,10 @@
 //!
 //! The first hit's Lambertian share (its direct light through the diffuse lobe plus the
 //! ambient term) is returned apart as [`RadianceSample::diffuse`], with the hit's diffuse
-//! albedo, for the bake's denoiser (pack v2: lighting apart from reflectance). Splitting draws
-//! no extra random numbers: the radiance is the same with or without it.
+//! albedo, for the bake's denoiser (pack v2: lighting apart from reflectance), and its direct
+//! light from the scene's sun as [`RadianceSample::sun`] (pack 3 leaves that to the runtime,
+//! thesis ch. 5's split of direct and indirect light at different accuracies). Splitting
+//! draws no extra random numbers: the radiance is the same with or without it.
 //!
 //! Emitters and the environment found by glossy rays and by light sampling are combined with
 //! the power heuristic; the diffuse lobe sees emitters through light sampling only. A ray that
@@ -142,6 +144,10 @@ impl<'f> MultiStageRenderer<'f> {
             let direct = estimate_direct_split(placed, &hit, &bsdf, Lobes::All, competing, n, s);
             l += direct.total;
             diffuse += direct.diffuse;
+            if let Some(out) = first.as_deref_mut() {
+                out.sun = direct.sun;
+                out.sun_diffuse = direct.sun_diffuse;
+            }
         }
         if bsdf.has(Lobes::Diffuse) {
             // One-sample estimate of the Lambertian lobe's directional albedo (its Fresnel

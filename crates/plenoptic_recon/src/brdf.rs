@@ -1,0 +1,177 @@
+//! The BSDF of a surface for one incident direction: what the runtime sun needs (pack 3,
+//! docs/architecture.md, "The runtime sun"). It is the tracer's glTF metallic-roughness model
+//! (`plenoptic_trace::material`: Lambert + GGX with separable Smith masking, the exact
+//! dielectric Fresnel for the IOR, Schlick's for metals, Walter et al. 2007's rough BTDF for
+//! transmission), evaluated only, not sampled. The runtime core does not depend on the
+//! tracer, so the formulas are repeated here; `tests/runtime_sun.rs` checks that both give
+//! the same value for random surfaces and directions.
+//!
+//! Everything is in world space: the model is isotropic, so only dot products with the
+//! shading normal matter and no tangent frame is built.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// Roughness below which the tracer's specular lobes are ideal (mirror, clear glass), which
+/// no light sample can reach.
+pub(crate) const DELTA_ROUGHNESS: f32 = 0.02;
+
+/// A material at a surface point, as the tracer's `SurfaceProps` holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceMaterial {
+    /// Base colour, textured, linear.
+    pub base: Vec3,
+    /// Metalness in [0, 1].
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: f32,
+    /// Transmission in [0, 1].
+    pub transmission: f32,
+    /// Index of refraction (> 0).
+    pub ior: f32,
+}
+
+impl SurfaceMaterial {
+    /// The diffuse albedo the bake divides the lighting by: `(1 − metallic)(1 − transmission)
+    /// · base`.
+    pub fn albedo(&self) -> Vec3 {
+        self.base * ((1.0 - self.metallic) * (1.0 - self.transmission))
+    }
+}
+
+/// The BSDF at a surface point seen along `wo`.
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    n: Vec3,
+    ng: Vec3,
+    wo: Vec3,
+    m: SurfaceMaterial,
+    alpha: f32,
+    eta: f32,
+    delta: bool,
+    /// Whether the Lambertian lobe has any weight (the tracer skips light sampling on
+    /// surfaces whose every lobe is ideal).
+    diffuse: bool,
+}
+
+impl Bsdf {
+    /// The BSDF of `m` at a point with geometric normal `ng` and shading normal `ns` (unit,
+    /// either side), seen from direction `wo` (unit, towards the viewer); `front_face`: the
+    /// viewer is on `ng`'s side of the triangle as the mesh winds it.
+    pub fn new(m: SurfaceMaterial, ng: Vec3, ns: Vec3, wo: Vec3, front_face: bool) -> Self {
+        let side = if wo.dot(ng) >= 0.0 { 1.0 } else { -1.0 };
+        let ng = ng * side;
+        let mut n = ns * side;
+        if n.dot(wo) < 1e-4 {
+            n = (n - wo * (n.dot(wo) - 1e-4)).normalize_or(ng);
+        }
+        let ior = if m.ior > 0.0 { m.ior } else { 1.5 };
+        let eta = if front_face { ior } else { 1.0 / ior };
+        let fd = fresnel_dielectric(wo.dot(n).clamp(1e-4, 1.0), eta);
+        let lum = 0.2126 * m.base.x + 0.7152 * m.base.y + 0.0722 * m.base.z;
+        Self {
+            n,
+            ng,
+            wo,
+            m,
+            alpha: (m.roughness * m.roughness).max(1e-4),
+            eta,
+            delta: m.roughness < DELTA_ROUGHNESS,
+            diffuse: (1.0 - m.metallic) * (1.0 - m.transmission) * (1.0 - fd) * lum.max(0.0) > 0.0,
+        }
+    }
+
+    /// The shading normal on the viewer's side (what the cosine factor uses).
+    pub fn normal(&self) -> Vec3 {
+        self.n
+    }
+
+    /// Whether light from a direction can be reflected at all: false where every lobe is
+    /// ideal (a mirror, clear glass), which the tracer lights through its specular paths
+    /// only.
+    pub fn takes_light_samples(&self) -> bool {
+        self.diffuse || !self.delta
+    }
+
+    /// The BSDF's value for incident direction `wi` (unit, away from the surface).
+    pub fn eval(&self, wi: Vec3) -> Vec3 {
+        let (wo, n, m) = (self.wo, self.n, &self.m);
+        let cos_i = wi.dot(n);
+        let reflect = cos_i > 0.0;
+        if reflect != (wi.dot(self.ng) > 0.0) {
+            return Vec3::ZERO;
+        }
+        let cos_o = wo.dot(n);
+        let (metal, tr) = (m.metallic, m.transmission);
+        if reflect {
+            let h = (wo + wi).normalize_or_zero();
+            if h == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            let voh = wo.dot(h).clamp(0.0, 1.0);
+            let fd = fresnel_dielectric(voh, self.eta);
+            let mut f = m.base * ((1.0 - metal) * (1.0 - tr) * (1.0 - fd) / PI);
+            if !self.delta {
+                let d = ggx_d(self.alpha, h.dot(n));
+                let g = smith_g1(self.alpha, cos_o) * smith_g1(self.alpha, cos_i);
+                let fr = Vec3::splat((1.0 - metal) * fd) + fresnel_schlick(m.base, voh) * metal;
+                f += fr * (d * g / (4.0 * cos_o * cos_i).max(1e-8));
+            }
+            f
+        } else if !self.delta && tr > 0.0 && metal < 1.0 {
+            let eta = self.eta;
+            let mut h = (wo + wi * eta).normalize_or_zero();
+            if h == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            if h.dot(n) < 0.0 {
+                h = -h;
+            }
+            let (woh, wih) = (wo.dot(h), wi.dot(h));
+            if woh * wih >= 0.0 {
+                return Vec3::ZERO;
+            }
+            let denom = (wih + woh / eta).powi(2);
+            let fd = fresnel_dielectric(woh.abs(), eta);
+            let d = ggx_d(self.alpha, h.dot(n));
+            let g = smith_g1(self.alpha, cos_o) * smith_g1(self.alpha, cos_i);
+            let ft = d * (1.0 - fd) * g * (wih * woh / (cos_i * cos_o * denom)).abs() / (eta * eta);
+            m.base * ((1.0 - metal) * tr * ft)
+        } else {
+            Vec3::ZERO
+        }
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric for `cos_i` and relative IOR `eta`.
+fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+fn fresnel_schlick(f0: Vec3, cos: f32) -> Vec3 {
+    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
+    f0 + (Vec3::ONE - f0) * m
+}
+
+fn ggx_d(alpha: f32, cos_h: f32) -> f32 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    a2 / (PI * d * d)
+}
+
+fn smith_g1(alpha: f32, cos: f32) -> f32 {
+    let c = cos.abs();
+    let a2 = alpha * alpha;
+    2.0 * c / (c + (a2 + (1.0 - a2) * c * c).sqrt())
+}

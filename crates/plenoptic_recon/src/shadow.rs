@@ -1,0 +1,215 @@
+//! Shadow rays against the pack's proxy geometry (pack 3's runtime sun, docs/architecture.md,
+//! "The runtime sun"; thesis ch. 5: direct light computed apart from indirect light, at its
+//! own accuracy).
+//!
+//! Objects that never move share one BVH over their world-space triangles, built once. Each
+//! animated object has a BVH of its own in object space; a ray is moved into the object's
+//! space at the frame's time, after a test against the object's bounds placed then. BVHs are
+//! obvhs's compressed wide BVHs with its own ray–triangle test (both faces), as the tracer's
+//! flat BVH uses them.
+//!
+//! Every proxy triangle blocks light: glass included, as in the tracer's shadow rays. Alpha
+//! masks are not applied (the tracer applies them; no tour object has one).
+
+use std::time::Duration;
+
+use glam::{Affine3A, Vec3, Vec3A};
+use obvhs::{
+    BvhBuildParams,
+    cwbvh::{CwBvh, builder::build_cwbvh_from_tris},
+    ray::Ray,
+    triangle::Triangle,
+};
+
+use crate::proxy::ProxyGeometry;
+
+/// A BVH and its triangles in BVH order.
+struct TriangleBvh {
+    bvh: CwBvh,
+    triangles: Vec<Triangle>,
+    /// Bounds (min, max) of the triangles.
+    bounds: (Vec3, Vec3),
+}
+
+impl TriangleBvh {
+    fn new(tris: Vec<Triangle>) -> Option<Self> {
+        if tris.is_empty() {
+            return None;
+        }
+        let bvh = build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let (mut lo, mut hi) = (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY));
+        for t in &tris {
+            lo = lo.min(t.v0).min(t.v1).min(t.v2);
+            hi = hi.max(t.v0).max(t.v1).max(t.v2);
+        }
+        let triangles = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| tris[i as usize])
+            .collect();
+        Some(Self {
+            bvh,
+            triangles,
+            bounds: (lo.into(), hi.into()),
+        })
+    }
+
+    fn occluded(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> bool {
+        // −0.0 components would disagree with obvhs's sign tests; + 0.0 turns them into +0.0.
+        let ray = Ray::new(origin, dir + Vec3A::ZERO, 0.0, tmax);
+        !self
+            .bvh
+            .ray_traverse_miss(ray, |r, i| self.triangles[i].intersect(r))
+    }
+}
+
+/// The proxies as shadow rays see them.
+pub struct ShadowScene {
+    fixed: Option<TriangleBvh>,
+    /// (pack id, object-space BVH) of every object with motion.
+    moving: Vec<(u32, TriangleBvh)>,
+}
+
+impl std::fmt::Debug for ShadowScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShadowScene")
+            .field("fixed", &self.fixed.as_ref().map(|b| b.triangles.len()))
+            .field("moving", &self.moving.len())
+            .finish()
+    }
+}
+
+/// A [`ShadowScene`] at one time: the moving objects placed.
+pub struct PlacedShadows<'s> {
+    scene: &'s ShadowScene,
+    /// Per moving object: world → object transform and world bounds.
+    moving: Vec<(Affine3A, Vec3, Vec3)>,
+}
+
+impl ShadowScene {
+    /// The shadow geometry of `proxy`.
+    pub fn new(proxy: &ProxyGeometry) -> Self {
+        let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
+            m.triangles
+                .iter()
+                .map(|t| {
+                    let [v0, v1, v2] =
+                        t.map(|i| xf.transform_point3a(m.positions[i as usize].into()));
+                    Triangle { v0, v1, v2 }
+                })
+                .collect()
+        };
+        let mut fixed = Vec::new();
+        let mut moving = Vec::new();
+        for (i, &id) in proxy.object_ids().iter().enumerate() {
+            let mesh = &proxy.meshes()[i];
+            match &proxy.motions()[i] {
+                Some(m) if m.is_animated() => {
+                    if let Some(b) = TriangleBvh::new(triangles(mesh, Affine3A::IDENTITY)) {
+                        moving.push((id, b));
+                    }
+                }
+                _ => fixed.extend(triangles(mesh, proxy.transform(id, 0.0))),
+            }
+        }
+        Self {
+            fixed: TriangleBvh::new(fixed),
+            moving,
+        }
+    }
+
+    /// The scene with its moving objects placed at time `t`.
+    pub fn at<'s>(&'s self, proxy: &ProxyGeometry, t: f32) -> PlacedShadows<'s> {
+        let moving = self
+            .moving
+            .iter()
+            .map(|(id, b)| {
+                let xf = proxy.transform(*id, t);
+                let (lo, hi) = placed_bounds(xf, b.bounds);
+                (xf.inverse(), lo, hi)
+            })
+            .collect();
+        PlacedShadows {
+            scene: self,
+            moving,
+        }
+    }
+}
+
+impl PlacedShadows<'_> {
+    /// Whether anything lies along the ray from `origin` along unit `dir` closer than
+    /// `tmax`.
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        if let Some(b) = &self.scene.fixed
+            && b.occluded(o, d, tmax)
+        {
+            return true;
+        }
+        self.scene
+            .moving
+            .iter()
+            .zip(&self.moving)
+            .any(|((_, b), (to_object, lo, hi))| {
+                ray_meets_box(origin, dir, tmax, *lo, *hi)
+                    // An affine map keeps the ray parameter: t is the same in object space.
+                    && b.occluded(
+                        to_object.transform_point3a(o),
+                        to_object.transform_vector3a(d),
+                        tmax,
+                    )
+            })
+    }
+}
+
+/// The world bounds of object-space bounds `b` moved by `xf` (its eight corners').
+fn placed_bounds(xf: Affine3A, b: (Vec3, Vec3)) -> (Vec3, Vec3) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for k in 0..8 {
+        let c = Vec3::new(
+            if k & 1 == 0 { b.0.x } else { b.1.x },
+            if k & 2 == 0 { b.0.y } else { b.1.y },
+            if k & 4 == 0 { b.0.z } else { b.1.z },
+        );
+        let p = xf.transform_point3(c);
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    (lo, hi)
+}
+
+/// Slab test of a ray against a box.
+fn ray_meets_box(origin: Vec3, dir: Vec3, tmax: f32, lo: Vec3, hi: Vec3) -> bool {
+    let inv = dir.recip();
+    let a = (lo - origin) * inv;
+    let b = (hi - origin) * inv;
+    let near = a.min(b).max_element().max(0.0);
+    let far = a.max(b).min_element().min(tmax);
+    // NaN (a zero direction component on the slab's plane) counts as a hit: the BVH decides.
+    near <= far || near.is_nan() || far.is_nan()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_test_hits_and_misses() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
+        let o = Vec3::new(0.5, 0.5, -1.0);
+        assert!(ray_meets_box(o, Vec3::Z, 10.0, lo, hi));
+        assert!(!ray_meets_box(o, Vec3::Z, 0.5, lo, hi));
+        assert!(!ray_meets_box(o, -Vec3::Z, 10.0, lo, hi));
+        assert!(!ray_meets_box(
+            Vec3::new(2.0, 0.5, -1.0),
+            Vec3::Z,
+            10.0,
+            lo,
+            hi
+        ));
+    }
+}

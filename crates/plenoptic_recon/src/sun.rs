@@ -1,0 +1,155 @@
+//! The runtime sun (pack 3; docs/architecture.md, "The runtime sun"; thesis ch. 5, direct and
+//! indirect light at different accuracies; issue 12: "direct light from punctual lights may
+//! be left out of the stored lighting and evaluated at runtime against the proxy geometry").
+//!
+//! A pack whose environment entry has `direct_sun` stores its lighting and non-diffuse
+//! radiance without the sun's direct light at the surfaces the base views see. Here it is
+//! added back per pixel, for the actual camera and time:
+//!
+//! `L_sun = 1/K Σ_k f(ω_k, ω_o) · E_sun · |n · ω_k| · V(x, ω_k)`
+//!
+//! with `f` the surface's full BSDF ([`crate::brdf`]: the Lambertian lobe, and the GGX
+//! highlight the base views would have frozen in place), `E_sun` the track's illuminance at
+//! t and `V` a shadow ray against the proxies ([`crate::shadow`]). A sun with a disc
+//! (angular radius > 0) is sampled with `K` = [`crate::ReconSettings::sun_shadow_rays`]
+//! directions spread uniformly over the disc's cone, as the tracer draws them (stratified in
+//! cos θ and φ, the strata turned per pixel). The rays also leave from `K` points spread over
+//! the pixel's footprint on the surface (a rotated R₂ lattice), so that a shadow edge is
+//! antialiased as the path tracer's jittered pixels show it; `K` applies to a delta sun too.
+//! Shadow edges are therefore at screen resolution, and a highlight moves with the camera.
+//!
+//! Surfaces whose every lobe is ideal (a mirror, clear glass) take no light sample, as in the
+//! tracer: they show the sun through their baked specular paths.
+
+use glam::Vec3;
+use plenoptic_pack::PackReader;
+use plenoptic_pack::plenoptic_sky::SunTrack;
+
+use crate::brdf::Bsdf;
+use crate::proxy::ProxyGeometry;
+use crate::shadow::{PlacedShadows, ShadowScene};
+
+/// Largest number of shadow rays per pixel a setting may ask for.
+pub const MAX_SUN_RAYS: u32 = 64;
+
+/// The pack's runtime sun with the proxies its shadow rays test.
+#[derive(Debug)]
+pub struct RuntimeSun {
+    track: SunTrack,
+    angular_radius: f32,
+    shadows: ShadowScene,
+}
+
+/// A [`RuntimeSun`] at one time.
+pub struct PlacedSun<'s> {
+    towards: Vec3,
+    illuminance: Vec3,
+    /// Tangent and bitangent of the cone around `towards`.
+    frame: (Vec3, Vec3),
+    cos_max: f32,
+    rays: u32,
+    shadows: PlacedShadows<'s>,
+}
+
+impl RuntimeSun {
+    /// The runtime sun of `pack`, when its lighting leaves the sun out and it has proxies.
+    pub fn load(pack: &PackReader, proxy: Option<&ProxyGeometry>) -> Option<Self> {
+        let (track, sun) = pack.direct_sun()?;
+        Some(Self {
+            track: track.clone(),
+            angular_radius: sun.angular_radius,
+            shadows: ShadowScene::new(proxy?),
+        })
+    }
+
+    /// The sun at time `t`, its shadow rays against `proxy` placed then; `rays` shadow rays
+    /// per pixel (clamped to 1..=[`MAX_SUN_RAYS`]).
+    pub fn at<'s>(&'s self, proxy: &ProxyGeometry, t: f32, rays: u32) -> PlacedSun<'s> {
+        let (towards, illuminance) = self.track.at(t);
+        let towards = towards.normalize_or(Vec3::Y);
+        PlacedSun {
+            towards,
+            illuminance,
+            frame: towards.any_orthonormal_pair(),
+            cos_max: self.angular_radius.min(0.5).cos(),
+            rays: rays.clamp(1, MAX_SUN_RAYS),
+            shadows: self.shadows.at(proxy, t),
+        }
+    }
+}
+
+impl PlacedSun<'_> {
+    /// Unit direction towards the sun's centre.
+    pub fn towards(&self) -> Vec3 {
+        self.towards
+    }
+
+    /// Radiance towards the viewer of the sun's direct light at `p` (geometric normal `ng`,
+    /// either side) through `bsdf`; the pixel's footprint on the surface spans `footprint`
+    /// (the displacements of a step of one pixel in x and in y) and `pixel` turns the strata.
+    pub fn radiance(
+        &self,
+        p: Vec3,
+        ng: Vec3,
+        footprint: (Vec3, Vec3),
+        bsdf: &Bsdf,
+        pixel: u32,
+    ) -> Vec3 {
+        if self.illuminance == Vec3::ZERO || !bsdf.takes_light_samples() {
+            return Vec3::ZERO;
+        }
+        let n = bsdf.normal();
+        let eps = 1e-4 * (1.0 + p.abs().max_element());
+        let turn = hash01(pixel);
+        let shift = hash01(pixel ^ 0x5bd1_e995);
+        let mut sum = Vec3::ZERO;
+        for k in 0..self.rays {
+            let wi = self.direction(k, turn);
+            let f = bsdf.eval(wi);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            // Point k of the R₂ sequence in the pixel, turned per pixel; one ray: the centre.
+            let q = if self.rays == 1 {
+                p
+            } else {
+                let u = (turn + k as f32 * 0.754_877_7).fract() - 0.5;
+                let v = (shift + k as f32 * 0.569_840_3).fract() - 0.5;
+                p + footprint.0 * u + footprint.1 * v
+            };
+            let origin = if wi.dot(ng) >= 0.0 {
+                q + ng * eps
+            } else {
+                q - ng * eps
+            };
+            if self.shadows.occluded(origin, wi, 1e9) {
+                continue;
+            }
+            sum += f * wi.dot(n).abs();
+        }
+        sum * self.illuminance / self.rays as f32
+    }
+
+    /// Shadow-ray direction `k` of [`Self::radiance`]: uniform over the disc's cone, stratum
+    /// `k` of `rays` in cos θ, a golden-angle step in φ, all turned by `turn`.
+    fn direction(&self, k: u32, turn: f32) -> Vec3 {
+        if self.cos_max >= 1.0 {
+            return self.towards;
+        }
+        let u = (k as f32 + 0.5) / self.rays as f32;
+        let cos_t = 1.0 - u * (1.0 - self.cos_max);
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let phi = std::f32::consts::TAU * (turn + k as f32 * 0.618_034).fract();
+        let (t, b) = self.frame;
+        (t * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + self.towards * cos_t).normalize()
+    }
+}
+
+/// A number in [0, 1) from `x` (a 32-bit integer hash).
+fn hash01(x: u32) -> f32 {
+    let mut h = x.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    (h >> 8) as f32 / (1u32 << 24) as f32
+}
