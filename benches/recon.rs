@@ -3,7 +3,10 @@
 //! built in the setup; the geometry-assisted mode also with seamless bilinear cube filtering
 //! (`geometry_bilinear`, `ReconSettings::cube_filter`; the other cases use the default,
 //! nearest texel) and with materials (`geometry_textured`: pack 2.0's albedo from a 256²
-//! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`); and
+//! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`), and
+//! with pack 3's runtime sun on top (`geometry_sun`: the room with a skylight, the sun's
+//! direct light through each pixel's BSDF with `ReconSettings::sun_shadow_rays` = 4 shadow
+//! rays against the proxies); and
 //! the reference path tracer's time for the same frame, as a ratio
 //! measured in the same run. The chunk cache is warm (decoded cubes, interleaved texels and
 //! binned volume blocks are built on the first frame), as in a walk-through.
@@ -58,6 +61,18 @@ fn bench(c: &mut Criterion) {
         &textured_path,
     );
     let textured = Reconstructor::open(&textured_path).unwrap();
+    // Textured, in the room with a skylight, with the sun left to the runtime (pack 3).
+    let sun_path = dir.path().join("sun.pack");
+    write_pack(
+        &open_room(),
+        &PackSpec {
+            materials: Materials::Textured,
+            direct_sun: true,
+            ..spec.clone()
+        },
+        &sun_path,
+    );
+    let sun = Reconstructor::open(&sun_path).unwrap();
     let mut group = c.benchmark_group("recon");
     group.sample_size(10);
     for (w, h) in [(640, 360), (1280, 720)] {
@@ -76,6 +91,11 @@ fn bench(c: &mut Criterion) {
         let _ = textured.render(&cam, T, mode).unwrap();
         group.bench_function(format!("geometry_textured/{w}x{h}"), |b| {
             b.iter(|| black_box(textured.render(black_box(&cam), T, mode).unwrap()))
+        });
+        let (_, report) = sun.render(&cam, T, mode).unwrap();
+        assert!(sun.runtime_sun().is_some(), "{:?}", report.missing);
+        group.bench_function(format!("geometry_sun/{w}x{h}"), |b| {
+            b.iter(|| black_box(sun.render(black_box(&cam), T, mode).unwrap()))
         });
     }
     let accel = SceneAccel::new(&scene).unwrap();

@@ -223,15 +223,15 @@ fn run(options: &Options) -> Result<(), BoxError> {
         return print_plan(&recipe_path);
     }
     let mut pack = options.pack.clone().unwrap_or(recipe.output.clone());
-    // A pack of an older format (version 1) is baked again; the new pack replaces it only
-    // once it is complete.
-    let outdated = pack.exists()
-        && matches!(
-            plenoptic_pack::PackReader::open(&pack),
-            Err(plenoptic_pack::PackError::NeedsRebake { .. })
-        );
+    // A pack of an older format is baked again (version 1 cannot be read; version 2 keeps
+    // the sun in its lighting, which version 3 evaluates at runtime); the new pack replaces it
+    // only once it is complete.
+    let outdated = pack.exists() && plenoptic_pack::is_outdated(&pack);
     if outdated {
-        println!("{} is a version-1 pack: baking it again", pack.display());
+        println!(
+            "{} is a pack of an older format: baking it again",
+            pack.display()
+        );
     }
     if !pack.exists() || outdated {
         if let Some(dir) = pack.parent().filter(|d| !d.as_os_str().is_empty()) {

@@ -48,11 +48,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &recipe,
     )?;
     let pack = dir.join("sun_study.pack");
-    // A pack of an older format (version 1) is baked again.
-    let outdated = matches!(
-        plenoptic_pack::PackReader::open(&pack),
-        Err(plenoptic_pack::PackError::NeedsRebake { .. })
-    );
+    // A pack of an older format is baked again.
+    let outdated = pack.exists() && plenoptic_pack::is_outdated(&pack);
     if !pack.exists() || outdated {
         let start = std::time::Instant::now();
         bake_recipe(

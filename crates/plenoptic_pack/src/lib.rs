@@ -94,7 +94,7 @@ pub use range_image::{
     decode_object_id, decode_radiance, encode_distance, encode_normal, encode_object_id,
     encode_radiance,
 };
-pub use reader::{Chunk, PackReader};
+pub use reader::{Chunk, PackReader, is_outdated};
 pub use texture::{
     ColourSpace, MAX_TEXTURE_SIDE, TextureImage, TextureLevel, decode_texture, encode_texture,
     mip_count, mip_size,

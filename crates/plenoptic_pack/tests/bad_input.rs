@@ -376,3 +376,22 @@ fn glazing_coverage_outside_zero_to_one_is_refused_and_named() {
     assert_eq!(back.objects[0].coverage, Some(0.12));
     assert_eq!(back.objects[1].coverage, None);
 }
+
+#[test]
+fn older_majors_are_outdated() {
+    let dir = tempfile::tempdir().unwrap();
+    for (major, outdated) in [(1, true), (2, true), (3, false)] {
+        let mut b = small_pack();
+        rewrite_header(&mut b, |h| h.version_major = major);
+        let path = dir.path().join(format!("v{major}.pack"));
+        std::fs::write(&path, &b).unwrap();
+        assert_eq!(
+            plenoptic_pack::is_outdated(&path),
+            outdated,
+            "major {major}"
+        );
+    }
+    assert!(!plenoptic_pack::is_outdated(
+        dir.path().join("missing.pack")
+    ));
+}

@@ -5,7 +5,8 @@
 // albedo (the material's factors) · lighting + non-diffuse, both looked up bilinearly.
 
 #import bevy_pbr::forward_io::VertexOutput
-#import bevy_pbr::mesh_view_bindings::view
+#import bevy_pbr::mesh_view_bindings::{view, lights}
+#import bevy_pbr::shadows::fetch_directional_shadow
 #ifdef TONEMAP_IN_SHADER
 #import bevy_core_pipeline::tonemapping::tone_mapping
 #endif
@@ -39,6 +40,12 @@ struct ReconParams {
     base_uv: vec4<f32>,
     mr_uv: vec4<f32>,
     uv_rotation: vec4<f32>,
+    // x: roughness factor, y: IOR (the runtime sun's BSDF).
+    surface: vec4<f32>,
+    // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
+    sun: vec4<f32>,
+    // Its illuminance at the camera's time (xyz).
+    sun_illuminance: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -69,6 +76,10 @@ struct ReconParams {
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).
 var<private> pixel_albedo: vec3<f32>;
+// Its textured base colour, metalness and roughness (the runtime sun's BSDF).
+var<private> pixel_base: vec3<f32>;
+var<private> pixel_metallic: f32;
+var<private> pixel_roughness: f32;
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
@@ -101,6 +112,7 @@ fn level(footprint: f32, t: vec4<f32>, side: f32) -> f32 {
 fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     var base = params.albedo.xyz;
     var metallic = params.albedo.w;
+    var roughness = params.surface.x;
     if params.material.y > 0.0 {
         let st = uv_transform(uv, params.base_uv, params.uv_rotation.x);
         let lod = level(footprint, params.base_uv, params.material.y);
@@ -109,8 +121,13 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     if params.material.z > 0.0 {
         let st = uv_transform(uv, params.mr_uv, params.uv_rotation.y);
         let lod = level(footprint, params.mr_uv, params.material.z);
-        metallic *= textureSampleLevel(metallic_roughness_texture, metallic_roughness_sampler, st, lod).b;
+        let mr = textureSampleLevel(metallic_roughness_texture, metallic_roughness_sampler, st, lod);
+        metallic *= mr.b;
+        roughness *= mr.g;
     }
+    pixel_base = base;
+    pixel_metallic = clamp(metallic, 0.0, 1.0);
+    pixel_roughness = clamp(roughness, 0.0, 1.0);
     return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.material.x));
 }
 
@@ -334,7 +351,12 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // Bevy's post-process pass).
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
-    let c = radiance(in);
+    // The triangle's plane, before any non-uniform branch.
+    let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));
+    var c = radiance(in);
+    if lit() && params.sun.w == 1.0 && params.fill.z != 1.0 {
+        c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
+    }
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
     let glazing = params.fill.w > 0.0 && params.fill.w < 1.0 && params.fill.z != 1.0;
@@ -420,4 +442,142 @@ fn radiance(in: VertexOutput) -> vec4<f32> {
         return vec4<f32>(colour(t, layer0, texel), 1.0);
     }
     return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+}
+
+// ---- The runtime sun (pack 3; plenoptic_recon's sun and brdf modules, the same formulas) ----
+
+const PI: f32 = 3.14159265358979;
+
+fn fresnel_dielectric(cos_in: f32, eta: f32) -> f32 {
+    let cos_i = clamp(cos_in, 0.0, 1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (r_par * r_par + r_perp * r_perp);
+}
+
+fn fresnel_schlick(f0: vec3<f32>, cos: f32) -> vec3<f32> {
+    let m = pow(1.0 - clamp(cos, 0.0, 1.0), 5.0);
+    return f0 + (vec3<f32>(1.0) - f0) * m;
+}
+
+fn ggx_d(alpha: f32, cos_h: f32) -> f32 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+fn smith_g1(alpha: f32, cos: f32) -> f32 {
+    let c = abs(cos);
+    let a2 = alpha * alpha;
+    return 2.0 * c / (c + sqrt(a2 + (1.0 - a2) * c * c));
+}
+
+// The BSDF for light from `wi` seen along `wo`, with shading normal `n` and geometric normal
+// `ng` (both on wo's side), relative IOR `eta`; the fragment's material.
+fn sun_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32) -> vec3<f32> {
+    let cos_i = dot(wi, n);
+    let reflect = cos_i > 0.0;
+    if reflect != (dot(wi, ng) > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let cos_o = dot(wo, n);
+    let m = pixel_metallic;
+    let tr = params.material.x;
+    let alpha = max(pixel_roughness * pixel_roughness, 1e-4);
+    let delta = pixel_roughness < 0.02;
+    if reflect {
+        let h = normalize(wo + wi);
+        let voh = clamp(dot(wo, h), 0.0, 1.0);
+        let fd = fresnel_dielectric(voh, eta);
+        var f = pixel_base * ((1.0 - m) * (1.0 - tr) * (1.0 - fd) / PI);
+        if !delta {
+            let d = ggx_d(alpha, dot(h, n));
+            let g = smith_g1(alpha, cos_o) * smith_g1(alpha, cos_i);
+            let fr = vec3<f32>((1.0 - m) * fd) + fresnel_schlick(pixel_base, voh) * m;
+            f += fr * (d * g / max(4.0 * cos_o * cos_i, 1e-8));
+        }
+        return f;
+    }
+    if delta || tr <= 0.0 || m >= 1.0 {
+        return vec3<f32>(0.0);
+    }
+    var h = normalize(wo + wi * eta);
+    if dot(h, n) < 0.0 {
+        h = -h;
+    }
+    let woh = dot(wo, h);
+    let wih = dot(wi, h);
+    if woh * wih >= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let denom = (wih + woh / eta) * (wih + woh / eta);
+    let fd = fresnel_dielectric(abs(woh), eta);
+    let d = ggx_d(alpha, dot(h, n));
+    let g = smith_g1(alpha, cos_o) * smith_g1(alpha, cos_i);
+    let ft = d * (1.0 - fd) * g * abs(wih * woh / (cos_i * cos_o * denom)) / (eta * eta);
+    return pixel_base * ((1.0 - m) * tr * ft);
+}
+
+// The sun's direct light towards the eye: BSDF × illuminance × cosine × the shadow of the
+// plugin's sun light (Bevy's cascaded shadow map of the proxies). `ng_raw`: the triangle's
+// plane from the position's derivatives.
+fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
+    let p = in.world_position.xyz;
+    let wo = normalize(view.world_position - p);
+    var ns = normalize(in.world_normal);
+    var ng = ns;
+    if dot(ng_raw, ng_raw) > 1e-20 {
+        ng = normalize(ng_raw);
+        // The winding's side: the vertex normals follow it.
+        if dot(ng, ns) < 0.0 {
+            ng = -ng;
+        }
+    }
+    let front = dot(wo, ng) > 0.0;
+    let side = select(-1.0, 1.0, dot(wo, ng) >= 0.0);
+    ng = ng * side;
+    var n = ns * side;
+    if dot(n, wo) < 1e-4 {
+        n = n - wo * (dot(n, wo) - 1e-4);
+        n = select(ng, normalize(n), dot(n, n) > 0.0);
+    }
+    let ior = select(1.5, params.surface.y, params.surface.y > 0.0);
+    let eta = select(1.0 / ior, ior, front);
+    // Surfaces whose every lobe is ideal take no light sample (as the tracer).
+    let fd = fresnel_dielectric(clamp(dot(wo, n), 1e-4, 1.0), eta);
+    let lum = dot(pixel_base, vec3<f32>(0.2126, 0.7152, 0.0722));
+    let diffuse = (1.0 - pixel_metallic) * (1.0 - params.material.x) * (1.0 - fd) * max(lum, 0.0) > 0.0;
+    if !diffuse && pixel_roughness < 0.02 {
+        return vec3<f32>(0.0);
+    }
+    let wi = normalize(params.sun.xyz);
+    let f = sun_bsdf(wi, wo, n, ng, eta);
+    if all(f == vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    // The plugin's sun light: the directional light aimed along the same direction.
+    var shadow = 1.0;
+    for (var i = 0u; i < lights.n_directional_lights; i++) {
+        let l = &lights.directional_lights[i];
+        if dot((*l).direction_to_light, wi) > 0.99999 {
+            let view_z = dot(vec4<f32>(
+                view.view_from_world[0].z,
+                view.view_from_world[1].z,
+                view.view_from_world[2].z,
+                view.view_from_world[3].z
+            ), in.world_position);
+            let towards = select(-ng, ng, dot(wi, ng) >= 0.0);
+            shadow = fetch_directional_shadow(i, in.world_position, towards, view_z, in.position.xy);
+            break;
+        }
+    }
+    return f * params.sun_illuminance.xyz * abs(dot(wi, n)) * shadow;
 }

@@ -36,6 +36,11 @@
 //! a full-screen triangle behind all geometry), as on the CPU. The
 //! background is drawn by every camera of the app: give other cameras other `RenderLayers`.
 //!
+//! On a pack 3 whose lighting leaves the sun to the runtime, lit objects add the sun's direct
+//! light per fragment through their BSDF, shadowed by Bevy's shadow map of a directional
+//! light the plugin keeps aimed along the pack's sun ([`sun`]). Proxies are drawn with both
+//! faces in every pass (the CPU's raster and shadow rays see both).
+//!
 //! Resident keys live in one `Rgba32Uint` 2D-array texture per pack: texel = (radiance as
 //! RGB9E5, distance as f32 bits, object id, oct-encoded RG16Snorm normal), six layers per
 //! streaming slot: the pack's own texel bytes interleaved, one binding and `textureLoad` only
@@ -44,6 +49,7 @@
 pub mod background;
 pub mod cpu;
 pub mod image;
+pub mod sun;
 pub mod upload;
 pub mod volume;
 pub mod volume_mode;
@@ -95,6 +101,7 @@ impl Plugin for PlenopticReconstructPlugin {
                     background::spawn_backgrounds,
                     volume_mode::prepare_cubes,
                     image::prepare_job,
+                    sun::update_suns,
                     update_materials,
                 )
                     .chain()
@@ -201,6 +208,19 @@ impl Material for PlenopticMaterial {
             AlphaMode::Opaque
         }
     }
+
+    /// Both faces, in every pass: the CPU's raster and shadow rays see both, and a room's
+    /// proxies face inwards, so with back faces culled the runtime sun's shadow map would miss
+    /// a ceiling seen from above.
+    fn specialize(
+        _pipeline: &bevy::pbr::MaterialPipeline,
+        descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
+        _layout: &bevy::mesh::MeshVertexBufferLayoutRef,
+        _key: bevy::pbr::MaterialPipelineKey<Self>,
+    ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
+        descriptor.primitive.cull_mode = None;
+        Ok(())
+    }
 }
 
 /// The per-frame uniform of a [`PlenopticMaterial`].
@@ -230,6 +250,12 @@ pub struct ReconParams {
     pub mr_uv: Vec4,
     /// The rotations of the two transforms (x, y), radians.
     pub uv_rotation: Vec4,
+    /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]).
+    pub surface: Vec4,
+    /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
+    pub sun: Vec4,
+    /// The runtime sun's illuminance at the camera's time (xyz).
+    pub sun_illuminance: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -348,6 +374,12 @@ impl MaterialFactors {
             m.transmission.clamp(0.0, 1.0),
             self.sizes.0 as f32,
             self.sizes.1 as f32,
+            0.0,
+        );
+        params.surface = Vec4::new(
+            m.roughness.clamp(0.0, 1.0),
+            if m.ior > 0.0 { m.ior } else { 1.5 },
+            0.0,
             0.0,
         );
         let uv = |b: Option<plenoptic_pack::TextureBinding>| {
@@ -590,6 +622,7 @@ fn update_materials(
                 && cam.settings.shading == plenoptic_recon::Shading::Materials
             {
                 f.fill(&mut params);
+                sun::fill(&mut params, pack, cam.time);
             }
             mat.params = params;
         }

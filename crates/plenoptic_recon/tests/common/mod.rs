@@ -296,7 +296,7 @@ pub struct PackSpec {
     /// radiance, distance, id and normal, as a damaged pack might).
     pub lighting_chunks: bool,
     /// Whether the pack leaves the sun's direct light to the runtime (pack 3's
-    /// `direct_sun`, with [`moving_sun`] as the sun; a delta sun): the runtime adds it to the
+    /// `direct_sun`, with [`runtime_sun`] as the sun; a delta sun): the runtime adds it to the
     /// stored lighting with shadow rays. The stored texels are not changed, so this tests
     /// that both backends add the same light, not the physics.
     pub direct_sun: bool,
@@ -363,6 +363,24 @@ pub fn moving_sun() -> plenoptic_pack::plenoptic_sky::SunTrack {
             illuminance: Vec3::splat(100_000.0),
         },
     ])
+    .unwrap()
+}
+
+/// The sun of test packs with a runtime sun: [`moving_sun`]'s path at an illuminance of the
+/// analytic shading's scale (1 at t = 0 to 3 at t = 2), so that it neither vanishes beside
+/// the stored light nor leaves the f16 range of a GPU target.
+pub fn runtime_sun() -> plenoptic_pack::plenoptic_sky::SunTrack {
+    use plenoptic_pack::plenoptic_sky::{SunTrack, SunTrackSample};
+    let m = moving_sun();
+    SunTrack::new(
+        [(0.0, 1.0), (2.0, 3.0)]
+            .map(|(t, e)| SunTrackSample {
+                time: t,
+                direction: m.at(t).0,
+                illuminance: Vec3::splat(e),
+            })
+            .to_vec(),
+    )
     .unwrap()
 }
 
@@ -597,7 +615,7 @@ pub fn write_pack_with(
     let environment = match environment {
         None if spec.direct_sun => Some((
             plenoptic_pack::plenoptic_sky::Environment::None,
-            Some(moving_sun()),
+            Some(runtime_sun()),
         )),
         e => e,
     };

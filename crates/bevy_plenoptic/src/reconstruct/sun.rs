@@ -1,0 +1,114 @@
+//! The runtime sun on the GPU (pack 3; docs/architecture.md, "The runtime sun"): a pack whose
+//! lighting leaves the sun's direct light out ([`plenoptic_pack::DirectSun`]) gets it back
+//! per fragment, as `plenoptic_recon::sun` adds it on the CPU: the surface's BSDF for the
+//! sun's direction (`geometry.wgsl`, the same formulas) × the track's illuminance at the
+//! camera's time × the cosine × the visibility.
+//!
+//! The visibility comes from Bevy's own cascaded shadow map of a [`DirectionalLight`] the
+//! plugin spawns per such pack ([`PlenopticSun`]), aimed along the sun's track at the time of
+//! the pack's first camera, shadows on: the proxies cast shadows as any mesh does. That light
+//! also lights the app's own `StandardMaterial` meshes like the pack's sun. The CPU casts
+//! shadow rays against the proxies instead, so the two agree away from shadow edges and
+//! differ at them by the shadow map's resolution and filter.
+
+use bevy::light::CascadeShadowConfigBuilder;
+use bevy::prelude::*;
+
+use super::ReconParams;
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+
+/// The directional light the plugin keeps for the runtime sun of `pack`.
+#[derive(Component, Debug, Clone)]
+pub struct PlenopticSun {
+    /// The pack whose sun it is.
+    pub pack: AssetId<RadiancePack>,
+}
+
+/// The sun of `pack` at time `t`, when its lighting leaves the sun to the runtime: unit
+/// direction towards it and its illuminance.
+pub fn sun_at(pack: &RadiancePack, t: f32) -> Option<(Vec3, Vec3)> {
+    let (track, _) = pack.reader.direct_sun()?;
+    let (towards, illuminance) = track.at(t);
+    Some((towards.normalize_or(Vec3::Y), illuminance))
+}
+
+/// The uniform's sun fields for a fragment shown at time `t` from `pack`.
+pub(super) fn fill(params: &mut ReconParams, pack: &RadiancePack, t: f32) {
+    if let Some((towards, illuminance)) = sun_at(pack, t) {
+        params.sun = towards.extend(1.0);
+        params.sun_illuminance = illuminance.extend(0.0);
+    }
+}
+
+/// Spawns, aims and removes the [`PlenopticSun`] lights: one per pack with a runtime sun that
+/// a camera shows, at its first camera's time.
+pub(super) fn update_suns(
+    mut commands: Commands,
+    packs: Res<Assets<RadiancePack>>,
+    cameras: Query<&PlenopticCamera>,
+    mut suns: Query<(Entity, &PlenopticSun, &mut Transform, &mut DirectionalLight)>,
+) {
+    let mut wanted: Vec<(AssetId<RadiancePack>, Vec3, Vec3, f32)> = Vec::new();
+    for cam in &cameras {
+        let id = cam.pack.id();
+        if wanted.iter().any(|w| w.0 == id) {
+            continue;
+        }
+        let Some(pack) = packs.get(id) else { continue };
+        if let Some((towards, e)) = sun_at(pack, cam.time) {
+            let b = &pack.reader.manifest().scene_bounds;
+            wanted.push((id, towards, e, (b.max - b.min).length()));
+        }
+    }
+    let lux = |e: Vec3| 0.2126 * e.x + 0.7152 * e.y + 0.0722 * e.z;
+    // The illuminance's colour at unit luminance (the light's `illuminance` carries the lux).
+    let colour = |e: Vec3| {
+        let c = e / lux(e).max(1e-6);
+        Color::linear_rgb(c.x, c.y, c.z)
+    };
+    let aim = |towards: Vec3| {
+        let up = if towards.y.abs() > 0.99 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        Transform::default().looking_to(-towards, up)
+    };
+    for (entity, sun, mut transform, mut light) in &mut suns {
+        match wanted.iter().position(|w| w.0 == sun.pack) {
+            Some(i) => {
+                let (_, towards, e, _) = wanted.swap_remove(i);
+                *transform = aim(towards);
+                light.illuminance = lux(e);
+                light.color = colour(e);
+            }
+            None => commands.entity(entity).despawn(),
+        }
+    }
+    for (pack, towards, e, diagonal) in wanted {
+        commands.spawn((
+            Name::new("plenoptic sun"),
+            PlenopticSun { pack },
+            DirectionalLight {
+                illuminance: lux(e),
+                color: colour(e),
+                shadow_maps_enabled: true,
+                ..default()
+            },
+            aim(towards),
+            // The cascades cover the scene from any camera inside it (Bevy's defaults for a
+            // pack without bounds).
+            if diagonal > 0.0 {
+                CascadeShadowConfigBuilder {
+                    maximum_distance: diagonal,
+                    first_cascade_far_bound: diagonal / 8.0,
+                    ..default()
+                }
+                .build()
+            } else {
+                CascadeShadowConfigBuilder::default().build()
+            },
+        ));
+    }
+}
