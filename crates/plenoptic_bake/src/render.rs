@@ -101,7 +101,15 @@ impl<'a> BakeRenderer<'a> {
         );
         let n = self.plan.quality.range_image_size.max(1);
         let denoise = self.plan.quality.denoise.then(DenoiseSettings::default);
-        render_range_image(&renderer, &placed, view.position, n, denoise.as_ref())
+        let runtime_sun = self.plan.quality.runtime_sun;
+        render_range_image(
+            &renderer,
+            &placed,
+            view.position,
+            n,
+            denoise.as_ref(),
+            runtime_sun,
+        )
     }
 
     /// The ambient field at time `t`, interpolated once per distinct `t` and cached (volume
@@ -147,22 +155,40 @@ impl<'a> BakeRenderer<'a> {
         let seed = seed_of(&[self.plan.seed, 2, bv as u64]);
         let renderer = MultiStageRenderer::new(self.settings(seed, 1), &field);
         let mut sampler = Sampler::new(seed, stream, 0);
-        renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler)
+        let mut s = renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler);
+        if !self.plan.quality.runtime_sun {
+            bake_the_sun(&mut s);
+        }
+        s
     }
 }
 
+/// Keeps the sun's direct light in the stored lighting (`quality.runtime_sun` off): the
+/// split then leaves it where the renderer put it.
+fn bake_the_sun(s: &mut RadianceSample) {
+    s.sun = Vec3::ZERO;
+    s.sun_diffuse = Vec3::ZERO;
+}
+
 /// The range image of face size `n` seen from `position` with `renderer`, its diffuse
-/// lighting denoised with `denoise` when given ([`crate::denoise`]). Without denoising the
-/// result is exactly [`to_range_image`] of the rendered faces.
+/// lighting denoised with `denoise` when given ([`crate::denoise`]); the sun's direct light
+/// left out of the lighting and non-diffuse radiance for the runtime when `runtime_sun`.
+/// Without denoising the result is exactly [`to_range_image`] of the rendered faces.
 pub fn render_range_image(
     renderer: &MultiStageRenderer<'_>,
     placed: &PlacedScene<'_>,
     position: Vec3,
     n: u32,
     denoise: Option<&DenoiseSettings>,
+    runtime_sun: bool,
 ) -> Result<RangeImage> {
     let cube = CubeCamera::new(position, n)?;
-    let faces = renderer.render_cube(placed, &cube);
+    let mut faces = renderer.render_cube(placed, &cube);
+    if !runtime_sun {
+        for face in &mut faces {
+            face.pixels.iter_mut().for_each(bake_the_sun);
+        }
+    }
     Ok(match denoise {
         None => to_range_image(n, &faces),
         Some(settings) => {

@@ -377,7 +377,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
             .unwrap_or(0),
         extra,
     };
-    m.environment = environment_entry(plan.start, plan.end, scene);
+    m.environment = environment_entry(plan.start, plan.end, scene, plan.quality.runtime_sun);
     m
 }
 
@@ -387,14 +387,19 @@ pub const SUN_TRACK_SAMPLES: usize = 256;
 
 /// The scene's environment and sun track over `[start, end]` as the pack stores them: `None`
 /// when the scene has neither.
-fn environment_entry(start: f32, end: f32, scene: &Scene) -> Option<EnvironmentEntry> {
+fn environment_entry(
+    start: f32,
+    end: f32,
+    scene: &Scene,
+    runtime_sun: bool,
+) -> Option<EnvironmentEntry> {
     let sun = scene.sun_track(start, end, SUN_TRACK_SAMPLES);
-    // The bake leaves the sun's direct light to the runtime whenever there is a sun
+    // With `quality.runtime_sun` the bake leaves the sun's direct light to the runtime
     // (`RadianceSample::sun`, taken out of the lighting by the denoiser's split).
     let direct_sun = scene
         .sun
         .as_ref()
-        .filter(|_| sun.is_some())
+        .filter(|_| sun.is_some() && runtime_sun)
         .and_then(|s| scene.lights.get(s.light))
         .map(|l| DirectSun {
             angular_radius: l.angular_radius.clamp(0.0, DirectSun::MAX_ANGULAR_RADIUS),
@@ -552,7 +557,7 @@ mod environment_tests {
 
     #[test]
     fn the_manifest_carries_the_scenes_environment_and_sun_track() {
-        assert_eq!(environment_entry(0.0, 1.0, &Scene::default()), None);
+        assert_eq!(environment_entry(0.0, 1.0, &Scene::default(), true), None);
         let track = SunTrack::new(vec![
             SunTrackSample {
                 time: 0.0,
@@ -574,7 +579,7 @@ mod environment_tests {
             }),
             ..Scene::default()
         };
-        let entry = environment_entry(0.0, 1.0, &scene).unwrap();
+        let entry = environment_entry(0.0, 1.0, &scene, true).unwrap();
         assert_eq!(
             entry.source,
             EnvironmentSource::Sky {
@@ -586,7 +591,7 @@ mod environment_tests {
             environment: Environment::Uniform(glam::Vec3::ONE),
             ..Scene::default()
         };
-        let entry = environment_entry(0.0, 1.0, &uniform).unwrap();
+        let entry = environment_entry(0.0, 1.0, &uniform, true).unwrap();
         assert_eq!(entry.sun, None);
         assert!(matches!(entry.source, EnvironmentSource::Uniform { .. }));
     }

@@ -209,7 +209,9 @@ fn a_sun_study_adds_time_keys_where_the_sun_moves() {
     let dir = tempfile::tempdir().unwrap();
     bim_building(&dir.path().join("bim.glb"));
     let keys = |local: [f64; 2]| {
-        let (recipe, scene) = load_recipe(&recipe(dir.path(), local, "draft")).unwrap();
+        // The sun baked: its own light keys (a runtime sun's are the ambient field's).
+        let path = recipe_with(dir.path(), local, "draft", "runtime_sun = false");
+        let (recipe, scene) = load_recipe(&path).unwrap();
         let accel = SceneAccel::new(&scene).unwrap();
         let (plan, _) = decompose(&recipe, &scene, &accel);
         plan.light_keys
@@ -233,13 +235,50 @@ fn a_sun_study_adds_time_keys_where_the_sun_moves() {
     assert!(minute.len() <= 3, "{minute:?}");
 }
 
+/// With the sun left to the runtime (the default) the views' keys follow neither the sun's
+/// patches nor its light-id image, since its direct light is not stored, but the ambient
+/// field's key times: fewer range images for the same day.
+#[test]
+fn a_runtime_sun_needs_fewer_keys_than_a_baked_one() {
+    let dir = tempfile::tempdir().unwrap();
+    bim_building(&dir.path().join("bim.glb"));
+    let keys = |quality: &str| {
+        let path = recipe_with(dir.path(), [6.0, 21.5], "draft", quality);
+        let (recipe, scene) = load_recipe(&path).unwrap();
+        let accel = SceneAccel::new(&scene).unwrap();
+        let plan = plenoptic_bake::plan::build(&recipe, &scene, &accel)
+            .unwrap()
+            .plan;
+        if recipe.quality.runtime_sun {
+            assert!(
+                plan.base_views
+                    .iter()
+                    .all(|v| plan.ambient_keys.iter().all(|k| v.time_keys.contains(k)))
+            );
+        }
+        plan.base_views
+            .iter()
+            .map(|v| v.time_keys.len())
+            .sum::<usize>()
+    };
+    let (runtime, baked) = (keys(""), keys("runtime_sun = false"));
+    println!("range images: runtime sun {runtime}, baked sun {baked}");
+    assert!(runtime < baked, "{runtime} vs {baked}");
+}
+
 #[test]
 fn a_day_long_sun_study_gets_more_keys_where_the_sun_patches_move_fast() {
     let dir = tempfile::tempdir().unwrap();
     bim_building(&dir.path().join("bim.glb"));
     // 6:00 to 21:30 in Paris on 21 June over 14 s, on a lattice fine enough (2^7 steps) that
-    // the keys do not saturate it.
-    let path = recipe_with(dir.path(), [6.0, 21.5], "draft", "max_time_depth = 7");
+    // the keys do not saturate it; the sun baked into the lighting, whose patches the views'
+    // keys then follow.
+    let path = recipe_with(
+        dir.path(),
+        [6.0, 21.5],
+        "draft",
+        "max_time_depth = 7\nruntime_sun = false",
+    );
     let (recipe, scene) = load_recipe(&path).unwrap();
     let accel = SceneAccel::new(&scene).unwrap();
     let (plan, _) = decompose(&recipe, &scene, &accel);

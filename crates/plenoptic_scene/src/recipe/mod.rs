@@ -158,6 +158,8 @@ pub struct QualityToml {
     pub reference_samples_per_pixel: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub denoise: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runtime_sun: Option<bool>,
 }
 
 /// A validated recipe.
@@ -515,7 +517,8 @@ impl QualityToml {
             temporal_volume_samples,
             max_specular_depth,
             reference_samples_per_pixel,
-            denoise
+            denoise,
+            runtime_sun
         );
         check_quality(&q, err)?;
         Ok(q)

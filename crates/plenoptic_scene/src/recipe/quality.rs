@@ -50,6 +50,13 @@ impl Preset {
 /// Whether the presets denoise the range images (see [`Quality::denoise`]).
 pub const DENOISE_DEFAULT: bool = false;
 
+/// Whether the presets leave the sun to the runtime (see [`Quality::runtime_sun`]).
+pub const RUNTIME_SUN_DEFAULT: bool = true;
+
+fn runtime_sun_default() -> bool {
+    RUNTIME_SUN_DEFAULT
+}
+
 /// Bake quality settings (docs/architecture.md "Baking"; thesis ch. 5–7). Start from a preset and
 /// override single fields; every field states its cost.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -95,6 +102,13 @@ pub struct Quality {
     /// image; removes most of the pixel noise of few samples per pixel.
     #[serde(default)]
     pub denoise: bool,
+    /// Leave the sun's direct light out of the stored lighting for the runtime to evaluate at
+    /// screen resolution (pack 3's `direct_sun`; docs/architecture.md, "The runtime sun").
+    /// The time decomposition then ignores where the sun falls, which only direct light
+    /// shows: fewer time keys for a moving sun. Off: the sun is baked into the lighting (cube
+    /// resolution) and each view follows its sun patches with keys of its own.
+    #[serde(default = "runtime_sun_default")]
+    pub runtime_sun: bool,
 }
 
 impl Quality {
@@ -113,6 +127,7 @@ impl Quality {
             max_specular_depth: 2,
             reference_samples_per_pixel: 64,
             denoise: DENOISE_DEFAULT,
+            runtime_sun: RUNTIME_SUN_DEFAULT,
         }
     }
 
@@ -131,6 +146,7 @@ impl Quality {
             max_specular_depth: 4,
             reference_samples_per_pixel: 256,
             denoise: DENOISE_DEFAULT,
+            runtime_sun: RUNTIME_SUN_DEFAULT,
         }
     }
 
@@ -149,6 +165,7 @@ impl Quality {
             max_specular_depth: 6,
             reference_samples_per_pixel: 1024,
             denoise: DENOISE_DEFAULT,
+            runtime_sun: RUNTIME_SUN_DEFAULT,
         }
     }
 
@@ -167,6 +184,7 @@ impl Quality {
             max_specular_depth: 8,
             reference_samples_per_pixel: 4096,
             denoise: DENOISE_DEFAULT,
+            runtime_sun: RUNTIME_SUN_DEFAULT,
         }
     }
 }
