@@ -235,9 +235,9 @@ fn a_sun_study_adds_time_keys_where_the_sun_moves() {
     assert!(minute.len() <= 3, "{minute:?}");
 }
 
-/// With the sun left to the runtime (the default) the views' keys follow neither the sun's
-/// patches nor its light-id image, since its direct light is not stored, but the ambient
-/// field's key times: fewer range images for the same day.
+/// With the sun left to the runtime (the default) the views' keys do not follow the sun's
+/// patches, whose direct light is not stored; the light keys (what the sun and the sky see,
+/// which drives the indirect light) stay: fewer range images for the same day.
 #[test]
 fn a_runtime_sun_needs_fewer_keys_than_a_baked_one() {
     let dir = tempfile::tempdir().unwrap();
@@ -263,7 +263,7 @@ fn a_runtime_sun_needs_fewer_keys_than_a_baked_one() {
     };
     let (runtime, baked) = (keys(""), keys("runtime_sun = false"));
     println!("range images: runtime sun {runtime}, baked sun {baked}");
-    assert!(runtime < baked, "{runtime} vs {baked}");
+    assert!(2 * runtime < baked, "{runtime} vs {baked}");
 }
 
 #[test]

@@ -53,32 +53,26 @@ pub const EMISSIVE_PROBES: usize = 4;
 
 /// The id-images "from every light" at one time: a cube at each point and spot light, an
 /// orthographic image along each directional light over the sphere (`centre`, `radius`), and a
-/// cube just in front of up to [`EMISSIVE_PROBES`] evenly spread emissive triangles. With
-/// `runtime_sun` the scene's sun and a sky that follows it are left out: the sun's direct
-/// light is the runtime's, and the indirect light of both (the ambient field) changes where
-/// the field's own key times say ([`super::ambient_phase`] adds them to every view).
+/// cube just in front of up to [`EMISSIVE_PROBES`] evenly spread emissive triangles. A
+/// runtime sun keeps its image: its direct light is not stored, but the indirect light it
+/// gives changes as what it sees does.
 pub fn light_ids(
     placed: &PlacedScene<'_>,
     centre: Vec3,
     radius: f32,
     size: u32,
-    runtime_sun: bool,
 ) -> Vec<Vec<ObjectId>> {
     let scene = placed.scene();
     let t = placed.time();
-    let sun = scene.sun.as_ref().map(|s| s.light).filter(|_| runtime_sun);
     let mut out = Vec::new();
     for (i, light) in scene.lights.iter().enumerate() {
-        if sun == Some(i) {
-            continue;
-        }
         let p = scene.placed_light(i, t);
         out.push(match light.kind {
             LightKind::Point | LightKind::Spot { .. } => cube_ids(placed, p.position, size),
             LightKind::Directional => ortho_ids(placed, p.direction, centre, radius, size),
         });
     }
-    if scene.environment_is_animated() && sun.is_none() {
+    if scene.environment_is_animated() {
         // A sky that changes (it follows a moving sun) is a light too: its id-image looks
         // along the direction its light arrives from on average.
         let towards = sky_direction(placed);

@@ -265,15 +265,7 @@ pub fn decompose(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> 
         let tt = |k| time::key_time(start, end, time_lattice, k);
         let (lk, tested, lv) = time::subdivide(
             &[0, time_lattice],
-            |k| {
-                ids::light_ids(
-                    &accel.at_time(tt(k)),
-                    centre,
-                    radius,
-                    id_size,
-                    q.runtime_sun,
-                )
-            },
+            |k| ids::light_ids(&accel.at_time(tt(k)), centre, radius, id_size),
             |a, b| ids::min_fitness(a, b) >= f64::from(q.q),
         );
         rays += lv.values().flatten().map(|v| v.len() as u64).sum::<u64>();
@@ -400,16 +392,5 @@ pub fn ambient_phase(
     )?;
     plan.ambient_keys = keys.times;
     plan.counters.ambient_intervals_tested = keys.tested;
-    // A runtime sun's light keys were left out of the decomposition ([`ids::light_ids`]):
-    // its indirect light changes where the field does, so every view gets the field's keys.
-    if plan.quality.runtime_sun && scene.sun_is_animated() {
-        for keys in std::iter::once(&mut plan.light_keys)
-            .chain(plan.base_views.iter_mut().map(|v| &mut v.time_keys))
-        {
-            keys.extend(plan.ambient_keys.iter().copied());
-            keys.sort_by(f32::total_cmp);
-            keys.dedup();
-        }
-    }
     Ok(keys.fields)
 }

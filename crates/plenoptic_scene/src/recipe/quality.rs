@@ -104,9 +104,10 @@ pub struct Quality {
     pub denoise: bool,
     /// Leave the sun's direct light out of the stored lighting for the runtime to evaluate at
     /// screen resolution (pack 3's `direct_sun`; docs/architecture.md, "The runtime sun").
-    /// The time decomposition then ignores where the sun falls, which only direct light
-    /// shows: fewer time keys for a moving sun. Off: the sun is baked into the lighting (cube
-    /// resolution) and each view follows its sun patches with keys of its own.
+    /// The time decomposition then ignores where the sun falls in each view, which only
+    /// direct light shows (what the sun sees still sets the light keys: the indirect light
+    /// follows it): fewer time keys for a moving sun. Off: the sun is baked into the lighting
+    /// (cube resolution) and each view follows its sun patches with keys of its own.
     #[serde(default = "runtime_sun_default")]
     pub runtime_sun: bool,
 }
