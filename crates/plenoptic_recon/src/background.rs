@@ -4,8 +4,10 @@
 //! camera's time, evaluated per pixel (not read from a cube texel), in every mode.
 //!
 //! The sun's direction at t comes from the pack's sun track; a sky without one has the sun at
-//! the zenith. Packs without an environment keep what the modes put there (the heaviest
-//! key's cube in the pixel's direction, or the background fill).
+//! the zenith. A pack whose manifest says its environment is none (rays that leave the
+//! scene see nothing, as the tracer renders them) shows black there. Packs that do not say
+//! (no environment entry, before 1.1) keep what the modes put there (the heaviest key's cube
+//! in the pixel's direction, or the background fill).
 
 use glam::Vec3;
 use plenoptic_pack::PackReader;
@@ -28,7 +30,17 @@ impl PackEnvironment {
     /// environment is then none.
     pub fn from_pack(pack: &PackReader) -> (Self, Option<String>) {
         let sun = pack.sun_track().cloned();
+        let declared = pack.manifest().environment.is_some();
         match pack.environment() {
+            // Declared as none: black, what the scene showed the bake (not a key's texels,
+            // which a base view elsewhere saw in that direction).
+            Ok(Environment::None) if declared => (
+                Self {
+                    environment: Environment::Uniform(Vec3::ZERO),
+                    sun,
+                },
+                None,
+            ),
             Ok(environment) => (Self { environment, sun }, None),
             Err(e) => (
                 Self {

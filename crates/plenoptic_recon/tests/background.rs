@@ -144,3 +144,30 @@ fn a_uniform_environment_fills_the_opening_and_a_pack_without_one_keeps_the_cube
         }
     }
 }
+
+/// A pack that declares its environment as none (rays that leave the scene see nothing, as the
+/// tracer rendered them: a scene with a sun but no sky) shows black where no proxy is; one
+/// that declares nothing keeps the modes' fallback (the heaviest key's texels).
+#[test]
+fn an_environment_declared_none_is_black_and_an_undeclared_one_falls_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = PackSpec::segment(1, vec![0.0], 16);
+    let declared = dir.path().join("declared.pack");
+    write_pack_with(
+        &open_room(),
+        &spec,
+        &declared,
+        Some((Environment::None, Some(track()))),
+    );
+    let rec = Reconstructor::open(&declared).unwrap();
+    assert!(!rec.environment().is_none());
+    assert_eq!(rec.environment().at(0.0).radiance(Vec3::Y), Vec3::ZERO);
+    let undeclared = dir.path().join("undeclared.pack");
+    write_pack_with(&open_room(), &spec, &undeclared, None);
+    assert!(
+        Reconstructor::open(&undeclared)
+            .unwrap()
+            .environment()
+            .is_none()
+    );
+}
