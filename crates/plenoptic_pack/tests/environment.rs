@@ -253,7 +253,7 @@ fn environment_error(path: &std::path::Path) -> String {
 fn a_runtime_sun_round_trips_and_needs_its_track() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("direct.pack");
-    let mut w = PackWriter::create(&path).unwrap();
+    let w = PackWriter::create(&path).unwrap();
     let mut m = manifest(1);
     let mut entry = EnvironmentEntry::new(&Environment::None, Some(track()));
     entry.direct_sun = Some(DirectSun {

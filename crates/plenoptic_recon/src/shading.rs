@@ -241,7 +241,7 @@ fn surface_image(
             };
             let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
                 let to_world = xf.matrix3.inverse().transpose();
-                tri.map(|i| Vec3::from(to_world * mesh.normals[i as usize]))
+                tri.map(|i| to_world * mesh.normals[i as usize])
             });
             let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
             if xf.matrix3.determinant() < 0.0 {
