@@ -55,11 +55,20 @@ fn two_tour_frames_from_a_small_bake_agree_with_the_path_tracer() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("tour_small_bake");
     std::fs::create_dir_all(&out).unwrap();
     let mut failures = Vec::new();
-    // Per frame: where on the path, and the bound on the corrected error. Measured when the
-    // test was written (dev profile): 1.82 and 3.73, mean luminance 1.03 and 1.02. The errors
-    // are high because the bake is tiny (16-px cubes 11 m apart, 2 samples, the sun's patches
-    // interpolated between keys seconds apart); the bounds leave a third on top.
-    for (k, (s, bound)) in [(0.3f32, 2.5), (0.75, 5.0)].into_iter().enumerate() {
+    // Per frame: where on the path, and the bounds on the corrected error and on the
+    // mean-luminance ratio. Measured with pack 3.0 (dev profile): 1.64 and 5.14, mean
+    // luminance 1.05 and 1.32 (pack 2.0: 1.82 and 3.73, 1.03 and 1.02). The errors are high
+    // because the bake is tiny (16-px cubes 11 m apart, 2 samples). Frame 1 looks up at the
+    // skylight's steel frame, whose bars are a pixel or two wide here and, with the sun's
+    // highlight evaluated per pixel (pack 3.0), bright: its pixels carry 87 % of the frame's
+    // excess luminance (2.25 against 0.94 per pixel). The reconstruction takes one sample
+    // per pixel, so a pixel the bar half covers shows all of the highlight where the
+    // antialiased reference shows half; at 128 × 72 the excess halves (1.16). The bounds
+    // leave a third on top.
+    for (k, (s, bound, mean_tolerance)) in [(0.3f32, 2.5, 0.12), (0.75, 7.0, 0.45)]
+        .into_iter()
+        .enumerate()
+    {
         let mut sample = path.sample(t0 + (t1 - t0) * s);
         sample.camera.width = 64;
         sample.camera.height = 36;
@@ -96,7 +105,7 @@ fn two_tour_frames_from_a_small_bake_agree_with_the_path_tracer() {
              luminance {:.3}; {:?}",
             sample.scene_time, c.corrected, c.noise_floor, c.mean_ratio, report.fallback
         );
-        if c.corrected > bound || (c.mean_ratio - 1.0).abs() > 0.12 {
+        if c.corrected > bound || (c.mean_ratio - 1.0).abs() > mean_tolerance {
             failures.push((k, c.corrected, c.mean_ratio));
         }
     }
