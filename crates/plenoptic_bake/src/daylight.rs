@@ -82,9 +82,7 @@ pub fn apply(scene: &mut Scene, recipe: &BakeRecipe) -> Result<()> {
 
 /// The directional light with the largest luminous illuminance, if any.
 fn brightest_directional(scene: &Scene) -> Option<usize> {
-    let lux = |l: &plenoptic_scene::Light| {
-        l.intensity * (0.2126 * l.color.x + 0.7152 * l.color.y + 0.0722 * l.color.z)
-    };
+    let lux = |l: &plenoptic_scene::Light| l.intensity * plenoptic_trace::image::luminance(l.color);
     scene
         .lights
         .iter()

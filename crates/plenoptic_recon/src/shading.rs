@@ -140,12 +140,12 @@ pub(crate) fn render(
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
     let start = std::time::Instant::now();
-    let (surface, raster_ms) = surface_image(rec, materials, camera, t, layer);
-    timed("albedo", start);
-    let start = std::time::Instant::now();
     let sun = rec
         .runtime_sun()
         .map(|s| s.at(proxy, t, rec.settings.sun_shadow_rays));
+    let (surface, raster_ms) = surface_image(rec, materials, camera, t, layer, sun.is_some());
+    timed("albedo", start);
+    let start = std::time::Instant::now();
     frame
         .radiance
         .par_iter_mut()
@@ -204,13 +204,15 @@ struct SurfacePixel {
 }
 
 /// Per pixel, the surface of an object with a material seen there (`None` where there is
-/// none); and the milliseconds its raster pass took.
+/// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it); and
+/// the milliseconds its raster pass took.
 fn surface_image(
     rec: &Reconstructor,
     materials: &Materials,
     camera: &Camera,
     t: f32,
     layer: Layer<'_>,
+    with_footprint: bool,
 ) -> (Vec<Option<SurfacePixel>>, f64) {
     let n = camera.pixel_count();
     let Some(proxy) = rec.proxy() else {
@@ -310,10 +312,14 @@ fn surface_image(
                 };
                 (basis.position + d * s - position).clamp_length_max(limit)
             };
-            let footprint = (
-                step(basis.direction(x + 1.0, y)),
-                step(basis.direction(x, y + 1.0)),
-            );
+            let footprint = if with_footprint {
+                (
+                    step(basis.direction(x + 1.0, y)),
+                    step(basis.direction(x, y + 1.0)),
+                )
+            } else {
+                (Vec3::ZERO, Vec3::ZERO)
+            };
             Some(SurfacePixel {
                 object: t.object,
                 material: materials.surface(rec.pack(), &t.material.material, uv, uv_footprint),
