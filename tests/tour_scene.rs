@@ -242,3 +242,35 @@ fn recipe_and_camera_path_fit_the_scene() {
         }
     }
 }
+
+#[test]
+fn the_recipe_lights_the_tour_with_a_sun_study_and_a_sky() {
+    let (recipe, scene) = plenoptic_bake::input::load_recipe(&assets().join("tour.toml"))
+        .expect("tour.toml and tour.glb load");
+    let sun = scene.sun.as_ref().expect("the recipe has a sun study");
+    assert!(sun.track.is_some(), "the sun follows the study's track");
+    assert_eq!(
+        scene.lights[sun.light].name,
+        scene::SUN,
+        "it drives the glb's own sun"
+    );
+    assert!(
+        matches!(scene.environment, plenoptic_scene::Environment::Sky(_)),
+        "the windows show a Hosek–Wilkie sky"
+    );
+    for t in [recipe.time.start, 7.0, recipe.time.end] {
+        let d = scene.placed_light(sun.light, t).direction;
+        // Above the horizon, and from the south (+z) all day, so that it shines in through
+        // the south windows.
+        assert!(d.y < -0.05 && d.z < 0.0, "sun direction {d} at {t}");
+    }
+    // The east window's pane is glazing as exporters write it.
+    let pane = scene
+        .objects
+        .iter()
+        .position(|o| o.name == "RoomB_Window_East_Pane")
+        .expect("the east window has a pane");
+    let material = &scene.materials[scene.objects[pane].material];
+    assert_eq!(material.alpha_mode, plenoptic_scene::AlphaMode::Blend);
+    assert!((material.base_color.w - 0.12).abs() < 1e-3);
+}

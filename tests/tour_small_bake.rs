@@ -19,7 +19,16 @@ fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/architectural_tour/assets")
 }
 
-/// A tiny bake of the tour: 3 × 3 base views over the rooms, 16-px cubes, 2 samples per
+/// The tour recipe's daylight: its `[sun]` and `[sky]` tables, which end the file.
+fn daylight() -> String {
+    let recipe = std::fs::read_to_string(assets().join("tour.toml")).unwrap();
+    let at = recipe.find("\n[sun]").expect("tour.toml has a sun study");
+    let tables = recipe[at..].to_owned();
+    assert!(tables.contains("\n[sky]"), "tour.toml has a sky");
+    tables
+}
+
+/// A tiny bake of the tour (with the recipe's daylight): 3 × 3 base views over the rooms, 16-px cubes, 2 samples per
 /// texel, a coarse time lattice.
 fn bake(dir: &Path) -> PathBuf {
     let glb = assets().join("tour.glb");
@@ -28,8 +37,9 @@ fn bake(dir: &Path) -> PathBuf {
          \"rectangle\"\nmin = [-11.0, -5.0]\nmax = [11.0, 5.0]\ny = 1.6\n\n[time]\nstart = 0.0\n\
          end = 14.0\nframe_rate = 24.0\n\n[quality]\npreset = \"draft\"\nid_image_size = 16\n\
          range_image_size = 16\nsamples_per_pixel = 2\nambient_samples = 32\n\
-         temporal_volume_samples = 2000\nmax_space_depth = 1\nmax_time_depth = 1\n",
-        glb.display()
+         temporal_volume_samples = 2000\nmax_space_depth = 1\nmax_time_depth = 1\n\n{}",
+        glb.display(),
+        daylight()
     );
     let path = dir.join("tour.toml");
     std::fs::write(&path, recipe).unwrap();

@@ -60,7 +60,9 @@
 //! - `--results DIR`: instead of the tour, the README's results (`results.rs`): path-traced
 //!   reference frames (`--spp N`, default 128) at `--frames` (default 8) frames spread over
 //!   the tour, each mode's reconstruction of them, errors, plot, montage and figures, at
-//!   `--width`/`--height` (default 320 × 180).
+//!   `--width`/`--height` (default 320 × 180); and a crop at full resolution of frame
+//!   `--crop-frame K` (default [`CROP_FRAME`]) against a reference of `--crop-spp N`
+//!   (default 256) samples per pixel and half.
 
 mod results;
 #[allow(dead_code, reason = "some items are for tests/tour_scene.rs")]
@@ -101,14 +103,19 @@ struct Options {
     plan: bool,
     results: Option<PathBuf>,
     spp: u32,
+    crop_frame: Option<usize>,
+    crop_spp: u32,
     screenshot: Option<PathBuf>,
     screenshot_at: f32,
     streaming: bool,
 }
 
+/// The frame of `--results` whose centre the full-resolution crop shows.
+const CROP_FRAME: usize = 4;
+
 const USAGE: &str = "usage: architectural_tour [--headless] [--cpu] [--frames N] [--width W] \
                      [--height H] [--out DIR] [--pack FILE] [--recipe FILE] [--mode geometry|image|volume] \
-                     [--plan] [--streaming] [--quiet] [--results DIR [--spp N]] [--screenshot FILE [--screenshot-at S]]";
+                     [--plan] [--streaming] [--quiet] [--results DIR [--spp N] [--crop-frame K] [--crop-spp N]] [--screenshot FILE [--screenshot-at S]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -125,6 +132,8 @@ fn parse_args() -> Result<Options, String> {
         plan: false,
         results: None,
         spp: 128,
+        crop_frame: None,
+        crop_spp: 256,
         screenshot: None,
         screenshot_at: 4.0,
         streaming: false,
@@ -152,6 +161,14 @@ fn parse_args() -> Result<Options, String> {
             "--recipe" => o.recipe = Some(value("--recipe")?.into()),
             "--results" => o.results = Some(value("--results")?.into()),
             "--spp" => o.spp = number("--spp", value("--spp")?)?,
+            "--crop-frame" => {
+                let v = value("--crop-frame")?;
+                o.crop_frame = Some(
+                    v.parse()
+                        .map_err(|_| format!("--crop-frame: `{v}` is not a frame number"))?,
+                );
+            }
+            "--crop-spp" => o.crop_spp = number("--crop-spp", value("--crop-spp")?)?,
             "--screenshot" => o.screenshot = Some(value("--screenshot")?.into()),
             "--screenshot-at" => {
                 let v = value("--screenshot-at")?;
@@ -292,6 +309,8 @@ fn run(options: &Options) -> Result<(), BoxError> {
                 spp: options.spp,
                 width: options.width.unwrap_or(320),
                 height: options.height.unwrap_or(180),
+                crop_frame: options.crop_frame.unwrap_or(CROP_FRAME),
+                crop_spp: options.crop_spp,
                 progress: !options.quiet,
             },
         );

@@ -11,7 +11,7 @@
 //!   a flight of stairs against the north wall, benches, a tall south window, and a sculpture
 //!   that revolves on its pedestal.
 //! - **Room B** (x ∈ [4, 12], 3.2 m high): a gallery with two south windows and one east
-//!   window, a glass vitrine on a plinth, shelves, a table, a lamp, a cart that crosses the
+//!   window glazed with a BLEND pane (as exporters write glass), a glass vitrine on a plinth, shelves, a table, a lamp, a cart that crosses the
 //!   room and comes back along a cubic spline, and a sliding door between it and the atrium.
 //!
 //! Room A opens to the atrium through a wide doorway at x = −4; room B through a doorway at
@@ -19,7 +19,10 @@
 //!
 //! The sun is a directional light whose rotation is animated over the whole tour
 //! ([`DURATION`] seconds): it climbs from the south-east and sets towards the south-west, so
-//! the patches of sunlight from the windows and the skylight travel across the floors.
+//! the patches of sunlight from the windows and the skylight travel across the floors. The
+//! bake recipe (`assets/tour.toml`) replaces that animation with a sun study (`[sun]`: a day
+//! in Paris) and a Hosek–Wilkie sky that the windows show; the glb's own animation is what an
+//! app that loads the glb without the recipe sees.
 //!
 //! Materials are textured in code ([`textures`]): oak planks in room A, tiles in the
 //! atrium, stone slabs in room B and on the stairs, plaster on the walls, brick on the
@@ -35,11 +38,11 @@ mod textures;
 
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Quat, Vec2, Vec3, Vec4};
 use plenoptic_scene::builder::{
     LightDesc, MaterialDesc, MaterialHandle, NodeDesc, NodeHandle, SceneBuilder, shapes,
 };
-use plenoptic_scene::{Mesh, Track, Trs};
+use plenoptic_scene::{AlphaMode, Mesh, Track, Trs};
 
 /// Length of the animation, seconds.
 pub const DURATION: f32 = 14.0;
@@ -335,6 +338,13 @@ pub fn build() -> SceneBuilder {
             .transmission(1.0, 1.5)
             .named("glass"),
     );
+    let glazing = b.add_material(
+        MaterialDesc::diffuse(Vec3::splat(0.9))
+            .base_color_alpha(Vec4::new(0.9, 0.95, 0.95, 0.12))
+            .alpha_mode(AlphaMode::Blend)
+            .double_sided(true)
+            .named("glazing"),
+    );
     let brass =
         b.add_material(MaterialDesc::metal(Vec3::new(0.90, 0.70, 0.35), 0.25).named("brass"));
     let red = b.add_material(MaterialDesc::diffuse(Vec3::new(0.75, 0.12, 0.10)).named("red_paint"));
@@ -539,6 +549,12 @@ pub fn build() -> SceneBuilder {
         c.cuboid(Vec3::new(11.85, 0.95, -1.5), Vec3::new(12.2, 1.0, 1.5));
         c.cuboid(Vec3::new(11.95, 1.0, -0.04), Vec3::new(12.05, 2.4, 0.04));
         object(&mut b, "RoomB_Window_East_Mullion", c.into_mesh(), walnut);
+        // The east window is glazed as CAD exporters write glass: one pane, 1 cm thick, of
+        // `alphaMode: BLEND` with alpha 0.12 (the see-through glazing of the daylight
+        // issue). The other openings stay open to the sky.
+        let mut c = Compound::default();
+        c.cuboid(Vec3::new(11.995, 1.0, -1.5), Vec3::new(12.005, 2.4, 1.5));
+        object(&mut b, "RoomB_Window_East_Pane", c.into_mesh(), glazing);
     }
 
     // --- Room A: mirror, table, benches, bookshelf, ceiling fan.

@@ -535,7 +535,8 @@ fn reference_render_and_compare_commands() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
         text.starts_with(
-            "frame,noise_floor,image_lrms_corrected,image_lrms,image_psnr,image_mean_ratio"
+            "frame,noise_floor,halves_ssim,image_lrms_corrected,image_lrms,image_psnr,\
+             image_mean_ratio,image_ssim"
         ),
         "{text}"
     );

@@ -1,6 +1,7 @@
 //! Image metrics: the thesis's relative LRMS and PSNR ([`plenoptic_trace::metrics`],
-//! re-exported), the mean-luminance ratio, and the relative LRMS corrected for the noise of
-//! a path-traced reference (docs/architecture.md, "Measuring against a noisy reference").
+//! re-exported), the mean-luminance ratio, SSIM of the displayed frames ([`ssim`]), and the
+//! relative LRMS corrected for the noise of a path-traced reference (docs/architecture.md,
+//! "Measuring against a noisy reference").
 //!
 //! # Variance correction
 //!
@@ -128,6 +129,63 @@ pub fn corrected_relative_lrms(
     }
 }
 
+/// The display exposure [`ssim`] uses by default: `0.5 / mean luminance of the reference`,
+/// the exposure of the tools' PNG frames (mid grey at half the mean).
+pub fn display_exposure(reference: &Image<Vec3>) -> f32 {
+    let mean = reference.mean_luminance();
+    if mean > 0.0 && mean.is_finite() {
+        (0.5 / mean) as f32
+    } else {
+        1.0
+    }
+}
+
+/// SSIM (Wang, Bovik, Sheikh and Simoncelli 2004) of `test` against `reference` as both are
+/// displayed: the luminance times `exposure`, clamped to [0, 1], sRGB-encoded and scaled to
+/// 0–255 (not rounded), compared with MATLAB's `ssim.m` (11 × 11 Gaussian window, σ = 1.5,
+/// K₁ = 0.01, K₂ = 0.03, L = 255) through the `blazediff-ssim` crate. SSIM is a structural
+/// measure of the picture people see, so it is taken on display values, not on radiance.
+///
+/// It is not corrected for the reference's noise: against a noisy reference a perfect
+/// image scores below 1. The SSIM of one reference half against the other shows how far.
+/// NaN when the sizes differ or the frames are smaller than the window.
+pub fn ssim(test: &Image<Vec3>, reference: &Image<Vec3>, exposure: f32) -> f64 {
+    if (test.width, test.height) != (reference.width, reference.height)
+        || test.pixels.len() != reference.pixels.len()
+    {
+        return f64::NAN;
+    }
+    let plane = |img: &Image<Vec3>| blazediff_ssim::Plane {
+        samples: img
+            .pixels
+            .iter()
+            .map(|&c| 255.0 * srgb_oetf(exposure * luminance(c)))
+            .collect(),
+        width: img.width as usize,
+        height: img.height as usize,
+    };
+    blazediff_ssim::ssim(
+        &plane(test),
+        &plane(reference),
+        &blazediff_ssim::SsimOptions::default(),
+    )
+    .map_or(f64::NAN, |o| o.score)
+}
+
+/// The sRGB transfer function of a linear value, clamped to [0, 1].
+fn srgb_oetf(v: f32) -> f32 {
+    let v = if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -206,6 +264,29 @@ mod tests {
         // the reference's share, leaving the test's own noise (σ = 0.3 over mean 1).
         let m = corrected_relative_lrms(&noisy(&s, 0.3, 5), &a, &b);
         assert!((m.corrected - 0.3).abs() < 0.015, "{m:?}");
+    }
+
+    #[test]
+    fn ssim_is_one_for_equal_frames_and_falls_with_noise_and_lost_structure() {
+        let s = signal();
+        let e = display_exposure(&s);
+        assert!((ssim(&s, &s, e) - 1.0).abs() < 1e-9);
+        let light = ssim(&noisy(&s, 0.02, 7), &s, e);
+        let heavy = ssim(&noisy(&s, 0.2, 8), &s, e);
+        assert!(light < 1.0 && heavy < light, "{light} {heavy}");
+        assert!(heavy < 0.5 && light > 0.5, "{light} {heavy}");
+        // Stripes 4 pixels wide and their mean: equal mean luminance, no structure left.
+        // (Wider than 1 pixel: like MATLAB, the crate low-passes and halves frames whose
+        // short side is above 384 before comparing.)
+        let stripes = Image::render(W, H, |x, _| {
+            Vec3::splat(if (x / 4) % 2 == 0 { 0.5 } else { 1.5 })
+        });
+        let flat = Image::render(W, H, |_, _| Vec3::ONE);
+        assert!(ssim(&flat, &stripes, display_exposure(&stripes)) < 0.2);
+        // Sizes that differ, or a frame smaller than the 11-pixel window.
+        let small = Image::render(8, 8, |_, _| Vec3::ONE);
+        assert!(ssim(&small, &s, e).is_nan());
+        assert!(ssim(&small, &small, 1.0).is_nan());
     }
 
     #[test]

@@ -8,8 +8,8 @@
 //!
 //! [`compare_with`] takes the reference as two independent halves (`plenoptic reference
 //! --halves` writes `DIR` and `DIR_b`) and reports the variance-corrected relative LRMS
-//! beside the uncorrected one, the reference's noise floor, PSNR and the mean-luminance ratio
-//! ([`crate::metrics`]).
+//! beside the uncorrected one, the reference's noise floor, PSNR, SSIM and the mean-luminance
+//! ratio ([`crate::metrics`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -21,7 +21,8 @@ use plenoptic_trace::Image;
 
 use crate::frame_io::{auto_exposure, read_exr, write_exr, write_png};
 use crate::metrics::{
-    CorrectedLrms, corrected_relative_lrms, mean_image, mean_luminance_ratio, psnr, relative_lrms,
+    CorrectedLrms, corrected_relative_lrms, display_exposure, mean_image, mean_luminance_ratio,
+    psnr, relative_lrms, ssim,
 };
 use crate::{EvalError, Result};
 
@@ -213,6 +214,9 @@ pub struct CandidateMetrics {
     pub psnr: Vec<f64>,
     /// Mean luminance of the candidate over the reference's, per frame.
     pub mean_ratio: Vec<f64>,
+    /// SSIM of the displayed frames per reference frame ([`ssim`], at the reference's
+    /// [`display_exposure`]).
+    pub ssim: Vec<f64>,
 }
 
 fn finite_mean(v: &[f64]) -> f64 {
@@ -244,6 +248,11 @@ impl CandidateMetrics {
     pub fn mean_ratio(&self) -> f64 {
         finite_mean(&self.mean_ratio)
     }
+
+    /// Mean SSIM over the frames present.
+    pub fn mean_ssim(&self) -> f64 {
+        finite_mean(&self.ssim)
+    }
 }
 
 /// What [`compare_with`] measured.
@@ -256,6 +265,9 @@ pub struct Comparison {
     /// Relative LRMS of the reference's own noise per frame (√(mean |A − B|²/4) / mean),
     /// with two reference halves.
     pub noise_floor: Option<Vec<f64>>,
+    /// SSIM of reference half A against half B per frame, with two halves: how far below 1
+    /// the reference's own noise puts SSIM.
+    pub halves_ssim: Option<Vec<f64>>,
     /// The plot files written (SVG, PNG).
     pub plots: Vec<PathBuf>,
 }
@@ -273,39 +285,43 @@ impl Comparison {
         let mut out = String::new();
         if corrected {
             out.push_str(&format!(
-                "{:<16} {:>10} {:>12} {:>9} {:>10}\n",
-                "candidate", "corrected", "uncorrected", "PSNR dB", "mean ratio"
+                "{:<16} {:>10} {:>12} {:>9} {:>7} {:>10}\n",
+                "candidate", "corrected", "uncorrected", "PSNR dB", "SSIM", "mean ratio"
             ));
         } else {
             out.push_str(&format!(
-                "{:<16} {:>12} {:>9} {:>10}\n",
-                "candidate", "rel. LRMS", "PSNR dB", "mean ratio"
+                "{:<16} {:>12} {:>9} {:>7} {:>10}\n",
+                "candidate", "rel. LRMS", "PSNR dB", "SSIM", "mean ratio"
             ));
         }
         for m in &self.candidates {
             if corrected {
                 out.push_str(&format!(
-                    "{:<16} {:>10.4} {:>12.4} {:>9.2} {:>10.4}\n",
+                    "{:<16} {:>10.4} {:>12.4} {:>9.2} {:>7.4} {:>10.4}\n",
                     m.label,
                     m.mean_corrected_lrms(),
                     m.mean_lrms(),
                     m.mean_psnr(),
+                    m.mean_ssim(),
                     m.mean_ratio()
                 ));
             } else {
                 out.push_str(&format!(
-                    "{:<16} {:>12.4} {:>9.2} {:>10.4}\n",
+                    "{:<16} {:>12.4} {:>9.2} {:>7.4} {:>10.4}\n",
                     m.label,
                     m.mean_lrms(),
                     m.mean_psnr(),
+                    m.mean_ssim(),
                     m.mean_ratio()
                 ));
             }
         }
         if corrected {
             out.push_str(&format!(
-                "reference noise floor (relative LRMS of (A − B)/2): {:.4}\n",
-                self.mean_noise_floor()
+                "reference noise floor (relative LRMS of (A − B)/2): {:.4}; SSIM of A against B: \
+                 {:.4}\n",
+                self.mean_noise_floor(),
+                self.halves_ssim.as_deref().map_or(f64::NAN, finite_mean)
             ));
         }
         out
@@ -353,9 +369,10 @@ pub fn compare(
 /// The reference is `reference_a`, or with `reference_b` (an independent second half with
 /// the same frame names) the mean (A + B)/2, with the variance-corrected relative LRMS
 /// ([`corrected_relative_lrms`]) and the noise floor. Writes per-frame metrics to `out_csv`
-/// (columns `frame`, `noise_floor`, then per candidate `<label>_lrms_corrected`,
-/// `<label>_lrms`, `<label>_psnr`, `<label>_mean_ratio`; the noise floor and the corrected
-/// column only with two halves) and the error-along-path plot (corrected relative LRMS with two halves, plus the
+/// (columns `frame`, `noise_floor`, `halves_ssim`, then per candidate
+/// `<label>_lrms_corrected`, `<label>_lrms`, `<label>_psnr`, `<label>_mean_ratio`,
+/// `<label>_ssim`; the noise floor, the halves' SSIM and the corrected column only with two
+/// halves) and the error-along-path plot (corrected relative LRMS with two halves, plus the
 /// noise floor; otherwise uncorrected) as `<out_plot stem>.svg` and `.png`.
 pub fn compare_with(
     reference_a: &Path,
@@ -377,6 +394,7 @@ pub fn compare_with(
         })
         .collect();
     let mut floor = Vec::new();
+    let mut halves_ssim = Vec::new();
     for (idx, apath) in &refs {
         let a = read_image(apath)?;
         let b = match reference_b {
@@ -404,17 +422,20 @@ pub fn compare_with(
             Some(b) => mean_image(&a, b).unwrap_or_else(|| a.clone()),
             None => a.clone(),
         };
+        let exposure = display_exposure(&reference);
         let mut frame_floor = f64::NAN;
         for ((_, dir), m) in candidates.iter().zip(&mut metrics) {
             let c = read_image(&dir.join(frame_name(*idx, "exr"))).ok();
-            let (l, p, r) = match &c {
+            let (l, p, r, q) = match &c {
                 Some(img) => (
                     relative_lrms(img, &reference),
                     psnr(img, &reference),
                     mean_luminance_ratio(img, &reference),
+                    ssim(img, &reference, exposure),
                 ),
-                None => (f64::NAN, f64::NAN, f64::NAN),
+                None => (f64::NAN, f64::NAN, f64::NAN, f64::NAN),
             };
+            m.ssim.push(q);
             m.relative_lrms
                 .push(if l.is_finite() { l } else { f64::NAN });
             m.psnr.push(if p.is_finite() || p == f64::INFINITY {
@@ -439,12 +460,14 @@ pub fn compare_with(
                 frame_floor = corrected_relative_lrms(&reference, &a, b).noise_floor;
             }
             floor.push(frame_floor);
+            halves_ssim.push(ssim(&a, b, exposure));
         }
     }
     let comparison = Comparison {
         frames: refs.iter().map(|r| r.0).collect(),
         candidates: metrics,
         noise_floor: halves.then_some(floor),
+        halves_ssim: halves.then_some(halves_ssim),
         plots: Vec::new(),
     };
     write_metrics_csv(out_csv, &comparison)?;
@@ -489,27 +512,31 @@ pub fn write_metrics_csv(path: &Path, comparison: &Comparison) -> Result<()> {
     let halves = comparison.noise_floor.is_some();
     let mut head = String::from("frame");
     if halves {
-        head.push_str(",noise_floor");
+        head.push_str(",noise_floor,halves_ssim");
     }
     for m in &comparison.candidates {
         if halves {
             head.push_str(&format!(",{}_lrms_corrected", m.label));
         }
-        head.push_str(&format!(",{0}_lrms,{0}_psnr,{0}_mean_ratio", m.label));
+        head.push_str(&format!(
+            ",{0}_lrms,{0}_psnr,{0}_mean_ratio,{0}_ssim",
+            m.label
+        ));
     }
     writeln!(f, "{head}").map_err(err)?;
     for (i, idx) in comparison.frames.iter().enumerate() {
         let mut row = idx.to_string();
         if let Some(floor) = &comparison.noise_floor {
-            row.push_str(&format!(",{:.6}", floor[i]));
+            let q = comparison.halves_ssim.as_ref().map_or(f64::NAN, |q| q[i]);
+            row.push_str(&format!(",{:.6},{q:.4}", floor[i]));
         }
         for m in &comparison.candidates {
             if halves {
                 row.push_str(&format!(",{:.6}", m.corrected_lrms[i]));
             }
             row.push_str(&format!(
-                ",{:.6},{:.3},{:.6}",
-                m.relative_lrms[i], m.psnr[i], m.mean_ratio[i]
+                ",{:.6},{:.3},{:.6},{:.4}",
+                m.relative_lrms[i], m.psnr[i], m.mean_ratio[i], m.ssim[i]
             ));
         }
         writeln!(f, "{row}").map_err(err)?;

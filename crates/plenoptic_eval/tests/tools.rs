@@ -87,7 +87,7 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
     let metrics = compare(&refdir, &candidates, &csv, &png).unwrap();
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
-        text.starts_with("frame,image_lrms,image_psnr,image_mean_ratio,volume_lrms"),
+        text.starts_with("frame,image_lrms,image_psnr,image_mean_ratio,image_ssim,volume_lrms"),
         "{text}"
     );
     assert_eq!(text.lines().count(), 6);
@@ -97,6 +97,7 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
         assert!(m.relative_lrms.iter().all(|x| x.is_finite()));
         assert!(m.mean_ratio.iter().all(|r| (0.5..2.0).contains(r)), "{m:?}");
         assert!(m.corrected_lrms.is_empty());
+        assert!(m.ssim.iter().all(|q| (0.0..=1.0).contains(q)), "{m:?}");
     }
     if let Ok(keep) = std::env::var("RECON_KEEP") {
         std::fs::copy(&png, &keep).unwrap();
@@ -131,7 +132,9 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
     .unwrap();
     let text = std::fs::read_to_string(&csv2).unwrap();
     assert!(
-        text.starts_with("frame,noise_floor,image_lrms_corrected,image_lrms,image_psnr"),
+        text.starts_with(
+            "frame,noise_floor,halves_ssim,image_lrms_corrected,image_lrms,image_psnr"
+        ),
         "{text}"
     );
     print!("{}", cmp.table());
@@ -145,7 +148,15 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
         );
         assert!(u > c, "{m:?}");
         assert!((c - truth).abs() < 0.25 * truth + 0.01, "{c} vs {truth}");
+        // SSIM is not corrected: the reference's noise lowers it.
+        assert!(m.mean_ssim() < clean.mean_ssim(), "{m:?} {clean:?}");
     }
+    let halves_ssim = cmp.halves_ssim.as_deref().unwrap();
+    assert_eq!(halves_ssim.len(), cmp.frames.len());
+    assert!(
+        halves_ssim.iter().all(|q| (0.0..0.99).contains(q)),
+        "{halves_ssim:?}"
+    );
     assert_eq!(cmp.plots.len(), 2);
     // A missing frame in B names the file.
     std::fs::remove_file(half_b.join(frame_name(2, "exr"))).unwrap();

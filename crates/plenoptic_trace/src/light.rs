@@ -64,7 +64,7 @@ pub struct LightSet {
 }
 
 impl LightSet {
-    pub(crate) fn new(scene: &Scene, t: f32, instances: &[Instance]) -> Self {
+    pub(crate) fn new(scene: &Scene, t: f32, instances: &[Instance], env: EnvLight) -> Self {
         let mut emissive = Vec::new();
         let mut weights = Vec::new();
         for inst in instances {
@@ -117,7 +117,7 @@ impl LightSet {
             index,
             punctual,
             sun: scene.sun.as_ref().map(|s| s.light),
-            env: EnvLight::new(scene.environment_at(t)),
+            env,
         }
     }
 

@@ -23,6 +23,7 @@ use std::time::Duration;
 
 use crate::alpha::{AlphaTest, accepts};
 use crate::camera::Camera;
+use crate::environment::EnvTableCache;
 use crate::image::Image;
 use crate::light::LightSet;
 use crate::texture::sample_ref;
@@ -94,6 +95,8 @@ pub struct SceneAccel<'s> {
     blas: Vec<Option<Blas>>,
     /// Per object id, how its hits are alpha-tested.
     alpha: Vec<AlphaTest>,
+    /// The environment's sampling tables, shared by placements at nearby times.
+    env_tables: EnvTableCache,
 }
 
 /// One object placed in the world.
@@ -135,7 +138,12 @@ impl<'s> SceneAccel<'s> {
             return Err(TraceError::EmptyScene);
         }
         let alpha = AlphaTest::per_object(scene);
-        Ok(Self { scene, blas, alpha })
+        Ok(Self {
+            scene,
+            blas,
+            alpha,
+            env_tables: EnvTableCache::default(),
+        })
     }
 
     /// The scene.
@@ -192,7 +200,7 @@ impl<'s> SceneAccel<'s> {
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), a| (lo.min(a.min.into()), hi.max(a.max.into())),
         );
-        let lights = LightSet::new(scene, t, &instances);
+        let lights = LightSet::new(scene, t, &instances, self.env_tables.light(scene, t));
         PlacedScene {
             accel: self,
             time: t,
