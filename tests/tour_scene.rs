@@ -255,8 +255,14 @@ fn the_recipe_lights_the_tour_with_a_sun_study_and_a_sky() {
         "it drives the glb's own sun"
     );
     assert!(
-        matches!(scene.environment, plenoptic_scene::Environment::Sky(_)),
-        "the windows show a Hosek–Wilkie sky"
+        matches!(
+            scene.environment,
+            plenoptic_scene::Environment::Sky(plenoptic_pack::plenoptic_sky::SkyParams {
+                ground: true,
+                ..
+            })
+        ),
+        "the windows show a Hosek–Wilkie sky, and its ground below the horizon"
     );
     for t in [recipe.time.start, 7.0, recipe.time.end] {
         let d = scene.placed_light(sun.light, t).direction;

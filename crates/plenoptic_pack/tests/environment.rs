@@ -65,6 +65,7 @@ fn every_kind_round_trips() {
         turbidity: 4.5,
         ground_albedo: Vec3::new(0.1, 0.2, 0.3),
         scale: 1000.0,
+        ground: true,
     });
     let (env, r) = round_trip(&path, &sky, Some(track()));
     assert_eq!(env, sky);

@@ -62,9 +62,9 @@ impl PackEnvironment {
         self.sun.as_ref().map(|s| s.at(t))
     }
 
-    /// The environment at time `t`: the sky lit from the track's sun direction then.
+    /// The environment at time `t`: the sky (and its ground) lit by the track's sun then.
     pub fn at(&self, t: f32) -> PlacedEnvironment {
-        self.environment.at(self.sun_at(t).map(|s| s.0))
+        self.environment.at_lit(self.sun_at(t))
     }
 }
 

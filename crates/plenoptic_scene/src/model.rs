@@ -376,9 +376,9 @@ impl Scene {
         Some((-p.direction, p.emitted))
     }
 
-    /// The environment at time `t` (a sky lit by the sun's direction then).
+    /// The environment at time `t` (a sky, and its ground, lit by the sun then).
     pub fn environment_at(&self, t: f32) -> PlacedEnvironment {
-        self.environment.at(self.sun_at(t).map(|s| s.0))
+        self.environment.at_lit(self.sun_at(t))
     }
 
     /// Whether the environment changes over time: a sky whose sun moves or changes.

@@ -162,6 +162,12 @@ impl Environment {
     /// Parameters should have passed [`Environment::validate`]; a sky that does not gives
     /// [`PlacedEnvironment::None`].
     pub fn at(&self, sun: Option<Vec3>) -> PlacedEnvironment {
+        self.at_lit(sun.map(|d| (d, Vec3::ZERO)))
+    }
+
+    /// [`Environment::at`] with the sun's direction and its illuminance on a plane facing it,
+    /// which also lights a sky's ground ([`SkyParams::ground`](crate::SkyParams::ground)).
+    pub fn at_lit(&self, sun: Option<(Vec3, Vec3)>) -> PlacedEnvironment {
         match self {
             Environment::None => PlacedEnvironment::None,
             Environment::Uniform(c) => PlacedEnvironment::Uniform(*c),
@@ -174,8 +180,11 @@ impl Environment {
                 intensity: *intensity,
                 to_image: Quat::from_rotation_y(rotation_deg.to_radians()),
             },
-            Environment::Sky(p) => Sky::new(p, sun.unwrap_or(Vec3::Y))
-                .map_or(PlacedEnvironment::None, PlacedEnvironment::Sky),
+            Environment::Sky(p) => {
+                let (direction, illuminance) = sun.unwrap_or((Vec3::Y, Vec3::ZERO));
+                Sky::new_lit(p, direction, illuminance)
+                    .map_or(PlacedEnvironment::None, PlacedEnvironment::Sky)
+            }
         }
     }
 }

@@ -5,7 +5,12 @@
 //! the whole sky fades linearly to black at [`TWILIGHT_DEG`] below it (civil twilight): a
 //! documented approximation so that a sun study may start before sunrise. The model has no
 //! solar disc: the sun is a separate directional light. Directions below the horizon see no
-//! sky (the ground is geometry, or nothing).
+//! sky: the ground is geometry, nothing, or with [`SkyParams::ground`] an infinite
+//! Lambertian ground of the model's own `ground_albedo`, lit by the sky and the sun without
+//! shadows: radiance `albedo / π · (E_sky + E_sun · max(0, sun.y))`, where E_sky is the
+//! sky's irradiance on a horizontal plane (512 cosine-distributed directions, stratified)
+//! and E_sun the sun's illuminance facing it ([`Sky::new_lit`]). What users see through a
+//! window at eye height is then the ground's light, not black.
 
 use glam::Vec3;
 use hw_skymodel::rgb::{SkyParams as HwParams, SkyState};
@@ -25,6 +30,10 @@ pub struct SkyParams {
     pub ground_albedo: Vec3,
     /// Multiplies the model's kcd/m² (1000: the scene's lux-based units).
     pub scale: f32,
+    /// Directions below the horizon see a ground of `ground_albedo` lit by the sky and the
+    /// sun (module docs) instead of black. Off by default (packs before 3.1 have none).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub ground: bool,
 }
 
 impl Default for SkyParams {
@@ -33,6 +42,7 @@ impl Default for SkyParams {
             turbidity: 3.0,
             ground_albedo: Vec3::splat(0.2),
             scale: 1000.0,
+            ground: false,
         }
     }
 }
@@ -77,6 +87,10 @@ pub struct SkyCoefficients {
     pub radiances: [f32; 3],
     /// Unit direction towards the sun (its elevation clamped to the horizon).
     pub sun: Vec3,
+    /// Linear RGB radiance of every direction below the horizon (zero without
+    /// [`SkyParams::ground`]).
+    #[serde(default)]
+    pub ground: [f32; 3],
 }
 
 /// The sky for one sun direction.
@@ -86,8 +100,15 @@ pub struct Sky {
 }
 
 impl Sky {
-    /// The sky with `params` and the sun towards `sun` (world, +Y up; need not be unit).
+    /// The sky with `params` and the sun towards `sun` (world, +Y up; need not be unit), its
+    /// ground (if any) lit by the sky alone.
     pub fn new(params: &SkyParams, sun: Vec3) -> Result<Self> {
+        Self::new_lit(params, sun, Vec3::ZERO)
+    }
+
+    /// [`Sky::new`] with the sun's illuminance on a plane facing it (linear RGB), which
+    /// lights the ground as well.
+    pub fn new_lit(params: &SkyParams, sun: Vec3, sun_illuminance: Vec3) -> Result<Self> {
         params.validate()?;
         let sun = sun.normalize_or(Vec3::Y);
         let elevation = sun.y.clamp(-1.0, 1.0).asin();
@@ -102,13 +123,38 @@ impl Sky {
         let (p, r) = state.raw();
         let horizontal = Vec3::new(sun.x, 0.0, sun.z).normalize_or(Vec3::X);
         let sun_clamped = horizontal * clamped.cos() + Vec3::Y * clamped.sin();
-        Ok(Self {
+        let mut sky = Self {
             coefficients: SkyCoefficients {
                 params: p,
                 radiances: r.map(|x| x * params.scale * fade),
                 sun: sun_clamped,
+                ground: [0.0; 3],
             },
-        })
+        };
+        if params.ground {
+            let e = sky.horizontal_irradiance() + sun_illuminance.max(Vec3::ZERO) * sun.y.max(0.0);
+            sky.coefficients.ground = (params.ground_albedo * e / std::f32::consts::PI).to_array();
+        }
+        Ok(sky)
+    }
+
+    /// The sky's irradiance on a horizontal plane (ground excluded): π × the mean radiance of
+    /// 512 cosine-distributed directions, one per cell of a 32 × 16 grid (Malley's method).
+    fn horizontal_irradiance(&self) -> Vec3 {
+        const NU: usize = 32;
+        const NV: usize = 16;
+        let mut sum = Vec3::ZERO;
+        for i in 0..NU {
+            for j in 0..NV {
+                let u = (i as f32 + 0.5) / NU as f32;
+                let v = (j as f32 + 0.5) / NV as f32;
+                let r = v.sqrt();
+                let phi = std::f32::consts::TAU * u;
+                let d = Vec3::new(r * phi.cos(), (1.0 - v).sqrt(), r * phi.sin());
+                sum += self.radiance(d);
+            }
+        }
+        sum * (std::f32::consts::PI / (NU * NV) as f32)
     }
 
     /// The coefficients, for a shader.
@@ -116,10 +162,11 @@ impl Sky {
         &self.coefficients
     }
 
-    /// Linear RGB radiance arriving from unit direction `dir` (zero below the horizon).
+    /// Linear RGB radiance arriving from unit direction `dir` (below the horizon, the
+    /// ground's, which is zero without [`SkyParams::ground`]).
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         if dir.y <= 0.0 {
-            return Vec3::ZERO;
+            return Vec3::from_array(self.coefficients.ground);
         }
         let c = &self.coefficients;
         let cos_theta = dir.y.min(1.0);
@@ -189,6 +236,57 @@ mod tests {
             let theirs = reference(&state, d.y.acos(), d.dot(sun).clamp(-1.0, 1.0).acos());
             assert!((ours - theirs).abs().max_element() <= 1e-4 * theirs.max_element().max(1.0));
         }
+    }
+
+    /// The ground is `albedo / π` × the horizontal irradiance of sky and sun, against a fine
+    /// midpoint integration of the sky; without `ground` it is black.
+    #[test]
+    fn the_ground_is_lit_by_the_sky_and_the_sun() {
+        let sun = Vec3::new(0.3, 0.5, -0.6).normalize();
+        let e_sun = Vec3::new(8000.0, 7600.0, 6800.0);
+        let params = SkyParams {
+            ground: true,
+            ground_albedo: Vec3::new(0.3, 0.2, 0.1),
+            ..SkyParams::default()
+        };
+        let sky = Sky::new_lit(&params, sun, e_sun).unwrap();
+        let n = 256;
+        let (dt, dp) = (
+            std::f32::consts::FRAC_PI_2 / n as f32,
+            std::f32::consts::TAU / (4 * n) as f32,
+        );
+        let mut e_sky = glam::DVec3::ZERO;
+        for i in 0..n {
+            let (st, ct) = ((i as f32 + 0.5) * dt).sin_cos();
+            for j in 0..4 * n {
+                let phi = (j as f32 + 0.5) * dp;
+                let d = Vec3::new(st * phi.cos(), ct, st * phi.sin());
+                e_sky += (sky.radiance(d) * (ct * st * dt * dp)).as_dvec3();
+            }
+        }
+        let want = params.ground_albedo * (e_sky.as_vec3() + e_sun * sun.y) / std::f32::consts::PI;
+        for d in [Vec3::NEG_Y, Vec3::new(0.9, -0.1, 0.3).normalize()] {
+            let got = sky.radiance(d);
+            assert!(
+                ((got - want) / want).abs().max_element() < 0.02,
+                "{got} vs {want}"
+            );
+        }
+        // Without the sun's illuminance only the sky lights it; without `ground` nothing.
+        let unlit = Sky::new(&params, sun).unwrap().radiance(Vec3::NEG_Y);
+        let sun_share = params.ground_albedo.x * e_sun.x * sun.y / std::f32::consts::PI;
+        let got = sky.radiance(Vec3::NEG_Y).x - unlit.x;
+        assert!((got / sun_share - 1.0).abs() < 1e-3, "{got} vs {sun_share}");
+        let off = SkyParams {
+            ground: false,
+            ..params
+        };
+        assert_eq!(
+            Sky::new_lit(&off, sun, e_sun)
+                .unwrap()
+                .radiance(Vec3::NEG_Y),
+            Vec3::ZERO
+        );
     }
 
     #[test]

@@ -77,6 +77,8 @@ pub struct EnvironmentUniform {
     pub sky_radiance: Vec4,
     /// Unit direction towards the sun (xyz).
     pub sun: Vec4,
+    /// The sky's radiance below the horizon: its ground (xyz; zero without one).
+    pub ground: Vec4,
 }
 
 impl EnvironmentUniform {
@@ -97,6 +99,7 @@ impl EnvironmentUniform {
                 }
                 u.sky_radiance = Vec3::from_array(c.radiances).extend(0.0);
                 u.sun = c.sun.extend(0.0);
+                u.ground = Vec3::from_array(c.ground).extend(0.0);
             }
             PlacedEnvironment::Image {
                 intensity,

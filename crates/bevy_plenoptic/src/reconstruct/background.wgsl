@@ -25,6 +25,8 @@ struct Environment {
     sky_radiance: vec4<f32>,
     // Unit direction towards the sun (xyz).
     sun: vec4<f32>,
+    // The sky's radiance below the horizon, its ground (xyz; zero without one).
+    ground: vec4<f32>,
 }
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
@@ -71,7 +73,7 @@ fn sky_channel(ch: u32, cos_theta: f32, gamma: f32, cos_gamma: f32) -> f32 {
 
 fn sky(dir: vec3<f32>) -> vec3<f32> {
     if dir.y <= 0.0 {
-        return vec3<f32>(0.0);
+        return env.ground.xyz;
     }
     let cos_theta = min(dir.y, 1.0);
     let cos_gamma = clamp(dot(dir, env.sun.xyz), -1.0, 1.0);

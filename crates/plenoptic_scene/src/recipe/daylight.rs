@@ -19,6 +19,7 @@
 //! turbidity = 3.0                # hosek-wilkie: 1 (clear) to 10 (hazy)
 //! ground_albedo = [0.2, 0.2, 0.2]
 //! scale = 1000.0                 # hosek-wilkie: model kcd/m² to the scene's lux units
+//! ground = true                  # hosek-wilkie: below the horizon a ground of ground_albedo, lit by sky and sun (default false: black)
 //! sun = "Sun"                    # hosek-wilkie without [sun]: the glTF directional light that is the sun
 //! # file = "studio.exr"          # image: equirectangular .hdr or .exr
 //! # intensity = 1.0              # image: multiplies the texels
@@ -80,6 +81,8 @@ pub struct SkyToml {
     pub ground_albedo: Option<[f32; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ground: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -221,7 +224,7 @@ impl SkyToml {
         let kind = self.kind.as_str();
         let allowed: &[&str] = match kind {
             "none" => &[],
-            "hosek-wilkie" => &["turbidity", "ground_albedo", "scale", "sun"],
+            "hosek-wilkie" => &["turbidity", "ground_albedo", "scale", "ground", "sun"],
             "image" => &["file", "intensity", "rotation_deg"],
             "uniform" => &["color"],
             _ => {
@@ -235,6 +238,7 @@ impl SkyToml {
             ("turbidity", self.turbidity.is_some()),
             ("ground_albedo", self.ground_albedo.is_some()),
             ("scale", self.scale.is_some()),
+            ("ground", self.ground.is_some()),
             ("sun", self.sun.is_some()),
             ("file", self.file.is_some()),
             ("intensity", self.intensity.is_some()),
@@ -258,6 +262,7 @@ impl SkyToml {
                         None => d.ground_albedo,
                     },
                     scale: self.scale.unwrap_or(d.scale),
+                    ground: self.ground.unwrap_or(d.ground),
                 };
                 params.validate().map_err(|e| {
                     let text = e.to_string();
@@ -392,9 +397,20 @@ frame_rate = 30.0
             d.sky,
             super::SkySpec::HosekWilkie {
                 sun_light: Some(_),
+                params: plenoptic_sky::SkyParams { ground: false, .. },
+            }
+        ));
+        let d = parse("[sky]\nkind = \"hosek-wilkie\"\nground = true\n").unwrap();
+        assert!(matches!(
+            d.sky,
+            super::SkySpec::HosekWilkie {
+                params: plenoptic_sky::SkyParams { ground: true, .. },
                 ..
             }
         ));
+        let e = parse("[sky]\nkind = \"uniform\"\ncolor = [0.1, 0.2, 0.3]\nground = true\n")
+            .unwrap_err();
+        assert!(e.contains("sky.ground"), "{e}");
     }
 
     #[test]
