@@ -163,20 +163,24 @@ pub fn auto_exposure(radiance: &[Vec3]) -> f32 {
     if avg > 1e-4 { 0.18 / avg } else { 1.0 }
 }
 
-/// Tonemaps one linear colour to 8-bit sRGB (exposure, ACES fit, sRGB).
-pub fn tonemap(c: Vec3, exposure: f32) -> [u8; 3] {
+/// One linear colour as the PNG frames display it, sRGB-encoded in [0, 1] per channel
+/// (exposure, ACES fit, sRGB), before quantisation.
+pub fn display(c: Vec3, exposure: f32) -> Vec3 {
     let aces = |x: f32| {
         let x = (x * exposure).max(0.0);
         (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
     };
-    let srgb = |x: f32| {
-        if x <= 0.0031308 {
-            12.92 * x
-        } else {
-            1.055 * x.powf(1.0 / 2.4) - 0.055
-        }
-    };
-    c.to_array().map(|v| (srgb(aces(v)) * 255.0 + 0.5) as u8)
+    Vec3::from_array(
+        c.to_array()
+            .map(|v| plenoptic_pack::texture::linear_to_srgb(aces(v))),
+    )
+}
+
+/// Tonemaps one linear colour to 8-bit sRGB ([`display`], quantised).
+pub fn tonemap(c: Vec3, exposure: f32) -> [u8; 3] {
+    display(c, exposure)
+        .to_array()
+        .map(|v| (v * 255.0 + 0.5) as u8)
 }
 
 /// Writes a tonemapped PNG.

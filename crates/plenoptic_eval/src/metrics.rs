@@ -129,22 +129,13 @@ pub fn corrected_relative_lrms(
     }
 }
 
-/// The display exposure [`ssim`] uses by default: `0.5 / mean luminance of the reference`,
-/// the exposure of the tools' PNG frames (mid grey at half the mean).
-pub fn display_exposure(reference: &Image<Vec3>) -> f32 {
-    let mean = reference.mean_luminance();
-    if mean > 0.0 && mean.is_finite() {
-        (0.5 / mean) as f32
-    } else {
-        1.0
-    }
-}
-
-/// SSIM (Wang, Bovik, Sheikh and Simoncelli 2004) of `test` against `reference` as both are
-/// displayed: the luminance times `exposure`, clamped to [0, 1], sRGB-encoded and scaled to
-/// 0–255 (not rounded), compared with MATLAB's `ssim.m` (11 × 11 Gaussian window, σ = 1.5,
-/// K₁ = 0.01, K₂ = 0.03, L = 255) through the `blazediff-ssim` crate. SSIM is a structural
-/// measure of the picture people see, so it is taken on display values, not on radiance.
+/// SSIM (Wang, Bovik, Sheikh and Simoncelli 2004) of `test` against `reference` as the PNG
+/// frames display them ([`crate::frame_io::display`]: `exposure`, ACES, sRGB), reduced to
+/// luma with MATLAB's `rgb2gray` weights on 0–255 (not rounded), and compared with MATLAB's
+/// `ssim.m` (11 × 11 Gaussian window, σ = 1.5, K₁ = 0.01, K₂ = 0.03, L = 255) through the
+/// `blazediff-ssim` crate. SSIM is a structural measure of the picture people see, so it is
+/// taken on display values, not on radiance. [`compare_with`](crate::tools::compare_with)
+/// passes each reference frame's [`auto_exposure`](crate::frame_io::auto_exposure).
 ///
 /// It is not corrected for the reference's noise: against a noisy reference a perfect
 /// image scores below 1. The SSIM of one reference half against the other shows how far.
@@ -159,7 +150,10 @@ pub fn ssim(test: &Image<Vec3>, reference: &Image<Vec3>, exposure: f32) -> f64 {
         samples: img
             .pixels
             .iter()
-            .map(|&c| 255.0 * srgb_oetf(exposure * luminance(c)))
+            .map(|&c| {
+                let d = crate::frame_io::display(c, exposure);
+                255.0 * (0.298_936 * d.x + 0.587_043 * d.y + 0.114_021 * d.z)
+            })
             .collect(),
         width: img.width as usize,
         height: img.height as usize,
@@ -170,20 +164,6 @@ pub fn ssim(test: &Image<Vec3>, reference: &Image<Vec3>, exposure: f32) -> f64 {
         &blazediff_ssim::SsimOptions::default(),
     )
     .map_or(f64::NAN, |o| o.score)
-}
-
-/// The sRGB transfer function of a linear value, clamped to [0, 1].
-fn srgb_oetf(v: f32) -> f32 {
-    let v = if v.is_finite() {
-        v.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 #[cfg(test)]
@@ -269,12 +249,12 @@ mod tests {
     #[test]
     fn ssim_is_one_for_equal_frames_and_falls_with_noise_and_lost_structure() {
         let s = signal();
-        let e = display_exposure(&s);
+        let e = crate::frame_io::auto_exposure(&s.pixels);
         assert!((ssim(&s, &s, e) - 1.0).abs() < 1e-9);
         let light = ssim(&noisy(&s, 0.02, 7), &s, e);
         let heavy = ssim(&noisy(&s, 0.2, 8), &s, e);
         assert!(light < 1.0 && heavy < light, "{light} {heavy}");
-        assert!(heavy < 0.5 && light > 0.5, "{light} {heavy}");
+        assert!(heavy < 0.6 && light > 0.9, "{light} {heavy}");
         // Stripes 4 pixels wide and their mean: equal mean luminance, no structure left.
         // (Wider than 1 pixel: like MATLAB, the crate low-passes and halves frames whose
         // short side is above 384 before comparing.)
@@ -282,7 +262,13 @@ mod tests {
             Vec3::splat(if (x / 4) % 2 == 0 { 0.5 } else { 1.5 })
         });
         let flat = Image::render(W, H, |_, _| Vec3::ONE);
-        assert!(ssim(&flat, &stripes, display_exposure(&stripes)) < 0.2);
+        assert!(
+            ssim(
+                &flat,
+                &stripes,
+                crate::frame_io::auto_exposure(&stripes.pixels)
+            ) < 0.2
+        );
         // Sizes that differ, or a frame smaller than the 11-pixel window.
         let small = Image::render(8, 8, |_, _| Vec3::ONE);
         assert!(ssim(&small, &s, e).is_nan());

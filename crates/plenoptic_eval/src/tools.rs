@@ -21,8 +21,8 @@ use plenoptic_trace::Image;
 
 use crate::frame_io::{auto_exposure, read_exr, write_exr, write_png};
 use crate::metrics::{
-    CorrectedLrms, corrected_relative_lrms, display_exposure, mean_image, mean_luminance_ratio,
-    psnr, relative_lrms, ssim,
+    CorrectedLrms, corrected_relative_lrms, mean_image, mean_luminance_ratio, psnr, relative_lrms,
+    ssim,
 };
 use crate::{EvalError, Result};
 
@@ -214,8 +214,8 @@ pub struct CandidateMetrics {
     pub psnr: Vec<f64>,
     /// Mean luminance of the candidate over the reference's, per frame.
     pub mean_ratio: Vec<f64>,
-    /// SSIM of the displayed frames per reference frame ([`ssim`], at the reference's
-    /// [`display_exposure`]).
+    /// SSIM of the displayed frames per reference frame ([`ssim`], at the reference frame's
+    /// [`auto_exposure`]).
     pub ssim: Vec<f64>,
 }
 
@@ -422,7 +422,7 @@ pub fn compare_with(
             Some(b) => mean_image(&a, b).unwrap_or_else(|| a.clone()),
             None => a.clone(),
         };
-        let exposure = display_exposure(&reference);
+        let exposure = auto_exposure(&reference.pixels);
         let mut frame_floor = f64::NAN;
         for ((_, dir), m) in candidates.iter().zip(&mut metrics) {
             let c = read_image(&dir.join(frame_name(*idx, "exr"))).ok();
