@@ -88,6 +88,9 @@ struct ModeTiming {
     ms_full: f64,
 }
 
+/// Each candidate's frame directory (label, directory), and its timing.
+type Reconstructed = (Vec<(String, PathBuf)>, Vec<ModeTiming>);
+
 /// Renders `samples` with every candidate in `names` into `<dir>/<name>`; returns the
 /// directories and the timings (the path's own size `full` is timed, not written).
 fn reconstruct(
@@ -97,7 +100,7 @@ fn reconstruct(
     full: &[PathSample],
     dir: &Path,
     exposure: f32,
-) -> Result<(Vec<(String, PathBuf)>, Vec<ModeTiming>), BoxError> {
+) -> Result<Reconstructed, BoxError> {
     let mut dirs = Vec::new();
     let mut timings = Vec::new();
     for (name, mode, shading) in CANDIDATES.into_iter().filter(|c| names.contains(&c.0)) {
@@ -252,7 +255,7 @@ pub fn run(
             height: CROP_FULL.1,
             ..frame.camera
         }),
-        ..frame.clone()
+        ..*frame
     };
     let crop_dir = frames_dir.join("crop");
     println!(
