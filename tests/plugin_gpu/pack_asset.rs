@@ -2,21 +2,12 @@
 //! truncated or damaged pack is an asset load failure naming the problem; a chunk that fails
 //! its checksum while streaming becomes a `PlenopticEvent::ChunkFailed`. The app never panics.
 
-// The plugin's GPU tests on packs built through the tracer. They live in the facade package
-// (not in bevy_plenoptic) so that the plugin needs the tracer not even as a dev-dependency.
-#[path = "../crates/bevy_plenoptic/tests/common/mod.rs"]
-mod common;
-/// The reconstruction crate's test pack builder (analytic scenes written with `PackWriter`),
-/// shared so that the GPU is tested on the very packs the CPU reconstruction is.
-#[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
-mod pack;
-
+use crate::common::*;
+use crate::pack::{PackSpec, room, write_pack};
 use bevy::asset::LoadState;
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamingStats;
-use common::*;
-use pack::{PackSpec, room, write_pack};
 use plenoptic_pack::{ChunkKind, PackReader};
 
 fn make_pack(dir: &std::path::Path) -> std::path::PathBuf {

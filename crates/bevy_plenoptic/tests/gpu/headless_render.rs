@@ -2,11 +2,9 @@
 //! software Vulkan driver, renders a lit scene into an image, and the pixels read back
 //! show what was drawn.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_plenoptic::{PlenopticPlugin, PlenopticSettings};
-use common::*;
 
 #[test]
 fn renders_a_frame_and_reads_it_back() {

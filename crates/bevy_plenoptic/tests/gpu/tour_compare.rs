@@ -1,10 +1,8 @@
 //! GPU against CPU on the architectural tour's pack at four points of its camera path (not
 //! run by default: the pack is baked by the example). Set `PLENOPTIC_TOUR_DUMP` to a folder
-//! to get both frames of each point as PPM images. `cargo test -p bevy_plenoptic --test tour_compare --
+//! to get both frames of each point as PPM images. `cargo test -p bevy_plenoptic --test gpu tour_compare --
 //! --ignored --nocapture`; the pack is `target/architectural_tour/tour.pack` or
 //! `$PLENOPTIC_TOUR_PACK`.
-
-mod common;
 
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -49,7 +47,7 @@ fn tour_gpu_against_cpu() {
         let (cpu, report) = rec
             .render(&cam, sample.scene_time, Mode::GeometryAssisted)
             .unwrap();
-        let mut app = common::headless_app_in(pack.parent().unwrap());
+        let mut app = crate::common::headless_app_in(pack.parent().unwrap());
         let handle: Handle<RadiancePack> = app
             .world()
             .resource::<AssetServer>()
@@ -93,9 +91,9 @@ fn tour_gpu_against_cpu() {
             }
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        let decode = common::rgba16f_pixels;
+        let decode = crate::common::rgba16f_pixels;
         let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
-        let data = common::render_until(&mut app, image, 600, |d| {
+        let data = crate::common::render_until(&mut app, image, 600, |d| {
             let stable = prev.borrow().as_deref() == Some(d);
             *prev.borrow_mut() = Some(d.to_vec());
             let red = decode(d)

@@ -2,22 +2,13 @@
 //! tracks composites with ordinary Bevy meshes through the depth buffer; streaming stays
 //! inside a budget smaller than the pack along a camera path through the whole view space.
 
-// The plugin's GPU tests on packs built through the tracer. They live in the facade package
-// (not in bevy_plenoptic) so that the plugin needs the tracer not even as a dev-dependency.
-#[path = "../crates/bevy_plenoptic/tests/common/mod.rs"]
-mod common;
-/// The reconstruction crate's test pack builder (analytic scenes written with `PackWriter`),
-/// shared so that the GPU is tested on the very packs the CPU reconstruction is.
-#[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
-mod pack;
-
+use crate::common::*;
+use crate::pack::{Materials, PackSpec, open_room, room, write_pack};
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::proxy::ProxyOf;
 use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
 use bevy_plenoptic::streaming::{StreamState, StreamingStats, key_bytes};
-use common::*;
-use pack::{Materials, PackSpec, open_room, room, write_pack};
 
 fn room_pack(dir: &std::path::Path, views: usize) {
     write_pack(
@@ -348,7 +339,7 @@ fn plugin_and_cpu_frames_with(
             ..PlenopticCamera::new(handle)
         },
     ));
-    let decode = common::rgba16f_pixels;
+    let decode = crate::common::rgba16f_pixels;
     let cam_entity = {
         let mut q = app
             .world_mut()

@@ -6,20 +6,14 @@
 //! glazed with a pane exported as `alphaMode: BLEND`, the GPU's blended glazing equals the
 //! CPU's composite, with the sky's lit ground below the horizon.
 
-#[path = "../crates/bevy_plenoptic/tests/common/mod.rs"]
-mod common;
-/// The reconstruction crate's test pack builder, shared with the CPU tests.
-#[path = "../crates/plenoptic_recon/tests/common/mod.rs"]
-mod pack;
-
+use crate::common::*;
+use crate::pack::{PackSpec, open_room, windowed_room, write_pack_with};
 use bevy::camera::{Exposure, Hdr};
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::camera::EV100_UNIT;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
-use common::*;
-use pack::{PackSpec, open_room, windowed_room, write_pack_with};
 use plenoptic_pack::plenoptic_sky::{Environment, SkyParams};
 use plenoptic_recon::{Mode, Reconstructor};
 
@@ -84,7 +78,7 @@ fn env_pack(path: &std::path::Path, env: Environment) {
 
 /// Writes `scene` with `env` and a moving sun to `path`.
 fn write_room_pack(scene: &plenoptic_scene::Scene, path: &std::path::Path, env: Environment) {
-    let track = pack::moving_sun();
+    let track = crate::pack::moving_sun();
     write_pack_with(
         scene,
         &PackSpec::segment(2, vec![0.0, 2.0], 16),
