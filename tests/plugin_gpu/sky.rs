@@ -1,7 +1,7 @@
 //! The sky on the GPU: looking up through the open ceiling of the test room, the pixels no
 //! proxy covers show the pack's Hosek–Wilkie sky at the camera's time, evaluated per pixel in
 //! WGSL from coefficients computed on the CPU, equal to `plenoptic_recon`'s background within
-//! the GPU-versus-CPU bounds of `plugin_scene_render.rs`; and the frame honours the camera's
+//! the GPU-versus-CPU bounds of `scene_render.rs`; and the frame honours the camera's
 //! `Exposure`: one EV100 more halves the linear output. Through a window of the room, open or
 //! glazed with a pane exported as `alphaMode: BLEND`, the GPU's blended glazing equals the
 //! CPU's composite, with the sky's lit ground below the horizon.
@@ -17,7 +17,7 @@ use bevy_plenoptic::streaming::StreamState;
 use plenoptic_pack::plenoptic_sky::{Environment, SkyParams};
 use plenoptic_recon::{Mode, Reconstructor};
 
-/// Compares `gpu` with `cpu` over the pixels `which`, as `plugin_scene_render.rs` does: per
+/// Compares `gpu` with `cpu` over the pixels `which`, as `scene_render.rs` does: per
 /// pixel the largest channel's |gpu − cpu| / (cpu + 0.02). Returns (mean, fraction within
 /// 5 %, within 20 %).
 fn compare(gpu: &[Vec3], cpu: &[Vec3], which: &[usize]) -> (f32, f32, f32) {
@@ -30,7 +30,7 @@ fn compare(gpu: &[Vec3], cpu: &[Vec3], which: &[usize]) -> (f32, f32, f32) {
 }
 
 /// Asserts that `gpu` equals `cpu` over the pixels `which` within the GPU-versus-CPU bounds of
-/// `plugin_scene_render.rs` (mean relative error below 0.003, 99.5 % of pixels within 5 %,
+/// `scene_render.rs` (mean relative error below 0.003, 99.5 % of pixels within 5 %,
 /// 99.9 % within 20 %), printing the figures as `what`; returns the mean.
 fn assert_gpu_matches(gpu: &[Vec3], cpu: &[Vec3], which: &[usize], what: &str) -> f32 {
     let (mean, f5, f20) = compare(gpu, cpu, which);
@@ -252,7 +252,7 @@ fn cpu_backend_shows_the_sky() {
         "CPU backend sky vs CPU frame: {:.1} % within 1 %",
         100.0 * within
     );
-    // As `cpu_backend_shows_the_cpu_frame` (plugin_scene_render.rs).
+    // As `cpu_backend_shows_the_cpu_frame` (scene_render.rs).
     assert!(within > 0.97, "{within}");
 }
 

@@ -144,7 +144,7 @@ impl Bsdf {
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric for `cos_i` and relative IOR `eta`.
-fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+pub(crate) fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let cos_i = cos_i.clamp(0.0, 1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -156,7 +156,7 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     0.5 * (r_par * r_par + r_perp * r_perp)
 }
 
-fn fresnel_schlick(f0: Vec3, cos: f32) -> Vec3 {
+pub(crate) fn fresnel_schlick(f0: Vec3, cos: f32) -> Vec3 {
     let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
     f0 + (Vec3::ONE - f0) * m
 }

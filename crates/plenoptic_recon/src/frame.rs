@@ -129,6 +129,11 @@ pub struct Report {
     /// lies behind it (`plenoptic_recon`'s glazing module).
     #[serde(default)]
     pub glazing_pixels: usize,
+    /// Geometry-assisted mode: pixels whose specular reflection was marched for the camera
+    /// (`plenoptic_recon::specular`), and of those, how many no base view could answer
+    /// (they show the baked non-diffuse radiance).
+    #[serde(default)]
+    pub reflections: (usize, usize),
     /// Wall-clock milliseconds of the stages of the reconstruction (diagnostics).
     pub stage_ms: Vec<(String, f64)>,
 }

@@ -94,6 +94,7 @@ mod sample;
 pub mod settings;
 mod shading;
 pub mod shadow;
+pub mod specular;
 pub mod sun;
 pub mod temporal;
 pub mod viewspace;
@@ -107,6 +108,7 @@ pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
 pub use reconstructor::Reconstructor;
 pub use settings::{CubeFilter, ReconSettings, Shading};
+pub use specular::Specular;
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -15,7 +15,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::brdf::SurfaceMaterial;
-use glam::{Vec2, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use plenoptic_pack::{
     ColourSpace, MaterialEntry, PackReader, TextureBinding, TextureImage, UvTransform, WrapMode,
 };
@@ -136,6 +136,21 @@ impl Materials {
             transmission: m.transmission.clamp(0.0, 1.0),
             ior: if m.ior > 0.0 { m.ior } else { 1.5 },
         }
+    }
+}
+
+impl Materials {
+    /// The emitted radiance of material `m` at `uv`: the emissive factor × its sRGB texture,
+    /// with the mip chosen from `footprint` as in [`Materials::surface`].
+    pub fn emission(&self, pack: &PackReader, m: &MaterialEntry, uv: Vec2, footprint: f32) -> Vec3 {
+        let mut e = m.emissive;
+        if e != Vec3::ZERO
+            && let Some(b) = m.emissive_texture
+            && let Some(t) = self.texture(pack, b.texture)
+        {
+            e *= sample(t, b, uv, footprint).truncate();
+        }
+        e
     }
 }
 

@@ -9,6 +9,7 @@ use std::ops::RangeInclusive;
 use glam::Vec3;
 use plenoptic_pack::Manifest;
 
+use crate::specular::Specular;
 use crate::viewspace::ViewWeights;
 
 /// Reconstruction settings; each field's cost/quality trade-off is documented.
@@ -50,6 +51,11 @@ pub struct ReconSettings {
     /// footprint and the sun's disc. More: smoother shadow edges and penumbrae, linear cost;
     /// 1 gives the pixel centre's hard shadow.
     pub sun_shadow_rays: u32,
+    /// How the geometry-assisted mode shows the specular part of surfaces with a material:
+    /// as the base views saw it, or for the actual camera by marching the reflected ray
+    /// through the distance cubes ([`crate::specular`]; the default, for mirrors and glossy
+    /// metals). The plugin's GPU path shows [`Specular::Baked`] today.
+    pub specular: Specular,
 }
 
 /// What the geometry-assisted mode shows on objects with a material ([`crate::shading`]).
@@ -97,6 +103,7 @@ impl Default for ReconSettings {
             max_splat_px: 8.0,
             shading: Shading::Materials,
             sun_shadow_rays: 4,
+            specular: Specular::default(),
         }
     }
 }

@@ -24,9 +24,15 @@
 //! to the axis and meets the surface at θ, times the triangle's UV-per-metre scale: the
 //! `√|det ∂uv/∂(x, y)|` a GPU's derivatives give).
 //!
-//! Not yet built: normal maps (the stored lighting is for the texel's normal only), runtime
-//! specular for the actual camera (the non-diffuse part is the base views'), emissive
-//! textures (emission is in the non-diffuse cube at cube resolution).
+//! Mirrors and glossy metals reflect for the actual camera ([`crate::specular`]): their
+//! non-diffuse radiance is replaced by their emission at the pixel's UV plus the reflected
+//! ray's radiance, marched through the base views' distance cubes.
+//!
+//! Not yet built: normal maps (the stored lighting is for the texel's normal only), emissive
+//! textures on surfaces that are not marched (emission is in the non-diffuse cube at cube
+//! resolution).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{Vec2, Vec3};
 use plenoptic_pack::{ChunkKind, VolumeSample};
@@ -39,6 +45,7 @@ use crate::geometry::{self, Layer, Pass};
 use crate::material::Materials;
 use crate::proxy::GeometryMask;
 use crate::settings::{CubeFilter, Shading};
+use crate::specular::{self, Reflections};
 use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
@@ -143,9 +150,26 @@ pub(crate) fn render(
     let sun = rec
         .runtime_sun()
         .map(|s| s.at(proxy, t, rec.settings.sun_shadow_rays));
-    let (surface, raster_ms) = surface_image(rec, materials, camera, t, layer, sun.is_some());
+    let glossy = specular::glossy_allowed(rec);
+    let (surface, raster_ms) =
+        surface_image(rec, materials, camera, t, layer, sun.is_some(), glossy);
     timed("albedo", start);
     let start = std::time::Instant::now();
+    let marched = surface
+        .iter()
+        .flatten()
+        .any(|px| rec.settings.specular.marches(&px.material, glossy));
+    let reflections = if marched {
+        Some(Reflections::new(
+            rec,
+            camera.position,
+            t,
+            &mut report.missing,
+        ))
+    } else {
+        None
+    };
+    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
     frame
         .radiance
         .par_iter_mut()
@@ -155,18 +179,41 @@ pub(crate) fn render(
             if lighting.object[j] != px.object {
                 return;
             }
-            *c = px.material.albedo() * lighting.radiance[j] + non_diffuse.radiance[j];
+            let front = px.view.dot(px.ng) < 0.0;
+            let bsdf = Bsdf::new(px.material, px.ng, px.ns, -px.view, front);
+            let specular = reflections
+                .as_ref()
+                .filter(|_| rec.settings.specular.marches(&px.material, glossy))
+                .and_then(|r| {
+                    let n = bsdf.normal();
+                    let cos_o = -px.view.dot(n);
+                    let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
+                    let eta = if front {
+                        px.material.ior
+                    } else {
+                        1.0 / px.material.ior
+                    };
+                    let alpha = px.material.roughness * px.material.roughness;
+                    let incoming = if px.material.roughness < specular::DELTA {
+                        r.incoming(px.position, dir, 0.0)
+                    } else {
+                        // A per-pixel turn of the lobe's directions (golden-ratio sequence).
+                        let turn = (j as f32 * 0.618_034).fract();
+                        r.lobe(px.position, n, -px.view, alpha, turn)
+                    };
+                    marched_pixels.fetch_add(1, Ordering::Relaxed);
+                    if incoming.is_none() {
+                        unanswered.fetch_add(1, Ordering::Relaxed);
+                    }
+                    Some(px.emission + specular::reflectance(&px.material, cos_o, eta) * incoming?)
+                });
+            *c = px.material.albedo() * lighting.radiance[j]
+                + specular.unwrap_or(non_diffuse.radiance[j]);
             if let Some(sun) = &sun {
-                let bsdf = Bsdf::new(
-                    px.material,
-                    px.ng,
-                    px.ns,
-                    -px.view,
-                    px.view.dot(px.ng) < 0.0,
-                );
                 *c += sun.radiance(px.position, px.ng, px.footprint, &bsdf, j as u32);
             }
         });
+    report.reflections = (marched_pixels.into_inner(), unanswered.into_inner());
     timed(
         if sun.is_some() {
             "compose_sun"
@@ -201,10 +248,14 @@ struct SurfacePixel {
     /// How far the point moves on the surface's plane for a step of one pixel in x and in y
     /// (the footprint the runtime sun's shadow rays spread over).
     footprint: (Vec3, Vec3),
+    /// Emitted radiance at the pixel's UV, where the specular part is marched (which
+    /// replaces the baked non-diffuse radiance that holds the emission); else zero.
+    emission: Vec3,
 }
 
 /// Per pixel, the surface of an object with a material seen there (`None` where there is
-/// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it); and
+/// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it), its
+/// emission where its specular part is marched (`glossy`: [`specular::glossy_allowed`]); and
 /// the milliseconds its raster pass took.
 fn surface_image(
     rec: &Reconstructor,
@@ -213,6 +264,7 @@ fn surface_image(
     t: f32,
     layer: Layer<'_>,
     with_footprint: bool,
+    glossy: bool,
 ) -> (Vec<Option<SurfacePixel>>, f64) {
     let n = camera.pixel_count();
     let Some(proxy) = rec.proxy() else {
@@ -320,9 +372,16 @@ fn surface_image(
             } else {
                 (Vec3::ZERO, Vec3::ZERO)
             };
+            let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
+            let emission = if rec.settings.specular.marches(&material, glossy) {
+                materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
+            } else {
+                Vec3::ZERO
+            };
             Some(SurfacePixel {
                 object: t.object,
-                material: materials.surface(rec.pack(), &t.material.material, uv, uv_footprint),
+                material,
+                emission,
                 position,
                 ng,
                 ns,

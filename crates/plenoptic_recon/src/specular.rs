@@ -1,0 +1,511 @@
+//! Mirror and glossy reflections for the actual camera (docs/architecture.md, "Pack v2";
+//! design.md: "the view-dependent part for the actual camera — reflected and refracted rays
+//! marched through the base views' distance cubes, filtered by roughness").
+//!
+//! The pack's non-diffuse cube holds a surface's specular radiance as its *base view* saw
+//! it: a mirror shows, from anywhere, what it reflected towards the base view. For surfaces
+//! that need it ([`Specular::Marched`]: no transmission, roughness at most the setting's) the
+//! geometry-assisted mode replaces it with
+//!
+//! `emission(uv) + W(n·ω_o) · L_in(reflect(−ω_o, n))`
+//!
+//! - `L_in` is found by marching the reflected ray through the distance cubes of the frame's
+//!   base views at the bracketing time keys, the way screen-space reflections march a depth
+//!   buffer (thesis ch. 6: a base view's range image holds the radiance field around it).
+//!   Along the ray `x(s) = p + s·r` the point is projected into the view's cube; the ray has
+//!   hit where `|x(s) − c|` first passes the cube's distance `D(x(s) − c)`. The crossing is
+//!   refined by bisection and accepted only when the ray meets the stored surface there (the
+//!   distance step is within the tolerance); a crossing at a silhouette means the ray went
+//!   behind what the view saw, and that view cannot answer. The radiance is the view's
+//!   radiance cube around the hit direction, blended between the two keys.
+//! - Steps follow the cube's texels: each advances the projected point by about one texel.
+//! - A ray that meets nothing within the scene's bounds sees the environment.
+//! - Roughness: the hit's radiance is averaged over the cone of the GGX lobe (half-angle
+//!   `2α`, α = roughness²) as it appears from the base view at the hit's distance, a 5 × 5
+//!   Gaussian-weighted set of directions, cone-traced reflections' prefiltering done on the
+//!   unfiltered cube.
+//! - `W` is the lobe's directional albedo: for ideal mirrors the tracer's own Fresnel (the
+//!   exact dielectric one, Schlick's for metals); for glossy lobes Karis's analytic fit of
+//!   the split-sum GGX term (B. Karis, "Physically Based Shading on Mobile", 2014), with F₀
+//!   from the IOR and the metalness.
+//! - Views are weighted by their view-space weight and by how close their direction to the
+//!   hit is to the ray's (the hit surface may be glossy too). A pixel no view answers keeps
+//!   the baked non-diffuse radiance.
+//!
+//! Transmission keeps the baked radiance: the cube stores the glass's first surface, so a
+//! ray refracted into it is behind the stored distance at once.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use plenoptic_pack::cube::direction_to_texel;
+use plenoptic_pack::{CubeImage, LightKind, plenoptic_sky::PlacedEnvironment};
+
+use crate::Reconstructor;
+use crate::brdf::{DELTA_ROUGHNESS, SurfaceMaterial, fresnel_dielectric, fresnel_schlick};
+use crate::temporal::bracketing;
+
+/// How the geometry-assisted mode shows the specular part of surfaces with a material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Specular {
+    /// The non-diffuse radiance the base views saw (highlights and reflections frozen at the
+    /// base views' positions). What the plugin's GPU path shows today.
+    Baked,
+    /// Surfaces without transmission reflect for the actual camera, marched through the
+    /// distance cubes ([`crate::specular`]): ideal mirrors always, glossy surfaces whose
+    /// perceptual roughness is at most `max_roughness` when no punctual light's highlight is
+    /// baked ([`glossy_allowed`]); the others keep [`Specular::Baked`]. Costs a march per
+    /// such pixel (up to [`MAX_STEPS`] cube lookups per view).
+    Marched {
+        /// Roughest surface marched (rougher reflections are blurred enough that the base
+        /// views' serve).
+        max_roughness: f32,
+    },
+}
+
+impl Default for Specular {
+    fn default() -> Self {
+        Specular::Marched {
+            max_roughness: 0.45,
+        }
+    }
+}
+
+impl Specular {
+    /// Whether a surface of material `m` is marched; `glossy`: whether glossy surfaces may
+    /// be ([`glossy_allowed`]).
+    pub fn marches(&self, m: &SurfaceMaterial, glossy: bool) -> bool {
+        match *self {
+            Specular::Baked => false,
+            Specular::Marched { max_roughness } => {
+                m.transmission <= 0.0
+                    && (m.roughness < DELTA_ROUGHNESS || (glossy && m.roughness <= max_roughness))
+            }
+        }
+    }
+}
+
+/// Whether glossy surfaces of `rec`'s pack may be marched: only when every light's direct
+/// highlight is evaluated at runtime, that is, the pack's only punctual light is the runtime
+/// sun. A point or spot light has no geometry in the cubes, and the pack stores no light
+/// positions, so a glossy surface's highlight of one exists only in the baked non-diffuse
+/// radiance (an ideal mirror has none: the tracer's delta lobes take no light samples).
+pub fn glossy_allowed(rec: &Reconstructor) -> bool {
+    let lights = &rec.pack().manifest().lights;
+    let directional = lights
+        .iter()
+        .filter(|l| matches!(l.kind, LightKind::Directional))
+        .count();
+    let runtime = usize::from(rec.runtime_sun().is_some());
+    directional == lights.len() && directional <= runtime
+}
+
+/// Roughness below which a surface is an ideal mirror (one ray).
+pub(crate) const DELTA: f32 = DELTA_ROUGHNESS;
+/// Rays per pixel on a glossy surface ([`Reflections::lobe`]).
+pub const GLOSSY_RAYS: usize = 8;
+/// Most march steps per view.
+pub const MAX_STEPS: usize = 160;
+/// Bisection steps refining a crossing.
+const REFINE_STEPS: usize = 6;
+
+/// One base view's cubes for the reflection march.
+struct MarchView {
+    centre: Vec3,
+    weight: f32,
+    /// The distance cube of the nearer bracketing key.
+    distance: Arc<CubeImage<f32>>,
+    /// Radiance cubes of the bracketing keys and their time weights.
+    radiance: Vec<(Arc<CubeImage<Vec3>>, f32)>,
+    /// The angle a texel subtends at the face centre.
+    texel_angle: f32,
+}
+
+/// The base views' cubes at one time, ready to answer reflected rays.
+pub(crate) struct Reflections {
+    views: Vec<MarchView>,
+    environment: PlacedEnvironment,
+    /// How far a ray is marched before it counts as leaving the scene.
+    far: f32,
+    depth_tolerance: f32,
+    angular_power: f32,
+}
+
+impl Reflections {
+    /// The cubes of the views blended for a camera at `position` at time `t` (unreadable
+    /// keys are listed in `missing` and left out).
+    pub fn new(rec: &Reconstructor, position: Vec3, t: f32, missing: &mut Vec<String>) -> Self {
+        let manifest = rec.pack().manifest();
+        let mut views = Vec::new();
+        for (v, w) in rec.view_weights(position) {
+            let bv = &manifest.base_views[v];
+            let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
+                continue;
+            };
+            let keys: Vec<(usize, f32)> = if k0 == k1 {
+                vec![(k0, 1.0)]
+            } else {
+                vec![(k0, 1.0 - s), (k1, s)]
+            };
+            let mut radiance = Vec::new();
+            let mut distance = None;
+            for &(k, wk) in &keys {
+                let Some(cubes) = rec.key_cubes(v, k, missing) else {
+                    continue;
+                };
+                // The nearer key's distances guide the march.
+                if distance.is_none() || wk > 0.5 {
+                    distance = Some(cubes.distance.clone());
+                }
+                radiance.push((cubes.radiance, wk));
+            }
+            let Some(distance) = distance else { continue };
+            let sum: f32 = radiance.iter().map(|r| r.1).sum();
+            if sum <= 0.0 {
+                continue;
+            }
+            for r in &mut radiance {
+                r.1 /= sum;
+            }
+            let face = distance.face_size.max(1) as f32;
+            views.push(MarchView {
+                centre: bv.position,
+                weight: w,
+                texel_angle: 2.0 / face,
+                distance,
+                radiance,
+            });
+        }
+        let bounds = manifest.scene_bounds;
+        let extent = (bounds.max - bounds.min).length();
+        let far = if extent.is_finite() && extent > 0.0 {
+            extent * 1.5
+        } else {
+            100.0
+        };
+        Reflections {
+            views,
+            environment: rec.environment().at(t),
+            far,
+            depth_tolerance: rec.settings.depth_tolerance,
+            angular_power: rec.settings.angular_power,
+        }
+    }
+
+    /// Radiance arriving at `origin` along unit direction `dir`, averaged over a cone of
+    /// half-angle `cone` (radians): `None` where no base view can tell.
+    pub fn incoming(&self, origin: Vec3, dir: Vec3, cone: f32) -> Option<Vec3> {
+        let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
+        let mut escaped = false;
+        for v in &self.views {
+            match self.march(v, origin, dir) {
+                March::Hit { s, point } => {
+                    let to = point - v.centre;
+                    let d = to.length();
+                    let cos = to.dot(dir) / d.max(1e-6);
+                    let w = v.weight * ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power);
+                    // The lobe's cone, as wide as it is at the hit, seen from the view.
+                    let angle = (cone * s / d.max(1e-3)).min(0.5);
+                    sum += self.fetch(v, to, angle) * w;
+                    total += w;
+                }
+                March::Escaped => escaped = true,
+                March::Hidden => {}
+            }
+        }
+        if total > 0.0 {
+            Some(sum / total)
+        } else if escaped {
+            Some(self.environment.radiance(dir))
+        } else {
+            None
+        }
+    }
+
+    /// Radiance arriving at `origin` over a GGX lobe of roughness `alpha` (α = perceptual²)
+    /// around normal `n`, seen from `wo`: the mean of [`Reflections::incoming`] over
+    /// [`GLOSSY_RAYS`] directions reflected about half-vectors drawn from the lobe's
+    /// distribution `D(h)(n·h)` (a Hammersley set turned by `turn` ∈ [0, 1), per pixel), each
+    /// averaged over a cone a third of the lobe's width. `None` where no direction is
+    /// answered.
+    pub fn lobe(&self, origin: Vec3, n: Vec3, wo: Vec3, alpha: f32, turn: f32) -> Option<Vec3> {
+        let (a, b) = n.any_orthonormal_pair();
+        let (mut sum, mut count) = (Vec3::ZERO, 0u32);
+        for k in 0..GLOSSY_RAYS {
+            let u1 = (k as f32 + 0.5) / GLOSSY_RAYS as f32;
+            let u2 = ((k as u32).reverse_bits() as f32 / 4_294_967_296.0 + turn).fract();
+            let tan2 = alpha * alpha * u1 / (1.0 - u1);
+            let cos_h = 1.0 / (1.0 + tan2).sqrt();
+            let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+            let phi = std::f32::consts::TAU * u2;
+            let h = n * cos_h + (a * phi.cos() + b * phi.sin()) * sin_h;
+            let wi = h * (2.0 * wo.dot(h)) - wo;
+            if wi.dot(n) <= 0.0 {
+                continue;
+            }
+            if let Some(l) = self.incoming(origin, wi, 0.7 * alpha) {
+                sum += l;
+                count += 1;
+            }
+        }
+        (count > 0).then(|| sum / count as f32)
+    }
+
+    /// Marches the ray through `v`'s distance cube.
+    fn march(&self, v: &MarchView, origin: Vec3, dir: Vec3) -> March {
+        let cube = &v.distance;
+        // Signed gap between the point's distance from the view and the cube's there
+        // (negative: in front of what the view saw).
+        let gap = |s: f32| -> (f32, f32) {
+            let q = origin + dir * s - v.centre;
+            let d = q.length();
+            let stored = cube.texels[direction_to_texel(cube.face_size, q)];
+            (d - stored, d)
+        };
+        let start = gap(0.0).1;
+        // Leave the surface the ray starts on: its own texels may be a texel's depth off.
+        let mut s = (start * v.texel_angle).max(0.01);
+        let mut prev_s = 0.0;
+        for _ in 0..MAX_STEPS {
+            if s > self.far {
+                return March::Escaped;
+            }
+            let (g, d) = gap(s);
+            if g > 0.0 {
+                // Crossed between prev_s and s: refine.
+                let (mut lo, mut hi) = (prev_s, s);
+                let mut g_hi = g;
+                for _ in 0..REFINE_STEPS {
+                    let mid = 0.5 * (lo + hi);
+                    let (gm, _) = gap(mid);
+                    if gm > 0.0 {
+                        hi = mid;
+                        g_hi = gm;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                let point = origin + dir * hi;
+                let d_hit = (point - v.centre).length();
+                // A surface (not a silhouette the ray went behind): the step in distance is
+                // within the tolerance, or the last step's size along the view's ray.
+                let step = (hi - lo) + d_hit * v.texel_angle;
+                if g_hi <= self.depth_tolerance * d_hit + step {
+                    return March::Hit { s: hi, point };
+                }
+                return March::Hidden;
+            }
+            prev_s = s;
+            // About one texel of the view's cube per step: the point moves across the view's
+            // rays at sin θ of its speed along the ray.
+            let q = (origin + dir * s - v.centre) / d.max(1e-6);
+            let sin = q.cross(dir).length().max(0.15);
+            s += (d * v.texel_angle / sin).clamp(0.005, 1.0);
+        }
+        March::Hidden
+    }
+
+    /// `v`'s radiance around direction `to`, over a cone of half-angle `angle`.
+    fn fetch(&self, v: &MarchView, to: Vec3, angle: f32) -> Vec3 {
+        let at = |dir: Vec3| -> Vec3 {
+            v.radiance
+                .iter()
+                .map(|(c, w)| c.texels[direction_to_texel(c.face_size, dir)] * *w)
+                .sum()
+        };
+        let axis = to.normalize_or(Vec3::Z);
+        if angle < 0.5 * v.texel_angle {
+            return at(axis);
+        }
+        let (a, b) = axis.any_orthonormal_pair();
+        let (mut sum, mut total) = (Vec3::ZERO, 0.0);
+        for i in -2i32..=2 {
+            for j in -2i32..=2 {
+                let w = (-0.5 * (i * i + j * j) as f32).exp();
+                let off = (a * i as f32 + b * j as f32) * (0.5 * angle);
+                sum += at(axis + off) * w;
+                total += w;
+            }
+        }
+        sum / total
+    }
+}
+
+/// How a march ended.
+enum March {
+    /// The ray met a surface the view saw, at `s` along it.
+    Hit { s: f32, point: Vec3 },
+    /// It went behind what the view saw: the view cannot tell what it meets.
+    Hidden,
+    /// It left the scene.
+    Escaped,
+}
+
+/// The specular lobe's directional albedo at a surface of material `m` seen at
+/// `cos_o = n·ω_o`, entering a medium of relative IOR `eta` (1/IOR on a back face): what
+/// the incoming radiance along the reflected ray is multiplied by.
+pub(crate) fn reflectance(m: &SurfaceMaterial, cos_o: f32, eta: f32) -> Vec3 {
+    let cos_o = cos_o.clamp(1e-4, 1.0);
+    let metal = m.metallic;
+    if m.roughness < DELTA_ROUGHNESS {
+        return Vec3::splat((1.0 - metal) * fresnel_dielectric(cos_o, eta))
+            + fresnel_schlick(m.base, cos_o) * metal;
+    }
+    let f0_dielectric = ((eta - 1.0) / (eta + 1.0)).powi(2);
+    let f0 = Vec3::splat(f0_dielectric * (1.0 - metal)) + m.base * metal;
+    // Karis 2014: the split-sum GGX term's scale and bias as a function of roughness and n·v.
+    let r = m.roughness;
+    let (c0, c1) = ([-1.0, -0.0275, -0.572, 0.022], [1.0, 0.0425, 1.04, -0.04]);
+    let rr: [f32; 4] = std::array::from_fn(|k| r * c0[k] + c1[k]);
+    let a004 = (rr[0] * rr[0]).min((-9.28 * cos_o).exp2()) * rr[0] + rr[1];
+    let scale = -1.04 * a004 + rr[2];
+    let bias = 1.04 * a004 + rr[3];
+    (f0 * scale + Vec3::splat(bias)).max(Vec3::ZERO)
+}
+
+/// Half-angle, radians, of the cone a GGX lobe of perceptual roughness `roughness` reflects
+/// into (0 for ideal mirrors).
+pub(crate) fn cone(roughness: f32) -> f32 {
+    if roughness < DELTA_ROUGHNESS {
+        0.0
+    } else {
+        (2.0 * roughness * roughness).min(1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metal(base: Vec3, roughness: f32) -> SurfaceMaterial {
+        SurfaceMaterial {
+            base,
+            metallic: 1.0,
+            roughness,
+            transmission: 0.0,
+            ior: 1.5,
+        }
+    }
+
+    #[test]
+    fn a_mirror_reflects_its_base_colour_head_on_and_everything_at_grazing() {
+        let m = metal(Vec3::splat(0.9), 0.0);
+        let head_on = reflectance(&m, 1.0, 1.5);
+        assert!(
+            (head_on - Vec3::splat(0.9)).abs().max_element() < 1e-4,
+            "{head_on}"
+        );
+        let grazing = reflectance(&m, 0.01, 1.5);
+        assert!(grazing.min_element() > 0.94, "{grazing}");
+        // Glass head on: 4 %.
+        let glass = SurfaceMaterial { metallic: 0.0, ..m };
+        assert!((reflectance(&glass, 1.0, 1.5).x - 0.04).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_glossy_fit_meets_the_mirror_and_falls_with_roughness() {
+        let smooth = reflectance(&metal(Vec3::splat(0.9), 0.03), 0.8, 1.5);
+        let mirror = reflectance(&metal(Vec3::splat(0.9), 0.0), 0.8, 1.5);
+        assert!(
+            (smooth - mirror).abs().max_element() < 0.03,
+            "{smooth} {mirror}"
+        );
+        let rough = reflectance(&metal(Vec3::splat(0.9), 0.8), 0.8, 1.5);
+        assert!(rough.x < smooth.x, "{rough} {smooth}");
+        assert!(cone(0.0) == 0.0 && cone(0.4) > cone(0.2));
+    }
+
+    #[test]
+    fn only_opaque_smooth_surfaces_are_marched() {
+        let s = Specular::default();
+        assert!(s.marches(&metal(Vec3::ONE, 0.0), false));
+        assert!(s.marches(&metal(Vec3::ONE, 0.4), true));
+        assert!(!s.marches(&metal(Vec3::ONE, 0.4), false));
+        assert!(!s.marches(&metal(Vec3::ONE, 0.5), true));
+        let glass = SurfaceMaterial {
+            transmission: 1.0,
+            ..metal(Vec3::ONE, 0.0)
+        };
+        assert!(!s.marches(&glass, true));
+        assert!(!Specular::Baked.marches(&metal(Vec3::ONE, 0.0), true));
+    }
+
+    /// A view at the origin inside a box room of half-size 2 whose walls have distinct
+    /// radiance; a ray from a point on the floor towards +x must find the +x wall.
+    #[test]
+    fn a_march_finds_the_wall_the_ray_meets() {
+        let n = 32;
+        let room = |dir: Vec3| {
+            let a = dir.abs();
+            2.0 / a.max_element()
+        };
+        let colour = |dir: Vec3| {
+            let (face, _, _) = plenoptic_pack::cube::direction_to_face_uv(dir);
+            Vec3::splat(face as f32 + 1.0)
+        };
+        let distance = Arc::new(CubeImage::from_fn(n, |_, d| room(d)));
+        let radiance = Arc::new(CubeImage::from_fn(n, |_, d| colour(d)));
+        let r = Reflections {
+            views: vec![MarchView {
+                centre: Vec3::ZERO,
+                weight: 1.0,
+                distance,
+                radiance: vec![(radiance, 1.0)],
+                texel_angle: 2.0 / n as f32,
+            }],
+            environment: PlacedEnvironment::Uniform(Vec3::splat(-1.0)),
+            far: 20.0,
+            depth_tolerance: 0.03,
+            angular_power: 8.0,
+        };
+        // From the floor (y = −2) up and towards +x: meets the +x wall (face 0) at y ≈ −1.
+        let origin = Vec3::new(1.0, -2.0, 0.3);
+        let dir = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let hit = r.incoming(origin, dir, 0.0).unwrap();
+        assert_eq!(hit, Vec3::splat(1.0));
+        // Straight up: the ceiling (face 2).
+        assert_eq!(r.incoming(origin, Vec3::Y, 0.0).unwrap(), Vec3::splat(3.0));
+        // A cone averages neighbouring texels: still the ceiling's colour in its middle.
+        let blurred = r.incoming(Vec3::new(0.0, -2.0, 0.0), Vec3::Y, 0.2).unwrap();
+        assert!((blurred - Vec3::splat(3.0)).length() < 1e-4, "{blurred}");
+    }
+
+    /// A pillar in front of the view hides part of the room: a ray passing behind it (as the
+    /// view sees it) cannot be answered by that view; with no view left it is `None`, and a
+    /// room with an opening lets the ray escape to the environment.
+    #[test]
+    fn rays_behind_an_occluder_are_hidden_and_openings_escape() {
+        let n = 64;
+        let pillar = |d: Vec3| d.z > 0.0 && (d.x / d.z).abs() < 0.1 && (d.y / d.z).abs() < 0.5;
+        let distance = Arc::new(CubeImage::from_fn(n, |_, d| {
+            if pillar(d) {
+                0.5 / d.z
+            } else if d.x > 0.9 * d.length() {
+                f32::INFINITY // an opening towards +x
+            } else {
+                2.0 / d.abs().max_element()
+            }
+        }));
+        let radiance = Arc::new(CubeImage::filled(n, Vec3::ONE));
+        let r = Reflections {
+            views: vec![MarchView {
+                centre: Vec3::ZERO,
+                weight: 1.0,
+                distance,
+                radiance: vec![(radiance, 1.0)],
+                texel_angle: 2.0 / n as f32,
+            }],
+            environment: PlacedEnvironment::Uniform(Vec3::splat(7.0)),
+            far: 20.0,
+            depth_tolerance: 0.03,
+            angular_power: 8.0,
+        };
+        // From a point the view sees, along −x: it passes behind the pillar (as the view sees
+        // it) before it could meet the −x wall.
+        let behind = r.incoming(Vec3::new(0.3, 0.0, 0.6), Vec3::NEG_X, 0.0);
+        assert_eq!(behind, None);
+        // Out through the opening.
+        let out = r.incoming(Vec3::new(0.5, 0.0, 0.0), Vec3::X, 0.0);
+        assert_eq!(out, Some(Vec3::splat(7.0)));
+    }
+}
