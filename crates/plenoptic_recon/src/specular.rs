@@ -422,6 +422,23 @@ mod tests {
         assert!(!Specular::Baked.marches(&metal(Vec3::ONE, 0.0), true));
     }
 
+    /// One view at the origin with these cubes, under a uniform environment.
+    fn one_view(distance: CubeImage<f32>, radiance: CubeImage<Vec3>, sky: Vec3) -> Reflections {
+        Reflections {
+            views: vec![MarchView {
+                centre: Vec3::ZERO,
+                weight: 1.0,
+                texel_angle: 2.0 / distance.face_size as f32,
+                distance: Arc::new(distance),
+                radiance: vec![(Arc::new(radiance), 1.0)],
+            }],
+            environment: PlacedEnvironment::Uniform(sky),
+            far: 20.0,
+            depth_tolerance: 0.03,
+            angular_power: 8.0,
+        }
+    }
+
     /// A view at the origin inside a box room of half-size 2 whose walls have distinct
     /// radiance; a ray from a point on the floor towards +x must find the +x wall.
     #[test]
@@ -435,21 +452,11 @@ mod tests {
             let (face, _, _) = plenoptic_pack::cube::direction_to_face_uv(dir);
             Vec3::splat(face as f32 + 1.0)
         };
-        let distance = Arc::new(CubeImage::from_fn(n, |_, d| room(d)));
-        let radiance = Arc::new(CubeImage::from_fn(n, |_, d| colour(d)));
-        let r = Reflections {
-            views: vec![MarchView {
-                centre: Vec3::ZERO,
-                weight: 1.0,
-                distance,
-                radiance: vec![(radiance, 1.0)],
-                texel_angle: 2.0 / n as f32,
-            }],
-            environment: PlacedEnvironment::Uniform(Vec3::splat(-1.0)),
-            far: 20.0,
-            depth_tolerance: 0.03,
-            angular_power: 8.0,
-        };
+        let r = one_view(
+            CubeImage::from_fn(n, |_, d| room(d)),
+            CubeImage::from_fn(n, |_, d| colour(d)),
+            Vec3::splat(-1.0),
+        );
         // From the floor (y = −2) up and towards +x: meets the +x wall (face 0) at y ≈ −1.
         let origin = Vec3::new(1.0, -2.0, 0.3);
         let dir = Vec3::new(1.0, 1.0, 0.0).normalize();
@@ -469,7 +476,7 @@ mod tests {
     fn rays_behind_an_occluder_are_hidden_and_openings_escape() {
         let n = 64;
         let pillar = |d: Vec3| d.z > 0.0 && (d.x / d.z).abs() < 0.1 && (d.y / d.z).abs() < 0.5;
-        let distance = Arc::new(CubeImage::from_fn(n, |_, d| {
+        let distance = CubeImage::from_fn(n, |_, d| {
             if pillar(d) {
                 0.5 / d.z
             } else if d.x > 0.9 * d.length() {
@@ -477,21 +484,8 @@ mod tests {
             } else {
                 2.0 / d.abs().max_element()
             }
-        }));
-        let radiance = Arc::new(CubeImage::filled(n, Vec3::ONE));
-        let r = Reflections {
-            views: vec![MarchView {
-                centre: Vec3::ZERO,
-                weight: 1.0,
-                distance,
-                radiance: vec![(radiance, 1.0)],
-                texel_angle: 2.0 / n as f32,
-            }],
-            environment: PlacedEnvironment::Uniform(Vec3::splat(7.0)),
-            far: 20.0,
-            depth_tolerance: 0.03,
-            angular_power: 8.0,
-        };
+        });
+        let r = one_view(distance, CubeImage::filled(n, Vec3::ONE), Vec3::splat(7.0));
         // From a point the view sees, along −x: it passes behind the pillar (as the view sees
         // it) before it could meet the −x wall.
         let behind = r.incoming(Vec3::new(0.3, 0.0, 0.6), Vec3::NEG_X, 0.0);
