@@ -17,7 +17,8 @@
 //!   refined by bisection and accepted only when the ray meets the stored surface there (the
 //!   distance step is within the tolerance); a crossing at a silhouette means the ray went
 //!   behind what the view saw, and that view cannot answer. The radiance is the view's
-//!   radiance cube around the hit direction, blended between the two keys.
+//!   radiance cube around the hit direction. Each bracketing key is marched in its own
+//!   cubes and weighted by its time weight, as the GPU's per-(view, key) lookups are.
 //! - Steps follow the cube's texels: each advances the projected point by about one texel.
 //! - A ray that meets nothing within the scene's bounds sees the environment.
 //! - Roughness: a glossy surface marches [`GLOSSY_RAYS`] rays reflected about half-vectors
@@ -112,14 +113,13 @@ pub const MAX_STEPS: usize = 160;
 /// Bisection steps refining a crossing.
 const REFINE_STEPS: usize = 6;
 
-/// One base view's cubes for the reflection march.
+/// One base view's cubes at one time key for the reflection march.
 struct MarchView {
     centre: Vec3,
+    /// The view-space weight × the key's time weight.
     weight: f32,
-    /// The distance cube of the nearer bracketing key.
     distance: Arc<CubeImage<f32>>,
-    /// Radiance cubes of the bracketing keys and their time weights.
-    radiance: Vec<(Arc<CubeImage<Vec3>>, f32)>,
+    radiance: Arc<CubeImage<Vec3>>,
     /// The angle a texel subtends at the face centre.
     texel_angle: f32,
 }
@@ -150,34 +150,22 @@ impl Reflections {
             } else {
                 vec![(k0, 1.0 - s), (k1, s)]
             };
-            let mut radiance = Vec::new();
-            let mut distance = None;
-            for &(k, wk) in &keys {
+            // Each key is marched in its own cubes (the GPU's lookups are per view and key).
+            for (k, wk) in keys {
+                if wk <= 0.0 {
+                    continue;
+                }
                 let Some(cubes) = rec.key_cubes(v, k, missing) else {
                     continue;
                 };
-                // The nearer key's distances guide the march.
-                if distance.is_none() || wk > 0.5 {
-                    distance = Some(cubes.distance.clone());
-                }
-                radiance.push((cubes.radiance, wk));
+                views.push(MarchView {
+                    centre: bv.position,
+                    weight: w * wk,
+                    texel_angle: 2.0 / cubes.distance.face_size.max(1) as f32,
+                    distance: cubes.distance,
+                    radiance: cubes.radiance,
+                });
             }
-            let Some(distance) = distance else { continue };
-            let sum: f32 = radiance.iter().map(|r| r.1).sum();
-            if sum <= 0.0 {
-                continue;
-            }
-            for r in &mut radiance {
-                r.1 /= sum;
-            }
-            let face = distance.face_size.max(1) as f32;
-            views.push(MarchView {
-                centre: bv.position,
-                weight: w,
-                texel_angle: 2.0 / face,
-                distance,
-                radiance,
-            });
         }
         let bounds = manifest.scene_bounds;
         let extent = (bounds.max - bounds.min).length();
@@ -310,12 +298,8 @@ impl Reflections {
 
     /// `v`'s radiance around direction `to`, over a cone of half-angle `angle`.
     fn fetch(&self, v: &MarchView, to: Vec3, angle: f32) -> Vec3 {
-        let at = |dir: Vec3| -> Vec3 {
-            v.radiance
-                .iter()
-                .map(|(c, w)| c.texels[direction_to_texel(c.face_size, dir)] * *w)
-                .sum()
-        };
+        let c = &v.radiance;
+        let at = |dir: Vec3| -> Vec3 { c.texels[direction_to_texel(c.face_size, dir)] };
         let axis = to.normalize_or(Vec3::Z);
         if angle < 0.5 * v.texel_angle {
             return at(axis);
@@ -430,7 +414,7 @@ mod tests {
                 weight: 1.0,
                 texel_angle: 2.0 / distance.face_size as f32,
                 distance: Arc::new(distance),
-                radiance: vec![(Arc::new(radiance), 1.0)],
+                radiance: Arc::new(radiance),
             }],
             environment: PlacedEnvironment::Uniform(sky),
             far: 20.0,
