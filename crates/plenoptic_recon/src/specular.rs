@@ -43,7 +43,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use plenoptic_pack::cube::direction_to_texel;
-use plenoptic_pack::{CubeImage, LightKind, plenoptic_sky::PlacedEnvironment};
+use plenoptic_pack::{CubeImage, LightKind, Manifest, plenoptic_sky::PlacedEnvironment};
 
 use crate::Reconstructor;
 use crate::brdf::{DELTA_ROUGHNESS, SurfaceMaterial, fresnel_dielectric, fresnel_schlick};
@@ -95,13 +95,30 @@ impl Specular {
 /// positions, so a glossy surface's highlight of one exists only in the baked non-diffuse
 /// radiance (an ideal mirror has none: the tracer's delta lobes take no light samples).
 pub fn glossy_allowed(rec: &Reconstructor) -> bool {
-    let lights = &rec.pack().manifest().lights;
+    glossy_allowed_in(rec.pack().manifest(), rec.runtime_sun().is_some())
+}
+
+/// [`glossy_allowed`] for a pack with `manifest`, which leaves its sun to the runtime when
+/// `runtime_sun` (the GPU path decides with this).
+pub fn glossy_allowed_in(manifest: &Manifest, runtime_sun: bool) -> bool {
+    let lights = &manifest.lights;
     let directional = lights
         .iter()
         .filter(|l| matches!(l.kind, LightKind::Directional))
         .count();
-    let runtime = usize::from(rec.runtime_sun().is_some());
-    directional == lights.len() && directional <= runtime
+    directional == lights.len() && directional <= usize::from(runtime_sun)
+}
+
+/// How far a reflected ray is marched in a pack with `manifest` before it counts as leaving
+/// the scene: 1.5 × the scene bounds' diagonal, or 100 m without bounds.
+pub fn march_distance(manifest: &Manifest) -> f32 {
+    let bounds = manifest.scene_bounds;
+    let extent = (bounds.max - bounds.min).length();
+    if extent.is_finite() && extent > 0.0 {
+        extent * 1.5
+    } else {
+        100.0
+    }
 }
 
 /// Roughness below which a surface is an ideal mirror (one ray).
@@ -167,17 +184,10 @@ impl Reflections {
                 });
             }
         }
-        let bounds = manifest.scene_bounds;
-        let extent = (bounds.max - bounds.min).length();
-        let far = if extent.is_finite() && extent > 0.0 {
-            extent * 1.5
-        } else {
-            100.0
-        };
         Reflections {
             views,
             environment: rec.environment().at(t),
-            far,
+            far: march_distance(manifest),
             depth_tolerance: rec.settings.depth_tolerance,
             angular_power: rec.settings.angular_power,
         }

@@ -125,7 +125,7 @@ pub struct EnvironmentImages {
 
 impl EnvironmentImages {
     /// The texture of `pack`'s environment image, made on first use.
-    fn get(
+    pub(super) fn get(
         &mut self,
         id: AssetId<RadiancePack>,
         pack: &RadiancePack,

@@ -2,7 +2,9 @@
 // Same lookups and weights as plenoptic_recon::geometry (nearest or seamless bilinear texel, id + distance test,
 // w_view · w_time · ((1 + cos θ)/2)^p), with its volume fallback and hole fill. An object with a
 // material in a 2.0 pack is shaded as plenoptic_recon's shading module does it without textures:
-// albedo (the material's factors) · lighting + non-diffuse, both looked up bilinearly.
+// albedo (the material's factors) · lighting + non-diffuse, both looked up bilinearly; on
+// mirrors and glossy metals the non-diffuse part is replaced by reflections marched for the
+// camera through the lookups' distance cubes (reflect.rs, reflect.wgsl).
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::{view, lights}
@@ -13,6 +15,8 @@
 #import bevy_pbr::prepass_utils
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
+#import plenoptic::environment::{Environment, environment}
+#import plenoptic::reflect::{march, fetch, orthonormal_pair}
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
@@ -46,6 +50,11 @@ struct ReconParams {
     sun: vec4<f32>,
     // Its illuminance at the camera's time (xyz).
     sun_illuminance: vec4<f32>,
+    // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
+    // marched (−1: ideal mirrors only), z: how far rays are marched.
+    specular: vec4<f32>,
+    // The material's emissive factor (xyz).
+    emissive: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -73,6 +82,9 @@ struct ReconParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(7) var base_colour_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(8) var metallic_roughness_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(9) var metallic_roughness_sampler: sampler;
+// The pack's environment at the camera's time, for reflected rays that leave the scene.
+@group(#{MATERIAL_BIND_GROUP}) @binding(10) var<uniform> env: Environment;
+@group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).
 var<private> pixel_albedo: vec3<f32>;
@@ -80,6 +92,8 @@ var<private> pixel_albedo: vec3<f32>;
 var<private> pixel_base: vec3<f32>;
 var<private> pixel_metallic: f32;
 var<private> pixel_roughness: f32;
+// 0 where a marched reflection replaces the baked non-diffuse radiance.
+var<private> non_diffuse_weight: f32 = 1.0;
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
@@ -89,7 +103,7 @@ fn lit() -> bool {
 // The shaded colour of a shading texel: the fragment's albedo · lighting + non-diffuse (in the
 // hole fill, the neighbours' lighting times this fragment's own albedo, as on the CPU).
 fn shaded(s: vec2<u32>) -> vec3<f32> {
-    return pixel_albedo * rgb9e5_decode(s.x) + rgb9e5_decode(s.y);
+    return pixel_albedo * rgb9e5_decode(s.x) + rgb9e5_decode(s.y) * non_diffuse_weight;
 }
 
 // KHR_texture_transform: offset + R(rotation) · (scale ∘ uv).
@@ -353,7 +367,24 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     // The triangle's plane, before any non-uniform branch.
     let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));
-    var c = radiance(in);
+    // The material's albedo at the pixel (derivatives are taken before any non-uniform
+    // branch). Without UVs the smallest level: the texture's mean, as on the CPU.
+#ifdef VERTEX_UVS_A
+    let duv = abs(determinant(mat2x2<f32>(dpdx(in.uv), dpdy(in.uv))));
+    pixel_albedo = material_albedo(in.uv, sqrt(duv));
+#else
+    pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
+#endif
+    var reflected = vec3<f32>(0.0);
+    if lit() && params.fill.z != 1.0 && marched() {
+        let r = reflection(in, ng);
+        if r.w > 0.0 {
+            non_diffuse_weight = 0.0;
+            reflected = params.emissive.xyz + r.rgb;
+        }
+    }
+    var c = radiance(in, ng);
+    c = vec4<f32>(c.rgb + reflected, c.a);
     if lit() && params.sun.w == 1.0 && params.fill.z != 1.0 {
         c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
     }
@@ -369,21 +400,14 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 }
 
 // The reconstructed radiance of the fragment (linear, before exposure).
-fn radiance(in: VertexOutput) -> vec4<f32> {
+// `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
+fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     let object = u32(params.header.y);
     let n = u32(params.header.z);
     let p = in.world_position.xyz;
     let eye = view.world_position;
-    // The material's albedo at the pixel (derivatives are taken before any non-uniform
-    // branch). Without UVs the smallest level: the texture's mean, as on the CPU.
-#ifdef VERTEX_UVS_A
-    let duv = abs(determinant(mat2x2<f32>(dpdx(in.uv), dpdy(in.uv))));
-    pixel_albedo = material_albedo(in.uv, sqrt(duv));
-#else
-    pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
-#endif
     // The surface plane.
-    var nrm = cross(dpdx(p), dpdy(p));
+    var nrm = ng_raw;
     if dot(nrm, nrm) < 1e-20 {
         nrm = in.world_normal;
     }
@@ -529,7 +553,17 @@ fn sun_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32)
 // The sun's direct light towards the eye: BSDF × illuminance × cosine × the shadow of the
 // plugin's sun light (Bevy's cascaded shadow map of the proxies). `ng_raw`: the triangle's
 // plane from the position's derivatives.
-fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
+// The shading frame of a fragment seen from the eye: the shading normal `n` and geometric
+// normal `ng` on the viewer's side (n bent towards the viewer where it faces away, as
+// plenoptic_recon's Bsdf::new), the direction `wo` towards the eye and the relative IOR.
+struct Viewer {
+    n: vec3<f32>,
+    ng: vec3<f32>,
+    wo: vec3<f32>,
+    eta: f32,
+}
+
+fn viewer(in: VertexOutput, ng_raw: vec3<f32>) -> Viewer {
     let p = in.world_position.xyz;
     let wo = normalize(view.world_position - p);
     var ns = normalize(in.world_normal);
@@ -550,7 +584,15 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
         n = select(ng, normalize(n), dot(n, n) > 0.0);
     }
     let ior = select(1.5, params.surface.y, params.surface.y > 0.0);
-    let eta = select(1.0 / ior, ior, front);
+    return Viewer(n, ng, wo, select(1.0 / ior, ior, front));
+}
+
+fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
+    let v = viewer(in, ng_raw);
+    let n = v.n;
+    let ng = v.ng;
+    let wo = v.wo;
+    let eta = v.eta;
     // Surfaces whose every lobe is ideal take no light sample (as the tracer).
     let fd = fresnel_dielectric(clamp(dot(wo, n), 1e-4, 1.0), eta);
     let lum = dot(pixel_base, vec3<f32>(0.2126, 0.7152, 0.0722));
@@ -580,4 +622,120 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
         }
     }
     return f * params.sun_illuminance.xyz * abs(dot(wi, n)) * shadow;
+}
+
+// ---- Reflections for the camera (plenoptic_recon's specular module, the same formulas) ----
+
+// Whether this fragment's surface is marched: no transmission, an ideal mirror, or glossy
+// up to the roughest surface marched.
+fn marched() -> bool {
+    return params.specular.x == 1.0 && params.material.x <= 0.0
+        && (pixel_roughness < 0.02 || pixel_roughness <= params.specular.y);
+}
+
+// Radiance arriving at `origin` along unit `dir`, over a cone of half-angle `cone`, from the
+// lookups' keys: (radiance, 1), or (0, 0) where no lookup can tell.
+fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
+    let count = min(u32(params.header.x), MAX_LOOKUPS);
+    let n = u32(params.header.z);
+    var sum = vec3<f32>(0.0);
+    var total = 0.0;
+    var escaped = false;
+    for (var k = 0u; k < count; k++) {
+        if params.weight[k].x <= 0.0 {
+            continue;
+        }
+        let centre = params.base[k].xyz;
+        let layer0 = u32(params.base[k].w);
+        let m = march(cubes, layer0, n, centre, origin, dir, params.specular.z, params.tuning.x);
+        if m.y == 1.0 {
+            let to = origin + dir * m.x - centre;
+            let d = length(to);
+            let cos = dot(to, dir) / max(d, 1e-6);
+            let w = params.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), params.tuning.y);
+            let angle = min(cone * m.x / max(d, 1e-3), 0.5);
+            sum += fetch(cubes, layer0, n, to, angle) * w;
+            total += w;
+        } else if m.y == 2.0 {
+            escaped = true;
+        }
+    }
+    if total > 0.0 {
+        return vec4<f32>(sum / total, 1.0);
+    }
+    if escaped {
+        return vec4<f32>(environment(env, env_image, dir), 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// The mean radiance over 8 directions reflected about GGX half-vectors (roughness `alpha`)
+// around `n` seen from `wo`, a Hammersley set turned by `turn`.
+fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -> vec4<f32> {
+    let pair = orthonormal_pair(n);
+    var sum = vec3<f32>(0.0);
+    var count = 0.0;
+    for (var k = 0u; k < 8u; k++) {
+        let u1 = (f32(k) + 0.5) / 8.0;
+        let u2 = fract(f32(reverseBits(k)) / 4294967296.0 + turn);
+        let tan2 = alpha * alpha * u1 / (1.0 - u1);
+        let cos_h = 1.0 / sqrt(1.0 + tan2);
+        let sin_h = sqrt(max(1.0 - cos_h * cos_h, 0.0));
+        let phi = 6.28318530717959 * u2;
+        let h = n * cos_h + (pair[0] * cos(phi) + pair[1] * sin(phi)) * sin_h;
+        let wi = h * (2.0 * dot(wo, h)) - wo;
+        if dot(wi, n) <= 0.0 {
+            continue;
+        }
+        let l = incoming(origin, wi, 0.7 * alpha);
+        if l.w > 0.0 {
+            sum += l.rgb;
+            count += 1.0;
+        }
+    }
+    if count > 0.0 {
+        return vec4<f32>(sum / count, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// The specular lobe's directional albedo at n·ω_o = `cos_in`: the exact Fresnel on ideal
+// mirrors, Karis's split-sum fit on glossy surfaces.
+fn reflectance(cos_in: f32, eta: f32) -> vec3<f32> {
+    let cos_o = clamp(cos_in, 1e-4, 1.0);
+    let m = pixel_metallic;
+    if pixel_roughness < 0.02 {
+        return vec3<f32>((1.0 - m) * fresnel_dielectric(cos_o, eta))
+            + fresnel_schlick(pixel_base, cos_o) * m;
+    }
+    let f0 = vec3<f32>(pow((eta - 1.0) / (eta + 1.0), 2.0) * (1.0 - m)) + pixel_base * m;
+    let r = pixel_roughness * vec4<f32>(-1.0, -0.0275, -0.572, 0.022)
+        + vec4<f32>(1.0, 0.0425, 1.04, -0.04);
+    let a004 = min(r.x * r.x, exp2(-9.28 * cos_o)) * r.x + r.y;
+    let scale = -1.04 * a004 + r.z;
+    let bias = 1.04 * a004 + r.w;
+    return max(f0 * scale + vec3<f32>(bias), vec3<f32>(0.0));
+}
+
+// The reflection at this fragment for the camera: (emission-free specular radiance, 1), or
+// (0, 0) where no lookup answers.
+fn reflection(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
+    let v = viewer(in, ng_raw);
+    let cos_o = dot(v.wo, v.n);
+    let origin = in.world_position.xyz;
+    var l: vec4<f32>;
+    if pixel_roughness < 0.02 {
+        let dir = normalize(v.n * (2.0 * cos_o) - v.wo);
+        l = incoming(origin, dir, 0.0);
+    } else {
+        // The pixel's index in the frame, as the CPU's per-pixel turn.
+        let px = vec2<u32>(in.position.xy - view.viewport.xy);
+        let j = px.y * u32(view.viewport.z) + px.x;
+        let turn = fract(f32(j) * 0.618034);
+        l = lobe(origin, v.n, v.wo, pixel_roughness * pixel_roughness, turn);
+    }
+    if l.w == 0.0 {
+        return l;
+    }
+    return vec4<f32>(reflectance(cos_o, v.eta) * l.rgb, 1.0);
 }

@@ -49,6 +49,7 @@
 pub mod background;
 pub mod cpu;
 pub mod image;
+pub mod reflect;
 pub mod sun;
 pub mod upload;
 pub mod volume;
@@ -82,6 +83,10 @@ impl Plugin for PlenopticReconstructPlugin {
     fn build(&self, app: &mut App) {
         // Cube helpers the reconstruction shaders import (`plenoptic::cube`).
         bevy::shader::load_shader_library!(app, "cube.wgsl");
+        // The pack's environment (`plenoptic::environment`) and the reflection march
+        // (`plenoptic::reflect`).
+        bevy::shader::load_shader_library!(app, "environment.wgsl");
+        bevy::shader::load_shader_library!(app, "reflect.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
         background::build(app);
@@ -184,6 +189,13 @@ pub struct PlenopticMaterial {
     #[texture(8)]
     #[sampler(9)]
     pub metallic_roughness_texture: Option<Handle<Image>>,
+    /// The pack's environment at the camera's time: what reflected rays that leave the scene
+    /// see ([`reflect`]).
+    #[uniform(10)]
+    pub environment: background::EnvironmentUniform,
+    /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
+    #[texture(11, sample_type = "float", filterable = false)]
+    pub environment_image: Handle<Image>,
     /// The object's diffuse albedo factors from its material in the pack: base-colour factor
     /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
     /// (the textures multiply per pixel); `None` for an object without a material, which
@@ -256,6 +268,11 @@ pub struct ReconParams {
     pub sun: Vec4,
     /// The runtime sun's illuminance at the camera's time (xyz).
     pub sun_illuminance: Vec4,
+    /// Reflections marched for the camera ([`reflect`]): x: 1 when on, y: the roughest
+    /// glossy surface marched (−1: ideal mirrors only), z: how far rays are marched.
+    pub specular: Vec4,
+    /// The material's emissive factor (xyz), which marched surfaces add.
+    pub emissive: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -302,6 +319,8 @@ fn attach_materials(
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
+    mut env_images: ResMut<background::EnvironmentImages>,
+    mut images: ResMut<Assets<Image>>,
 ) {
     if backend.0 != Backend::Gpu {
         return;
@@ -318,6 +337,7 @@ fn attach_materials(
             continue;
         };
         let factors = material_factors(pack, of.id);
+        let environment_image = env_images.get(scene.pack.id(), pack, &mut images);
         let m = materials.add(PlenopticMaterial {
             cubes: tex.image.clone(),
             params: ReconParams::default(),
@@ -327,6 +347,8 @@ fn attach_materials(
             shading_cubes: tex.shading.clone(),
             base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
+            environment: background::EnvironmentUniform::default(),
+            environment_image,
             albedo: factors,
             coverage: object_coverage(pack, of.id),
         });
@@ -623,6 +645,12 @@ fn update_materials(
             {
                 f.fill(&mut params);
                 sun::fill(&mut params, pack, cam.time);
+                reflect::fill(&mut params, pack, &cam.settings, &f.material);
+                let environment =
+                    background::EnvironmentUniform::new(&pack.environment.at(cam.time));
+                if mat.environment != environment {
+                    mat.environment = environment;
+                }
             }
             mat.params = params;
         }

@@ -1,0 +1,48 @@
+//! Reflections for the actual camera on the GPU (docs/architecture.md, "Pack v2"), as
+//! `plenoptic_recon::specular` makes them on the CPU: on a mirror, or a glossy surface where
+//! no baked lamp's highlight would be lost, the fragment marches the reflected ray through
+//! each lookup's distance cube (`reflect.wgsl`: the same steps, refinement and acceptance),
+//! reads the hit's radiance around it from that key, blends the keys with their lookup
+//! weights × the angular closeness, and shows
+//!
+//! `albedo · lighting + emission + W(n·ω_o) · L_in`
+//!
+//! instead of the baked non-diffuse radiance (`geometry.wgsl`). Glossy lobes march 8 rays
+//! reflected about GGX half-vectors from the same Hammersley set, turned per pixel by the
+//! same golden-ratio sequence; rays that leave the scene see the pack's environment at the
+//! camera's time. Where no lookup answers, the baked non-diffuse radiance stays.
+//!
+//! Not on the GPU: emissive textures on marched surfaces (the emissive factor only).
+
+use bevy::prelude::*;
+use plenoptic_pack::MaterialEntry;
+use plenoptic_recon::Specular;
+use plenoptic_recon::specular::{glossy_allowed_in, march_distance};
+
+use super::ReconParams;
+use crate::asset::RadiancePack;
+use crate::camera::ReconSettings;
+
+/// The uniform's reflection fields for an object of material `material` in `pack`, as the
+/// camera's `settings` ask.
+pub(super) fn fill(
+    params: &mut ReconParams,
+    pack: &RadiancePack,
+    settings: &ReconSettings,
+    material: &MaterialEntry,
+) {
+    let manifest = pack.reader.manifest();
+    params.specular = match settings.specular {
+        Specular::Baked => Vec4::ZERO,
+        Specular::Marched { max_roughness } => {
+            let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());
+            Vec4::new(
+                1.0,
+                if glossy { max_roughness } else { -1.0 },
+                march_distance(manifest),
+                0.0,
+            )
+        }
+    };
+    params.emissive = material.emissive.extend(0.0);
+}
