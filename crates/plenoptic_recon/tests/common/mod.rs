@@ -313,6 +313,10 @@ pub enum Materials {
     /// The factors times a 256 × 256 sRGB checker texture on planar proxy UVs. The analytic
     /// shading's own checker is not the texture's: for speed, not accuracy.
     Textured,
+    /// [`Materials::Factors`], with the left wall an ideal mirror (metal, base 0.9) and the
+    /// right wall glossy metal (roughness 0.3, base 0.8): the geometry-assisted mode marches
+    /// their reflections for the camera ([`plenoptic_recon::Specular::Marched`]).
+    Mirror,
 }
 
 impl PackSpec {
@@ -537,8 +541,13 @@ pub fn write_pack_with(
                 tangents: Vec::new(),
             })
             .unwrap();
+            let (base, metallic, roughness) = match (spec.materials, obj.name.as_str()) {
+                (Materials::Mirror, "left") => (Vec3::splat(0.9), 1.0, 0.0),
+                (Materials::Mirror, "right") => (Vec3::splat(0.8), 1.0, 0.3),
+                _ => (object_colour(i as u32), 0.0, 0.5),
+            };
             manifest.materials.push(plenoptic_pack::MaterialEntry {
-                base_colour: object_colour(i as u32).extend(1.0),
+                base_colour: base.extend(1.0),
                 base_colour_texture: (spec.materials == Materials::Textured).then_some(
                     plenoptic_pack::TextureBinding {
                         texture: 0,
@@ -547,8 +556,8 @@ pub fn write_pack_with(
                         transform: None,
                     },
                 ),
-                metallic: 0.0,
-                roughness: 0.5,
+                metallic,
+                roughness,
                 ..Default::default()
             });
         }
