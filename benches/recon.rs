@@ -6,7 +6,9 @@
 //! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`), and
 //! with pack 3's runtime sun on top (`geometry_sun`: the room with a skylight, the sun's
 //! direct light through each pixel's BSDF with `ReconSettings::sun_shadow_rays` = 4 shadow
-//! rays against the proxies); and
+//! rays against the proxies), and with a mirror and a glossy metal wall whose reflections
+//! are marched for the camera (`geometry_reflections`, `Specular::Marched`) beside the same
+//! pack with the baked specular (`geometry_reflections_baked`); and
 //! the reference path tracer's time for the same frame, as a ratio
 //! measured in the same run. The chunk cache is warm (decoded cubes, interleaved texels and
 //! binned volume blocks are built on the first frame), as in a walk-through.
@@ -21,7 +23,7 @@ use std::time::Instant;
 
 use common::*;
 use criterion::{Criterion, criterion_group, criterion_main};
-use plenoptic_recon::{Camera, CubeFilter, Mode, Reconstructor};
+use plenoptic_recon::{Camera, CubeFilter, Mode, Reconstructor, Specular};
 use plenoptic_trace::glam::Vec3;
 use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
 
@@ -73,6 +75,20 @@ fn bench(c: &mut Criterion) {
         &sun_path,
     );
     let sun = Reconstructor::open(&sun_path).unwrap();
+    // A mirror and a glossy metal wall: reflections marched for the camera, against the same
+    // pack with the baked specular.
+    let mirror_path = dir.path().join("mirror.pack");
+    write_pack(
+        &scene,
+        &PackSpec {
+            materials: Materials::Mirror,
+            ..spec.clone()
+        },
+        &mirror_path,
+    );
+    let mirror = Reconstructor::open(&mirror_path).unwrap();
+    let mut mirror_baked = Reconstructor::open(&mirror_path).unwrap();
+    mirror_baked.settings.specular = Specular::Baked;
     let mut group = c.benchmark_group("recon");
     group.sample_size(10);
     for (w, h) in [(640, 360), (1280, 720)] {
@@ -96,6 +112,15 @@ fn bench(c: &mut Criterion) {
         assert!(sun.runtime_sun().is_some(), "{:?}", report.missing);
         group.bench_function(format!("geometry_sun/{w}x{h}"), |b| {
             b.iter(|| black_box(sun.render(black_box(&cam), T, mode).unwrap()))
+        });
+        let (_, report) = mirror.render(&cam, T, mode).unwrap();
+        assert!(report.reflections.0 > 0, "{:?}", report.reflections);
+        let _ = mirror_baked.render(&cam, T, mode).unwrap();
+        group.bench_function(format!("geometry_reflections/{w}x{h}"), |b| {
+            b.iter(|| black_box(mirror.render(black_box(&cam), T, mode).unwrap()))
+        });
+        group.bench_function(format!("geometry_reflections_baked/{w}x{h}"), |b| {
+            b.iter(|| black_box(mirror_baked.render(black_box(&cam), T, mode).unwrap()))
         });
     }
     let accel = SceneAccel::new(&scene).unwrap();
