@@ -19,7 +19,8 @@
 //!   behind what the view saw, and that view cannot answer. The radiance is the view's
 //!   radiance cube around the hit direction. Each bracketing key is marched in its own
 //!   cubes and weighted by its time weight, as the GPU's per-(view, key) lookups are.
-//! - Steps follow the cube's texels: each advances the projected point by about one texel.
+//! - Steps follow the cube's texels: each advances the projected point by about
+//!   [`STEP_TEXELS`] texels.
 //! - A ray that meets nothing within the scene's bounds sees the environment.
 //! - Roughness: a glossy surface marches [`GLOSSY_RAYS`] rays reflected about half-vectors
 //!   drawn from the GGX distribution (α = roughness², a Hammersley set turned per pixel),
@@ -127,6 +128,10 @@ pub(crate) const DELTA: f32 = DELTA_ROUGHNESS;
 pub const GLOSSY_RAYS: usize = 8;
 /// Most march steps per view.
 pub const MAX_STEPS: usize = 160;
+/// Cube texels the projected point moves per march step: the bisection finds the crossing
+/// within a step, and surfaces thinner than a step may be skipped. 2 halves the cost of 1
+/// and left the `specular` test's figures unchanged.
+pub const STEP_TEXELS: f32 = 2.0;
 /// Bisection steps refining a crossing.
 const REFINE_STEPS: usize = 6;
 
@@ -297,11 +302,11 @@ impl Reflections {
                 return March::Hidden;
             }
             prev_s = s;
-            // About one texel of the view's cube per step: the point moves across the view's
-            // rays at sin θ of its speed along the ray.
+            // About STEP_TEXELS texels of the view's cube per step: the point moves across the
+            // view's rays at sin θ of its speed along the ray.
             let q = (origin + dir * s - v.centre) / d.max(1e-6);
             let sin = q.cross(dir).length().max(0.15);
-            s += (d * v.texel_angle / sin).clamp(0.005, 1.0);
+            s += (STEP_TEXELS * d * v.texel_angle / sin).clamp(0.005, 1.0);
         }
         March::Hidden
     }

@@ -9,6 +9,8 @@
 
 const MAX_STEPS: u32 = 160u;
 const REFINE_STEPS: u32 = 6u;
+// Cube texels the projected point moves per step.
+const STEP_TEXELS: f32 = 2.0;
 
 // (|x(s) − centre| − the cube's distance there, |x(s) − centre|).
 fn gap(cubes: texture_2d_array<u32>, layer0: u32, n: u32, centre: vec3<f32>, origin: vec3<f32>, dir: vec3<f32>, s: f32) -> vec2<f32> {
@@ -56,7 +58,7 @@ fn march(cubes: texture_2d_array<u32>, layer0: u32, n: u32, centre: vec3<f32>, o
         prev_s = s;
         let q = (origin + dir * s - centre) / max(g.y, 1e-6);
         let sin = max(length(cross(q, dir)), 0.15);
-        s += clamp(g.y * texel_angle / sin, 0.005, 1.0);
+        s += clamp(STEP_TEXELS * g.y * texel_angle / sin, 0.005, 1.0);
     }
     return vec2<f32>(0.0, 0.0);
 }
