@@ -115,6 +115,11 @@ fn bench(c: &mut Criterion) {
         });
         let (_, report) = mirror.render(&cam, T, mode).unwrap();
         assert!(report.reflections.0 > 0, "{:?}", report.reflections);
+        eprintln!(
+            "geometry_reflections/{w}x{h}: {:.1} % of the pixels marched, {} of them unanswered",
+            100.0 * report.reflections.0 as f64 / (w * h) as f64,
+            report.reflections.1
+        );
         let _ = mirror_baked.render(&cam, T, mode).unwrap();
         group.bench_function(format!("geometry_reflections/{w}x{h}"), |b| {
             b.iter(|| black_box(mirror.render(black_box(&cam), T, mode).unwrap()))

@@ -137,9 +137,7 @@ impl Materials {
             ior: if m.ior > 0.0 { m.ior } else { 1.5 },
         }
     }
-}
 
-impl Materials {
     /// The emitted radiance of material `m` at `uv`: the emissive factor × its sRGB texture,
     /// with the mip chosen from `footprint` as in [`Materials::surface`].
     pub fn emission(&self, pack: &PackReader, m: &MaterialEntry, uv: Vec2, footprint: f32) -> Vec3 {

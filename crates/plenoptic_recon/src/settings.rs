@@ -54,7 +54,7 @@ pub struct ReconSettings {
     /// How the geometry-assisted mode shows the specular part of surfaces with a material:
     /// as the base views saw it, or for the actual camera by marching the reflected ray
     /// through the distance cubes ([`crate::specular`]; the default, for mirrors and glossy
-    /// metals). The plugin's GPU path shows [`Specular::Baked`] today.
+    /// metals). The plugin's GPU path follows the camera's setting.
     pub specular: Specular,
 }
 

@@ -38,7 +38,7 @@ use glam::{Vec2, Vec3};
 use plenoptic_pack::{ChunkKind, VolumeSample};
 use rayon::prelude::*;
 
-use crate::brdf::{Bsdf, SurfaceMaterial};
+use crate::brdf::{Bsdf, DELTA_ROUGHNESS, SurfaceMaterial};
 use crate::camera::Camera;
 use crate::frame::{Frame, Report};
 use crate::geometry::{self, Layer, Pass};
@@ -155,11 +155,7 @@ pub(crate) fn render(
         surface_image(rec, materials, camera, t, layer, sun.is_some(), glossy);
     timed("albedo", start);
     let start = std::time::Instant::now();
-    let marched = surface
-        .iter()
-        .flatten()
-        .any(|px| rec.settings.specular.marches(&px.material, glossy));
-    let reflections = if marched {
+    let reflections = if surface.iter().flatten().any(|px| px.marched) {
         Some(Reflections::new(
             rec,
             camera.position,
@@ -179,12 +175,15 @@ pub(crate) fn render(
             if lighting.object[j] != px.object {
                 return;
             }
+            // The BSDF only where the sun or a reflection needs it.
             let front = px.view.dot(px.ng) < 0.0;
-            let bsdf = Bsdf::new(px.material, px.ng, px.ns, -px.view, front);
+            let bsdf = (sun.is_some() || px.marched)
+                .then(|| Bsdf::new(px.material, px.ng, px.ns, -px.view, front));
             let specular = reflections
                 .as_ref()
-                .filter(|_| rec.settings.specular.marches(&px.material, glossy))
-                .and_then(|r| {
+                .zip(bsdf.as_ref())
+                .filter(|_| px.marched)
+                .and_then(|(r, bsdf)| {
                     let n = bsdf.normal();
                     let cos_o = -px.view.dot(n);
                     let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
@@ -194,7 +193,7 @@ pub(crate) fn render(
                         1.0 / px.material.ior
                     };
                     let alpha = px.material.roughness * px.material.roughness;
-                    let incoming = if px.material.roughness < specular::DELTA {
+                    let incoming = if px.material.roughness < DELTA_ROUGHNESS {
                         r.incoming(px.position, dir, 0.0)
                     } else {
                         // A per-pixel turn of the lobe's directions (golden-ratio sequence).
@@ -209,8 +208,8 @@ pub(crate) fn render(
                 });
             *c = px.material.albedo() * lighting.radiance[j]
                 + specular.unwrap_or(non_diffuse.radiance[j]);
-            if let Some(sun) = &sun {
-                *c += sun.radiance(px.position, px.ng, px.footprint, &bsdf, j as u32);
+            if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {
+                *c += sun.radiance(px.position, px.ng, px.footprint, bsdf, j as u32);
             }
         });
     report.reflections = (marched_pixels.into_inner(), unanswered.into_inner());
@@ -248,6 +247,8 @@ struct SurfacePixel {
     /// How far the point moves on the surface's plane for a step of one pixel in x and in y
     /// (the footprint the runtime sun's shadow rays spread over).
     footprint: (Vec3, Vec3),
+    /// Whether its specular part is marched for the camera ([`specular::Specular::marches`]).
+    marched: bool,
     /// Emitted radiance at the pixel's UV, where the specular part is marched (which
     /// replaces the baked non-diffuse radiance that holds the emission); else zero.
     emission: Vec3,
@@ -373,7 +374,8 @@ fn surface_image(
                 (Vec3::ZERO, Vec3::ZERO)
             };
             let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
-            let emission = if rec.settings.specular.marches(&material, glossy) {
+            let marched = rec.settings.specular.marches(&material, glossy);
+            let emission = if marched {
                 materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
             } else {
                 Vec3::ZERO
@@ -381,6 +383,7 @@ fn surface_image(
             Some(SurfacePixel {
                 object: t.object,
                 material,
+                marched,
                 emission,
                 position,
                 ng,

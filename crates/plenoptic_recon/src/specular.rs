@@ -54,13 +54,14 @@ use crate::temporal::bracketing;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Specular {
     /// The non-diffuse radiance the base views saw (highlights and reflections frozen at the
-    /// base views' positions). What the plugin's GPU path shows today.
+    /// base views' positions): one lookup pass, no march.
     Baked,
     /// Surfaces without transmission reflect for the actual camera, marched through the
     /// distance cubes ([`crate::specular`]): ideal mirrors always, glossy surfaces whose
     /// perceptual roughness is at most `max_roughness` when no punctual light's highlight is
     /// baked ([`glossy_allowed`]); the others keep [`Specular::Baked`]. Costs a march per
-    /// such pixel (up to [`MAX_STEPS`] cube lookups per view).
+    /// (view, key) and ray (up to [`MAX_STEPS`] cube lookups each; [`GLOSSY_RAYS`] rays on
+    /// glossy surfaces).
     Marched {
         /// Roughest surface marched (rougher reflections are blurred enough that the base
         /// views' serve).
@@ -122,15 +123,14 @@ pub fn march_distance(manifest: &Manifest) -> f32 {
     }
 }
 
-/// Roughness below which a surface is an ideal mirror (one ray).
-pub(crate) const DELTA: f32 = DELTA_ROUGHNESS;
 /// Rays per pixel on a glossy surface ([`Reflections::lobe`]).
 pub const GLOSSY_RAYS: usize = 8;
 /// Most march steps per view.
 pub const MAX_STEPS: usize = 160;
 /// Cube texels the projected point moves per march step: the bisection finds the crossing
-/// within a step, and surfaces thinner than a step may be skipped. 2 halves the cost of 1
-/// and left the `specular` test's figures unchanged.
+/// within a step, and surfaces thinner than a step may be skipped. 2 halves the cost of 1;
+/// it left the `specular` test's figures unchanged and moved the tour's mean from 0.583 to
+/// 0.586 (its mirror frames 1.90 → 1.92 and 1.67 → 1.71).
 pub const STEP_TEXELS: f32 = 2.0;
 /// Bisection steps refining a crossing.
 const REFINE_STEPS: usize = 6;
