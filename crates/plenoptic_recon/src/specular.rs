@@ -133,7 +133,7 @@ pub const MAX_STEPS: usize = 160;
 /// 0.586 (its mirror frames 1.90 → 1.92 and 1.67 → 1.71).
 pub const STEP_TEXELS: f32 = 2.0;
 /// Bisection steps refining a crossing.
-const REFINE_STEPS: usize = 6;
+pub const REFINE_STEPS: usize = 6;
 
 /// One base view's cubes at one time key for the reflection march.
 struct MarchView {

@@ -51,7 +51,8 @@ struct ReconParams {
     // Its illuminance at the camera's time (xyz).
     sun_illuminance: vec4<f32>,
     // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
-    // marched (−1: ideal mirrors only), z: how far rays are marched.
+    // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
+    // pixel (plenoptic_recon's GLOSSY_RAYS).
     specular: vec4<f32>,
     // The material's emissive factor (xyz).
     emissive: vec4<f32>,
@@ -669,14 +670,15 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     return vec4<f32>(0.0);
 }
 
-// The mean radiance over 8 directions reflected about GGX half-vectors (roughness `alpha`)
-// around `n` seen from `wo`, a Hammersley set turned by `turn`.
+// The mean radiance over params.specular.w directions reflected about GGX half-vectors
+// (roughness `alpha`) around `n` seen from `wo`, a Hammersley set turned by `turn`.
 fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -> vec4<f32> {
     let pair = orthonormal_pair(n);
     var sum = vec3<f32>(0.0);
     var count = 0.0;
-    for (var k = 0u; k < 8u; k++) {
-        let u1 = (f32(k) + 0.5) / 8.0;
+    let rays = u32(params.specular.w);
+    for (var k = 0u; k < rays; k++) {
+        let u1 = (f32(k) + 0.5) / f32(rays);
         let u2 = fract(f32(reverseBits(k)) / 4294967296.0 + turn);
         let tan2 = alpha * alpha * u1 / (1.0 - u1);
         let cos_h = 1.0 / sqrt(1.0 + tan2);

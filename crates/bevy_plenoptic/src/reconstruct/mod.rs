@@ -269,7 +269,8 @@ pub struct ReconParams {
     /// The runtime sun's illuminance at the camera's time (xyz).
     pub sun_illuminance: Vec4,
     /// Reflections marched for the camera ([`reflect`]): x: 1 when on, y: the roughest
-    /// glossy surface marched (−1: ideal mirrors only), z: how far rays are marched.
+    /// glossy surface marched (−1: ideal mirrors only), z: how far rays are marched, w: rays
+    /// per glossy pixel.
     pub specular: Vec4,
     /// The material's emissive factor (xyz), which marched surfaces add.
     pub emissive: Vec4,

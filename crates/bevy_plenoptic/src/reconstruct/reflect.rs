@@ -17,7 +17,7 @@
 use bevy::prelude::*;
 use plenoptic_pack::MaterialEntry;
 use plenoptic_recon::Specular;
-use plenoptic_recon::specular::{glossy_allowed_in, march_distance};
+use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
 use super::ReconParams;
 use crate::asset::RadiancePack;
@@ -40,9 +40,28 @@ pub(super) fn fill(
                 1.0,
                 if glossy { max_roughness } else { -1.0 },
                 march_distance(manifest),
-                0.0,
+                GLOSSY_RAYS as f32,
             )
         }
     };
     params.emissive = material.emissive.extend(0.0);
+}
+
+#[cfg(test)]
+mod tests {
+    use plenoptic_recon::specular::{MAX_STEPS, REFINE_STEPS, STEP_TEXELS};
+
+    /// The march's constants in `reflect.wgsl` are the runtime core's (the GPU frame equals
+    /// the CPU's only if both step alike).
+    #[test]
+    fn the_shader_marches_with_the_cores_constants() {
+        let wgsl = include_str!("reflect.wgsl");
+        for line in [
+            format!("const MAX_STEPS: u32 = {MAX_STEPS}u;"),
+            format!("const REFINE_STEPS: u32 = {REFINE_STEPS}u;"),
+            format!("const STEP_TEXELS: f32 = {STEP_TEXELS:?};"),
+        ] {
+            assert!(wgsl.contains(&line), "reflect.wgsl lacks `{line}`");
+        }
+    }
 }

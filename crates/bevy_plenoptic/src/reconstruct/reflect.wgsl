@@ -7,6 +7,8 @@
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel}
 
+// plenoptic_recon::specular's MAX_STEPS, REFINE_STEPS and STEP_TEXELS (checked by a test in
+// reflect.rs).
 const MAX_STEPS: u32 = 160u;
 const REFINE_STEPS: u32 = 6u;
 // Cube texels the projected point moves per step.
