@@ -7,6 +7,8 @@
 //!   a budget; GPU against CPU in every mode.
 //! - [`pack_asset`]: the `RadiancePack` asset and its failures.
 //! - [`sky`]: the sky, its ground and the glazing on the GPU.
+//! - [`many_cameras`]: several plenoptic cameras in one app (two modes and times, a stereo
+//!   pair, a runtime sun per camera), each equal to its CPU frame.
 
 #[path = "../../crates/bevy_plenoptic/tests/gpu/common/mod.rs"]
 mod common;
@@ -15,6 +17,7 @@ mod common;
 #[path = "../../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
+mod many_cameras;
 mod pack_asset;
 mod scene_render;
 mod sky;

@@ -392,7 +392,7 @@ fn plugin_and_cpu_frames_with(
 /// Compares the GPU frame with the CPU frame: (mean relative error, fraction of pixels within
 /// 5 %, within 20 %), with the error per pixel the largest channel's |gpu − cpu| / (cpu + 0.02).
 /// Prints an error map ('.' < 5 %, 'o' < 20 %, '#' worse).
-fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
+pub(crate) fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
     let err =
         |j: usize| ((gpu[j] - cpu[j]).abs() / (cpu[j].abs() + Vec3::splat(0.02))).max_element();
     let n = cpu.len();

@@ -116,6 +116,10 @@ pub struct PlenopticSettings {
     pub prefetch_seconds: f32,
     /// Where frames are reconstructed. Read when a pack's proxy geometry is first shown.
     pub backend: Backend,
+    /// The first render layer given to plenoptic cameras: each camera draws its own proxy
+    /// geometry on a layer of its own, the lowest free one from here up
+    /// ([`camera::layers`]). Choose it above the layers the app uses itself.
+    pub first_render_layer: usize,
 }
 
 /// Where frames are reconstructed.
@@ -126,9 +130,9 @@ pub enum Backend {
     /// runs). Image mode runs as compute passes ([`reconstruct::image`]: splats of the
     /// weighted views' cube texels, view blend, background fill) shown through the proxies
     /// and the background. Volume mode ([`reconstruct::volume_mode`]) interpolates each
-    /// weighted view's cube at t from its resident temporal-volume blocks on the CPU (main
-    /// thread, when the time or views change) and warps those cubes with the same passes.
-    /// Only the first camera in image or volume mode is reconstructed that way; until its
+    /// weighted view's cube at t from its resident temporal-volume blocks on the CPU (off
+    /// the main thread, when the time or views change) and warps those cubes with the same
+    /// passes. Every camera in image or volume mode has its own passes and frame; until its
     /// volume cubes exist a volume-mode camera is shown geometry-assisted.
     Gpu,
     /// `plenoptic_recon`'s CPU reconstructor on a worker thread, its frame shown through the
@@ -146,6 +150,7 @@ impl Default for PlenopticSettings {
             memory_budget_bytes: 256 * 1024 * 1024,
             prefetch_seconds: 0.5,
             backend: Backend::Auto,
+            first_render_layer: 16,
         }
     }
 }

@@ -1,4 +1,7 @@
-//! The [`PlenopticCamera`] component and playback.
+//! The [`PlenopticCamera`] component, playback, and each camera's render layer
+//! ([`layers`]).
+
+pub mod layers;
 
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::prelude::*;
@@ -14,7 +17,12 @@ pub struct PlenopticCameraPlugin;
 
 impl Plugin for PlenopticCameraPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(Update, advance_playback.in_set(PlenopticSystems::Playback));
+        app.init_resource::<layers::ViewLayers>().add_systems(
+            Update,
+            (layers::assign_view_layers, advance_playback)
+                .chain()
+                .in_set(PlenopticSystems::Playback),
+        );
     }
 }
 
@@ -30,6 +38,10 @@ pub const EV100_UNIT: f32 = -0.263_034_4;
 /// Requires a [`Camera3d`] (the proxy geometry is rasterised by it) with a
 /// [`DepthPrepass`] (the GPU reconstruction's hole fill reads the depth of neighbouring
 /// pixels), and carries the per-camera streaming state.
+///
+/// Any number of plenoptic cameras may render in one app, each with its own pack, time and
+/// mode: each draws its own proxy geometry on a render layer of its own, which the plugin
+/// adds to the camera's `RenderLayers` ([`layers`]).
 ///
 /// The reconstructed radiance honours the camera's `Exposure` (EV100) as Bevy's own lights
 /// do: it is multiplied by `2^−EV100 / 1.2` before it reaches the HDR target, and the

@@ -4,6 +4,10 @@
 //! Rasterising them gives every pixel its object and the point on it and writes real depth
 //! into Bevy's depth buffer, so ordinary Bevy meshes occlude the baked scene and are occluded
 //! by it without any special compositing.
+//!
+//! Each [`PlenopticCamera`] has its own set, on its own render layer
+//! ([`crate::camera::layers`]): two cameras at different times see the objects where each
+//! camera's time puts them.
 
 use std::collections::HashMap;
 
@@ -11,9 +15,10 @@ use bevy::prelude::*;
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::camera::layers::ViewLayer;
 use crate::{PlenopticEvent, PlenopticSystems};
 
-/// Spawns and animates the proxy geometry of every pack a [`PlenopticCamera`] shows.
+/// Spawns and animates the proxy geometry of every [`PlenopticCamera`].
 #[derive(Debug, Default)]
 pub struct PlenopticProxyPlugin;
 
@@ -29,15 +34,17 @@ impl Plugin for PlenopticProxyPlugin {
     }
 }
 
-/// The root entity of the proxy geometry of each pack on screen.
+/// The root entity of each plenoptic camera's proxy geometry.
 #[derive(Resource, Debug, Default)]
-pub struct ProxyScenes(pub HashMap<AssetId<RadiancePack>, Entity>);
+pub struct ProxyScenes(pub HashMap<Entity, Entity>);
 
-/// Marks the root of a pack's proxy geometry.
+/// Marks the root of a camera's proxy geometry.
 #[derive(Component, Debug, Clone)]
 pub struct PlenopticScene {
     /// The pack.
     pub pack: Handle<RadiancePack>,
+    /// The camera it is drawn for (and placed at the time of).
+    pub camera: Entity,
 }
 
 /// One proxy object: its pack object id.
@@ -51,18 +58,31 @@ pub struct ProxyOf {
 #[derive(Resource, Debug, Clone)]
 pub struct ProxyMaterial(pub Handle<StandardMaterial>);
 
+/// Spawns each camera's proxy geometry once its pack has loaded (again when the camera
+/// changes pack) and despawns that of cameras that are gone.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn spawn_proxy_scenes(
     mut commands: Commands,
     mut scenes: ResMut<ProxyScenes>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<&PlenopticCamera>,
+    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer)>,
+    roots: Query<&PlenopticScene>,
     material: Option<Res<ProxyMaterial>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut events: MessageWriter<PlenopticEvent>,
 ) {
-    for cam in &cameras {
+    scenes.0.retain(|camera, root| {
+        let keep = cameras
+            .get(*camera)
+            .is_ok_and(|(_, cam, _)| roots.get(*root).is_ok_and(|s| s.pack == cam.pack));
+        if !keep && let Ok(mut e) = commands.get_entity(*root) {
+            e.despawn();
+        }
+        keep
+    });
+    for (camera, cam, layer) in &cameras {
         let id = cam.pack.id();
-        if scenes.0.contains_key(&id) {
+        if scenes.0.contains_key(&camera) {
             continue;
         }
         let Some(pack) = packs.get(id) else {
@@ -83,17 +103,25 @@ fn spawn_proxy_scenes(
                 m
             }
         };
-        for (chunk, reason) in &pack.failed {
-            events.write(PlenopticEvent::ChunkFailed {
-                chunk: chunk.clone(),
-                reason: reason.clone(),
-            });
+        // Once per pack, not per camera.
+        if !scenes.0.keys().any(|c| {
+            cameras
+                .get(*c)
+                .is_ok_and(|(_, other, _)| other.pack.id() == id)
+        }) {
+            for (chunk, reason) in &pack.failed {
+                events.write(PlenopticEvent::ChunkFailed {
+                    chunk: chunk.clone(),
+                    reason: reason.clone(),
+                });
+            }
         }
         let root = commands
             .spawn((
                 Name::new("plenoptic proxy geometry"),
                 PlenopticScene {
                     pack: cam.pack.clone(),
+                    camera,
                 },
                 Transform::IDENTITY,
                 Visibility::default(),
@@ -106,15 +134,16 @@ fn spawn_proxy_scenes(
                         Mesh3d(p.mesh.clone()),
                         MeshMaterial3d(material.clone()),
                         p.transform_at(cam.time),
+                        layer.layers(),
                     ));
                 }
             })
             .id();
-        scenes.0.insert(id, root);
+        scenes.0.insert(camera, root);
     }
 }
 
-/// Places every proxy object at the time of the first camera showing its pack.
+/// Places every proxy object at its camera's time.
 fn place_proxies(
     packs: Res<Assets<RadiancePack>>,
     cameras: Query<&PlenopticCamera>,
@@ -125,7 +154,7 @@ fn place_proxies(
         let Some(pack) = packs.get(&scene.pack) else {
             continue;
         };
-        let Some(cam) = cameras.iter().find(|c| c.pack.id() == scene.pack.id()) else {
+        let Ok(cam) = cameras.get(scene.camera) else {
             continue;
         };
         for child in children.iter() {

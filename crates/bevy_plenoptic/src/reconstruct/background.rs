@@ -12,7 +12,8 @@
 //! positions as clip-space corners of a full-screen triangle at depth 0, the far end of Bevy's
 //! reverse-Z depth (no culling, not frustum-culled): it
 //! passes the depth test only where nothing was drawn, so proxies and ordinary meshes stay
-//! in front of it. It takes no part in the prepass or shadows.
+//! in front of it. It takes no part in the prepass or shadows, and is drawn on the camera's
+//! own render layer ([`crate::camera::layers`]), so no other camera sees it.
 
 use bevy::asset::{RenderAssetUsages, embedded_asset};
 use bevy::camera::visibility::NoFrustumCulling;
@@ -34,6 +35,7 @@ use super::{KeyTextures, ResolvedBackend};
 use crate::Backend;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::camera::layers::ViewLayer;
 
 /// Adds the background material and keeps one background per GPU camera.
 pub(super) fn build(app: &mut App) {
@@ -211,7 +213,7 @@ pub struct PlenopticBackground {
 fn spawn_background(
     commands: &mut Commands,
     meshes: &mut Assets<Mesh>,
-    camera: Entity,
+    (camera, layer): (Entity, ViewLayer),
     cpu: bool,
     material: Handle<PlenopticBackgroundMaterial>,
 ) {
@@ -235,6 +237,7 @@ fn spawn_background(
             MeshMaterial3d(material),
             NoFrustumCulling,
             Transform::IDENTITY,
+            layer.layers(),
         ))
         .id();
     commands.entity(camera).add_child(child);
@@ -248,7 +251,7 @@ pub(super) fn spawn_cpu_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     frames: Res<super::cpu::CpuFrames>,
-    cameras: Query<(Entity, &PlenopticCamera)>,
+    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer)>,
     existing: Query<&PlenopticBackground>,
     packs: Res<Assets<RadiancePack>>,
     mut images: ResMut<Assets<Image>>,
@@ -258,12 +261,11 @@ pub(super) fn spawn_cpu_backgrounds(
     if backend.0 != Backend::Cpu {
         return;
     }
-    for (entity, cam) in &cameras {
+    for (entity, cam, layer) in &cameras {
         if existing.iter().any(|b| b.camera == entity) {
             continue;
         }
-        let (Some(pack), Some(frame)) = (packs.get(cam.pack.id()), frames.image(cam.pack.id()))
-        else {
+        let (Some(pack), Some(frame)) = (packs.get(cam.pack.id()), frames.image(entity)) else {
             continue;
         };
         if pack.environment.is_none() {
@@ -301,7 +303,7 @@ pub(super) fn spawn_cpu_backgrounds(
             environment: EnvironmentUniform::default(),
             environment_image: images.add(black),
         });
-        spawn_background(&mut commands, &mut meshes, entity, true, material);
+        spawn_background(&mut commands, &mut meshes, (entity, *layer), true, material);
     }
 }
 
@@ -312,8 +314,12 @@ pub(super) fn spawn_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
-    image_frame: Res<super::image::ImageFrame>,
-    cameras: Query<(Entity, &PlenopticCamera)>,
+    cameras: Query<(
+        Entity,
+        &PlenopticCamera,
+        &ViewLayer,
+        &super::image::ImageFrame,
+    )>,
     existing: Query<&PlenopticBackground>,
     packs: Res<Assets<RadiancePack>>,
     mut env_images: ResMut<EnvironmentImages>,
@@ -324,7 +330,7 @@ pub(super) fn spawn_backgrounds(
     if backend.0 != Backend::Gpu {
         return;
     }
-    for (entity, cam) in &cameras {
+    for (entity, cam, layer, image_frame) in &cameras {
         if existing.iter().any(|b| b.camera == entity) {
             continue;
         }
@@ -339,7 +345,13 @@ pub(super) fn spawn_backgrounds(
             environment: EnvironmentUniform::default(),
             environment_image,
         });
-        spawn_background(&mut commands, &mut meshes, entity, false, material);
+        spawn_background(
+            &mut commands,
+            &mut meshes,
+            (entity, *layer),
+            false,
+            material,
+        );
     }
 }
 

@@ -2,7 +2,8 @@
 //! each frame on the async compute pool (never on the main thread); the finished frame is
 //! copied into an `Rgba32Float` image that the proxy meshes show in screen space
 //! (`cpu.wgsl`), so depth compositing with Bevy meshes is the same as on the GPU path. The
-//! image lags the camera by the time a frame takes.
+//! image lags the camera by the time a frame takes. Every camera has its own reconstructor,
+//! frame task and image.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -58,11 +59,12 @@ impl Material for CpuFrameMaterial {
 
 type FrameTask = Task<Result<Frame, String>>;
 
-/// Per pack: the reconstructor, the frame in flight and the displayed image.
+/// Per camera: the reconstructor, the frame in flight and the displayed image.
 #[derive(Resource, Default)]
-pub struct CpuFrames(HashMap<AssetId<RadiancePack>, CpuFrame>);
+pub struct CpuFrames(HashMap<Entity, CpuFrame>);
 
 struct CpuFrame {
+    pack: AssetId<RadiancePack>,
     rec: Option<Arc<Reconstructor>>,
     task: Option<FrameTask>,
     image: Handle<Image>,
@@ -71,14 +73,14 @@ struct CpuFrame {
 }
 
 impl CpuFrames {
-    /// The image showing `pack`'s latest CPU frame, once the backend has one for it.
-    pub fn image(&self, pack: AssetId<RadiancePack>) -> Option<Handle<Image>> {
-        self.0.get(&pack).map(|f| f.image.clone())
+    /// The image showing `camera`'s latest CPU frame, once the backend has one for it.
+    pub fn image(&self, camera: Entity) -> Option<Handle<Image>> {
+        self.0.get(&camera).map(|f| f.image.clone())
     }
 
-    /// Frames the CPU backend has completed for `pack`.
-    pub fn frames_done(&self, pack: AssetId<RadiancePack>) -> u64 {
-        self.0.get(&pack).map_or(0, |f| f.done)
+    /// Frames the CPU backend has completed for `camera`.
+    pub fn frames_done(&self, camera: Entity) -> u64 {
+        self.0.get(&camera).map_or(0, |f| f.done)
     }
 }
 
@@ -106,7 +108,10 @@ fn attach_cpu_materials(
         };
         let id = scene.pack.id();
         let Some(pack) = packs.get(id) else { continue };
-        let frame = frames.0.entry(id).or_insert_with(|| {
+        if frames.0.get(&scene.camera).is_some_and(|f| f.pack != id) {
+            frames.0.remove(&scene.camera);
+        }
+        let frame = frames.0.entry(scene.camera).or_insert_with(|| {
             let rec = match pack.file.as_ref().map(Reconstructor::open) {
                 Some(Ok(r)) => Some(Arc::new(r)),
                 Some(Err(e)) => {
@@ -129,6 +134,7 @@ fn attach_cpu_materials(
                 RenderAssetUsages::default(),
             );
             CpuFrame {
+                pack: id,
                 rec,
                 task: None,
                 image: images.add(image),
@@ -153,7 +159,8 @@ fn run_cpu_frames(
     mut backgrounds: ResMut<Assets<super::background::PlenopticBackgroundMaterial>>,
     mut events: MessageWriter<PlenopticEvent>,
 ) {
-    for (id, f) in frames.0.iter_mut() {
+    frames.0.retain(|camera, _| cameras.contains(*camera));
+    for (camera, f) in frames.0.iter_mut() {
         if let Some(task) = f.task.as_mut()
             && let Some(result) = check_ready(task)
         {
@@ -214,9 +221,7 @@ fn run_cpu_frames(
         if f.task.is_some() {
             continue;
         }
-        let Some((cam, camera, projection, transform)) =
-            cameras.iter().find(|(c, ..)| c.pack.id() == *id)
-        else {
+        let Ok((cam, camera, projection, transform)) = cameras.get(*camera) else {
             continue;
         };
         // The camera's settings, applied while no frame task shares the reconstructor.

@@ -17,17 +17,23 @@
 //! neighbour, `ReconSettings::background_passes` times. Every tunable comes from the
 //! camera's `ReconSettings`, in [`ImageParams`].
 //!
-//! The frame is written to [`ImageFrame`]'s `Rgba32Float` storage texture, which the proxy
-//! materials and the background show in screen space while the camera is in image mode.
-//! Only the first camera of the app in image or volume mode is reconstructed (volume mode:
-//! [`super::volume_mode`] supplies each view's cube at t as its single key).
+//! The frame is written to the camera's [`ImageFrame`], an `Rgba32Float` storage texture
+//! which the camera's proxy materials and background show in screen space while it is in
+//! image mode (volume mode: [`super::volume_mode`] supplies each view's cube at t as its
+//! single key).
+//!
+//! Every camera has its own work: the main world fills the camera's [`ImageJob`], which is
+//! extracted onto the camera's render-world view entity; the view's bind groups
+//! ([`ImageBindGroups`]) are prepared per view, and the passes run for each view in turn
+//! before the cameras render. The scratch buffers are shared (the views' passes run one
+//! after the other), sized for the largest view.
 
 use std::borrow::Cow;
 
 use bevy::asset::{RenderAssetUsages, embedded_asset, load_embedded_asset};
 use bevy::core_pipeline::schedule::camera_driver;
 use bevy::prelude::*;
-use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
+use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
     storage_buffer_sized, texture_2d_array, texture_storage_2d, uniform_buffer,
@@ -44,7 +50,7 @@ use bevy::render::texture::GpuImage;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use plenoptic_recon::temporal::bezier_weights;
 
-use super::background::PlenopticBackgroundMaterial;
+use super::background::{PlenopticBackground, PlenopticBackgroundMaterial};
 use super::volume_mode::VolumeCubes;
 use super::{KeyTextures, ResolvedBackend};
 use crate::Backend;
@@ -85,12 +91,14 @@ pub struct ImageParams {
     pub nearest: [UVec4; MAX_IMAGE_VIEWS],
 }
 
-/// The frame the image mode writes (an `Rgba32Float` storage texture, resized to the camera).
-#[derive(Resource, Debug, Clone)]
+/// The frame a camera's image-mode passes write (an `Rgba32Float` storage texture, resized
+/// to the camera); every plenoptic camera has one.
+#[derive(Component, Debug, Clone)]
 pub struct ImageFrame(pub Handle<Image>);
 
-/// This frame's image-mode work, if a camera is in image mode on the GPU backend.
-#[derive(Resource, Debug, Clone, Default, ExtractResource)]
+/// A camera's image-mode work this frame: `Some` while it is in image (or volume) mode on
+/// the GPU backend with keys to warp. Extracted onto the camera's render-world view.
+#[derive(Component, Debug, Clone, Default, ExtractComponent)]
 pub struct ImageJob(pub Option<ImageWork>);
 
 /// What the image-mode passes read and write.
@@ -123,13 +131,7 @@ fn frame_image(width: u32, height: u32) -> Image {
 
 pub(super) fn build(app: &mut App) {
     embedded_asset!(app, "image.wgsl");
-    app.init_resource::<ImageJob>()
-        .add_plugins(ExtractResourcePlugin::<ImageJob>::default());
-    let frame = app
-        .world_mut()
-        .resource_mut::<Assets<Image>>()
-        .add(frame_image(1, 1));
-    app.insert_resource(ImageFrame(frame));
+    app.add_plugins(ExtractComponentPlugin::<ImageJob>::default());
     if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
         render_app
             .init_resource::<ImageBuffers>()
@@ -142,138 +144,175 @@ pub(super) fn build(app: &mut App) {
     }
 }
 
-/// Fills [`ImageJob`] for the first camera in image or volume mode (warping the
-/// [`VolumeCubes`] in volume mode) and resizes [`ImageFrame`] to it.
+/// Gives every plenoptic camera its [`ImageFrame`] and [`ImageJob`].
+pub(super) fn add_frames(
+    mut commands: Commands,
+    cameras: Query<Entity, (With<PlenopticCamera>, Without<ImageFrame>)>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    for camera in &cameras {
+        let frame = images.add(frame_image(1, 1));
+        commands
+            .entity(camera)
+            .insert((ImageFrame(frame), ImageJob::default()));
+    }
+}
+
+/// A camera in image or volume mode: the components [`prepare_jobs`] reads.
+type WarpCamera<'a> = (
+    Entity,
+    &'a PlenopticCamera,
+    &'a Camera,
+    &'a Projection,
+    &'a GlobalTransform,
+    &'a ImageFrame,
+    Option<&'a VolumeCubes>,
+);
+
+/// Fills each camera's [`ImageJob`] (warping its [`VolumeCubes`] in volume mode) and resizes
+/// its [`ImageFrame`] to it.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
-pub(super) fn prepare_job(
+pub(super) fn prepare_jobs(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    volume: Res<VolumeCubes>,
-    frame: Res<ImageFrame>,
-    cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
+    mut cameras: Query<(WarpCamera, &mut ImageJob)>,
     mut images: ResMut<Assets<Image>>,
-    mut job: ResMut<ImageJob>,
-    mut backgrounds: ResMut<Assets<PlenopticBackgroundMaterial>>,
+    backgrounds: Query<(
+        &PlenopticBackground,
+        &MeshMaterial3d<PlenopticBackgroundMaterial>,
+    )>,
+    mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
 ) {
-    let work = (|| {
-        if backend.0 != Backend::Gpu {
-            return None;
-        }
-        let (cam, camera, projection, transform) = cameras
-            .iter()
-            .find(|(c, ..)| matches!(c.mode, ReconMode::Image | ReconMode::Volume))?;
-        let id = cam.pack.id();
-        let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
-        let volume_mode = cam.mode == ReconMode::Volume;
-        let size = camera.physical_viewport_size()?;
-        let vfov = match projection {
-            Projection::Perspective(p) => p.fov,
-            _ => std::f32::consts::FRAC_PI_4,
-        };
-        let (_, rotation, position) = transform.to_scale_rotation_translation();
-        let basis = plenoptic_recon::Camera::new(position, rotation, vfov, size.x, size.y)
-            .ok()?
-            .basis();
-        let mut params = ImageParams {
-            eye: basis.position.extend(basis.focal_px),
-            right: basis.right.extend(basis.tan_x),
-            up: basis.up.extend(basis.tan_y),
-            forward: basis.forward.extend(cam.settings.depth_tolerance),
-            size: UVec4::new(size.x, size.y, tex.face, 0),
-            misc: UVec4::new(cam.settings.background_passes, 0, 0, 0),
-            splat: Vec4::new(
-                cam.settings.same_surface,
-                cam.settings.max_splat_px,
-                0.0,
-                0.0,
-            ),
-            ..default()
-        };
-        if volume_mode {
-            // Each view's cube at t is its single key.
-            let image = volume.image.clone()?;
-            params.size.z = volume.face;
-            for (n, &(v, w)) in volume.views.iter().enumerate() {
-                let layer = 6 * n as u32;
-                params.views[n] = pack.reader.manifest().base_views[v].position.extend(w);
-                params.nearest[n] = UVec4::new(layer, 1, 0, 0);
-                params.layers[n][0] = layer;
-                params.key_weights[n][0] = 1.0;
+    for (camera, mut job) in &mut cameras {
+        let work = job_for(&backend, &keys, &cache, &packs, camera);
+        let (entity, frame) = (camera.0, camera.5);
+        if let Some(w) = &work {
+            let size = UVec2::new(w.params.size.x, w.params.size.y);
+            if images.get(&frame.0).is_some_and(|i| i.size() != size) {
+                images.insert(&frame.0, frame_image(size.x, size.y)).ok();
+                // Touch the camera's background so that its bind group takes the new texture
+                // (the proxy materials are updated every frame anyway).
+                for (bg, handle) in &backgrounds {
+                    if bg.camera == entity {
+                        background_materials.get_mut(&handle.0);
+                    }
+                }
             }
-            params.size.w = volume.views.len() as u32;
-            return Some(ImageWork {
-                cubes: image,
-                output: frame.0.clone(),
-                params,
-            });
         }
-        let m = pack.reader.manifest();
-        let t = cam.time;
-        let views = cam.settings.view_weights(m, &pack.usable_views, position);
-        let mut n = 0;
-        for (v, w) in views {
-            if n == MAX_IMAGE_VIEWS {
-                break;
-            }
-            let times = &m.base_views[v].time_keys;
-            let wanted = bezier_weights(times, t);
-            let resident: Vec<(usize, f32, u32)> = wanted
-                .iter()
-                .filter_map(|&(k, wk)| {
-                    let r = cache.get(id, (v as u32, k as u32))?;
-                    (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
-                        .then_some((k, wk, r.slot))
-                })
-                .take(KEYS_PER_VIEW)
-                .collect();
-            if resident.is_empty() {
-                continue;
-            }
-            let weights: Vec<f32> = if resident.len() == wanted.len() {
-                resident.iter().map(|r| r.1).collect()
-            } else {
-                resident
-                    .iter()
-                    .map(|r| 1.0 / ((times[r.0] - t).abs() + 1e-4))
-                    .collect()
-            };
-            let total: f32 = weights.iter().sum();
-            let nearest = resident
-                .iter()
-                .min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?;
-            params.views[n] = m.base_views[v].position.extend(w);
-            params.nearest[n] = UVec4::new(nearest.2 * 6, resident.len() as u32, 0, 0);
-            for (k, (r, wk)) in resident.iter().zip(&weights).enumerate() {
-                params.layers[n][k] = r.2 * 6;
-                params.key_weights[n][k] = wk / total;
-            }
-            n += 1;
+        job.0 = work;
+    }
+}
+
+/// The image-mode work of one camera, if it is in image or volume mode on the GPU backend.
+fn job_for(
+    backend: &ResolvedBackend,
+    keys: &KeyTextures,
+    cache: &StreamCache,
+    packs: &Assets<RadiancePack>,
+    (_, cam, camera, projection, transform, frame, volume): WarpCamera,
+) -> Option<ImageWork> {
+    if backend.0 != Backend::Gpu || !matches!(cam.mode, ReconMode::Image | ReconMode::Volume) {
+        return None;
+    }
+    let id = cam.pack.id();
+    let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
+    let volume_mode = cam.mode == ReconMode::Volume;
+    let size = camera.physical_viewport_size()?;
+    let vfov = match projection {
+        Projection::Perspective(p) => p.fov,
+        _ => std::f32::consts::FRAC_PI_4,
+    };
+    let (_, rotation, position) = transform.to_scale_rotation_translation();
+    let basis = plenoptic_recon::Camera::new(position, rotation, vfov, size.x, size.y)
+        .ok()?
+        .basis();
+    let mut params = ImageParams {
+        eye: basis.position.extend(basis.focal_px),
+        right: basis.right.extend(basis.tan_x),
+        up: basis.up.extend(basis.tan_y),
+        forward: basis.forward.extend(cam.settings.depth_tolerance),
+        size: UVec4::new(size.x, size.y, tex.face, 0),
+        misc: UVec4::new(cam.settings.background_passes, 0, 0, 0),
+        splat: Vec4::new(
+            cam.settings.same_surface,
+            cam.settings.max_splat_px,
+            0.0,
+            0.0,
+        ),
+        ..default()
+    };
+    if volume_mode {
+        // Each view's cube at t is its single key.
+        let volume = volume?;
+        let image = volume.image.clone()?;
+        params.size.z = volume.face;
+        for (n, &(v, w)) in volume.views.iter().enumerate() {
+            let layer = 6 * n as u32;
+            params.views[n] = pack.reader.manifest().base_views[v].position.extend(w);
+            params.nearest[n] = UVec4::new(layer, 1, 0, 0);
+            params.layers[n][0] = layer;
+            params.key_weights[n][0] = 1.0;
         }
-        if n == 0 {
-            return None;
-        }
-        params.size.w = n as u32;
-        Some(ImageWork {
-            cubes: tex.image.clone(),
+        params.size.w = volume.views.len() as u32;
+        return Some(ImageWork {
+            cubes: image,
             output: frame.0.clone(),
             params,
-        })
-    })();
-    if let Some(w) = &work {
-        let size = UVec2::new(w.params.size.x, w.params.size.y);
-        if images.get(&frame.0).is_some_and(|i| i.size() != size) {
-            images.insert(&frame.0, frame_image(size.x, size.y)).ok();
-            // Touch the backgrounds so that their bind groups take the new texture (the proxy
-            // materials are updated every frame anyway).
-            let ids: Vec<_> = backgrounds.ids().collect();
-            for id in ids {
-                backgrounds.get_mut(id);
-            }
-        }
+        });
     }
-    job.0 = work;
+    let m = pack.reader.manifest();
+    let t = cam.time;
+    let views = cam.settings.view_weights(m, &pack.usable_views, position);
+    let mut n = 0;
+    for (v, w) in views {
+        if n == MAX_IMAGE_VIEWS {
+            break;
+        }
+        let times = &m.base_views[v].time_keys;
+        let wanted = bezier_weights(times, t);
+        let resident: Vec<(usize, f32, u32)> = wanted
+            .iter()
+            .filter_map(|&(k, wk)| {
+                let r = cache.get(id, (v as u32, k as u32))?;
+                (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
+                    .then_some((k, wk, r.slot))
+            })
+            .take(KEYS_PER_VIEW)
+            .collect();
+        if resident.is_empty() {
+            continue;
+        }
+        let weights: Vec<f32> = if resident.len() == wanted.len() {
+            resident.iter().map(|r| r.1).collect()
+        } else {
+            resident
+                .iter()
+                .map(|r| 1.0 / ((times[r.0] - t).abs() + 1e-4))
+                .collect()
+        };
+        let total: f32 = weights.iter().sum();
+        let nearest = resident
+            .iter()
+            .min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?;
+        params.views[n] = m.base_views[v].position.extend(w);
+        params.nearest[n] = UVec4::new(nearest.2 * 6, resident.len() as u32, 0, 0);
+        for (k, (r, wk)) in resident.iter().zip(&weights).enumerate() {
+            params.layers[n][k] = r.2 * 6;
+            params.key_weights[n][k] = wk / total;
+        }
+        n += 1;
+    }
+    if n == 0 {
+        return None;
+    }
+    params.size.w = n as u32;
+    Some(ImageWork {
+        cubes: tex.image.clone(),
+        output: frame.0.clone(),
+        params,
+    })
 }
 
 #[derive(Resource)]
@@ -330,12 +369,13 @@ fn init_pipelines(
 #[derive(Resource, Default)]
 struct ImageBuffers {
     buffers: Option<[Buffer; 4]>,
-    /// (views × pixels) they hold.
+    /// Pixels of the largest frame they hold (splats: [`MAX_IMAGE_VIEWS`] per pixel).
     capacity: u64,
 }
 
-#[derive(Resource)]
-struct ImageBindGroups {
+/// A view's image-mode bind groups this frame (on its render-world view entity).
+#[derive(Component)]
+pub struct ImageBindGroups {
     /// Frame buffers (a, b) and (b, a) as (in, out).
     groups: [BindGroup; 2],
     params: ImageParams,
@@ -344,7 +384,7 @@ struct ImageBindGroups {
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn prepare_bind_groups(
     mut commands: Commands,
-    job: Res<ImageJob>,
+    views: Query<(Entity, &ImageJob)>,
     pipelines: Option<Res<ImagePipelines>>,
     images: Res<RenderAssets<GpuImage>>,
     mut buffers: ResMut<ImageBuffers>,
@@ -352,20 +392,14 @@ fn prepare_bind_groups(
     queue: Res<RenderQueue>,
     pipeline_cache: Res<PipelineCache>,
 ) {
-    commands.remove_resource::<ImageBindGroups>();
-    let (Some(work), Some(pipelines)) = (job.0.as_ref(), pipelines) else {
-        return;
-    };
-    let (Some(cubes), Some(output)) = (images.get(&work.cubes), images.get(&work.output)) else {
-        return;
-    };
-    let p = work.params.size;
-    if output.texture_descriptor.size.width != p.x || output.texture_descriptor.size.height != p.y {
-        return;
-    }
-    let pixels = u64::from(p.x) * u64::from(p.y);
-    let need = pixels * MAX_IMAGE_VIEWS as u64;
-    if buffers.capacity < need || buffers.buffers.is_none() {
+    // The scratch buffers serve every view in turn: sized for the largest.
+    let need = views
+        .iter()
+        .filter_map(|(_, job)| job.0.as_ref())
+        .map(|w| u64::from(w.params.size.x) * u64::from(w.params.size.y))
+        .max()
+        .unwrap_or(0);
+    if need > 0 && (buffers.capacity < need || buffers.buffers.is_none()) {
         let make = |label: &'static str, bytes: u64| {
             device.create_buffer(&BufferDescriptor {
                 label: Some(label),
@@ -374,48 +408,63 @@ fn prepare_bind_groups(
                 mapped_at_creation: false,
             })
         };
+        let splats = need * MAX_IMAGE_VIEWS as u64;
         buffers.buffers = Some([
-            make("plenoptic image splat keys", need * 8),
-            make("plenoptic image splat texels", need * 4),
-            make("plenoptic image frame a", pixels * 16),
-            make("plenoptic image frame b", pixels * 16),
+            make("plenoptic image splat keys", splats * 8),
+            make("plenoptic image splat texels", splats * 4),
+            make("plenoptic image frame a", need * 16),
+            make("plenoptic image frame b", need * 16),
         ]);
         buffers.capacity = need;
     }
-    let Some([keys, texels, a, b]) = buffers.buffers.as_ref() else {
-        return;
-    };
-    let mut uniform = UniformBuffer::from(work.params.clone());
-    uniform.write_buffer(&device, &queue);
-    let layout = pipeline_cache.get_bind_group_layout(&pipelines.layout);
-    let group = |fin: &Buffer, fout: &Buffer| {
-        device.create_bind_group(
-            "plenoptic image mode",
-            &layout,
-            &BindGroupEntries::sequential((
-                &cubes.texture_view,
-                &uniform,
-                keys.as_entire_binding(),
-                texels.as_entire_binding(),
-                fin.as_entire_binding(),
-                fout.as_entire_binding(),
-                &output.texture_view,
-            )),
-        )
-    };
-    commands.insert_resource(ImageBindGroups {
-        groups: [group(a, b), group(b, a)],
-        params: work.params.clone(),
-    });
+    for (view, job) in &views {
+        let groups = (|| {
+            let (work, pipelines) = (job.0.as_ref()?, pipelines.as_ref()?);
+            let (cubes, output) = (images.get(&work.cubes)?, images.get(&work.output)?);
+            let p = work.params.size;
+            if output.texture_descriptor.size.width != p.x
+                || output.texture_descriptor.size.height != p.y
+            {
+                return None;
+            }
+            let [keys, texels, a, b] = buffers.buffers.as_ref()?;
+            let mut uniform = UniformBuffer::from(work.params.clone());
+            uniform.write_buffer(&device, &queue);
+            let layout = pipeline_cache.get_bind_group_layout(&pipelines.layout);
+            let group = |fin: &Buffer, fout: &Buffer| {
+                device.create_bind_group(
+                    "plenoptic image mode",
+                    &layout,
+                    &BindGroupEntries::sequential((
+                        &cubes.texture_view,
+                        &uniform,
+                        keys.as_entire_binding(),
+                        texels.as_entire_binding(),
+                        fin.as_entire_binding(),
+                        fout.as_entire_binding(),
+                        &output.texture_view,
+                    )),
+                )
+            };
+            Some(ImageBindGroups {
+                groups: [group(a, b), group(b, a)],
+                params: work.params.clone(),
+            })
+        })();
+        match groups {
+            Some(g) => commands.entity(view).insert(g),
+            None => commands.entity(view).remove::<ImageBindGroups>(),
+        };
+    }
 }
 
 fn run_passes(
     mut render_context: RenderContext,
-    groups: Option<Res<ImageBindGroups>>,
+    views: Query<&ImageBindGroups>,
     pipelines: Option<Res<ImagePipelines>>,
     pipeline_cache: Res<PipelineCache>,
 ) {
-    let (Some(groups), Some(pipelines)) = (groups, pipelines) else {
+    let Some(pipelines) = pipelines else {
         return;
     };
     let Some(passes) = pipelines
@@ -426,30 +475,33 @@ fn run_passes(
     else {
         return;
     };
-    let p = &groups.params;
-    let (w, h, face, views) = (p.size.x, p.size.y, p.size.z, p.size.w);
-    let texels = 6 * face * face;
-    let mut pass = render_context
-        .command_encoder()
-        .begin_compute_pass(&ComputePassDescriptor {
-            label: Some("plenoptic image mode"),
-            ..default()
-        });
-    pass.set_bind_group(0, &groups.groups[0], &[]);
-    pass.set_pipeline(passes[0]);
-    pass.dispatch_workgroups((w * h).div_ceil(64), views, 1);
-    for splat in &passes[1..4] {
-        pass.set_pipeline(splat);
-        pass.dispatch_workgroups(texels.div_ceil(64), views, 1);
-    }
-    pass.set_pipeline(passes[4]);
-    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-    pass.set_pipeline(passes[5]);
-    for k in 0..p.misc.x {
-        pass.set_bind_group(0, &groups.groups[k as usize % 2], &[]);
+    for groups in &views {
+        let p = &groups.params;
+        let (w, h, face, views) = (p.size.x, p.size.y, p.size.z, p.size.w);
+        let texels = 6 * face * face;
+        let mut pass =
+            render_context
+                .command_encoder()
+                .begin_compute_pass(&ComputePassDescriptor {
+                    label: Some("plenoptic image mode"),
+                    ..default()
+                });
+        pass.set_bind_group(0, &groups.groups[0], &[]);
+        pass.set_pipeline(passes[0]);
+        pass.dispatch_workgroups((w * h).div_ceil(64), views, 1);
+        for splat in &passes[1..4] {
+            pass.set_pipeline(splat);
+            pass.dispatch_workgroups(texels.div_ceil(64), views, 1);
+        }
+        pass.set_pipeline(passes[4]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        pass.set_pipeline(passes[5]);
+        for k in 0..p.misc.x {
+            pass.set_bind_group(0, &groups.groups[k as usize % 2], &[]);
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
+        pass.set_bind_group(0, &groups.groups[p.misc.x as usize % 2], &[]);
+        pass.set_pipeline(passes[6]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
-    pass.set_bind_group(0, &groups.groups[p.misc.x as usize % 2], &[]);
-    pass.set_pipeline(passes[6]);
-    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
 }

@@ -33,8 +33,11 @@
 //!
 //! Pixels no proxy covers show the pack's environment for their viewing direction at the
 //! camera's time, or without one the heaviest key's cube in that direction ([`background`],
-//! a full-screen triangle behind all geometry), as on the CPU. The
-//! background is drawn by every camera of the app: give other cameras other `RenderLayers`.
+//! a full-screen triangle behind all geometry), as on the CPU.
+//!
+//! Every plenoptic camera has its own proxies, materials, background, image-mode frame and
+//! sun, on its own render layer ([`crate::camera::layers`]): any number of cameras, each with
+//! its own pack, time and mode, render in one app.
 //!
 //! On a pack 3 whose lighting leaves the sun to the runtime, lit objects add the sun's direct
 //! light per fragment through their BSDF, shadowed by Bevy's shadow map of a directional
@@ -95,17 +98,17 @@ impl Plugin for PlenopticReconstructPlugin {
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
             .init_resource::<volume::VolumeBuffers>()
-            .init_resource::<volume_mode::VolumeCubes>()
             .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
                 (
                     upload::upload_keys,
                     volume::upload_volumes,
+                    image::add_frames,
                     attach_materials,
                     background::spawn_backgrounds,
                     volume_mode::prepare_cubes,
-                    image::prepare_job,
+                    image::prepare_jobs,
                     sun::update_suns,
                     update_materials,
                 )
@@ -159,7 +162,8 @@ fn resolve_backend(
     }
 }
 
-/// The proxy material of the GPU path: one instance per proxy object.
+/// The proxy material of the GPU path: one instance per proxy object of each camera (its
+/// uniform carries that camera's lookups).
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
 pub struct PlenopticMaterial {
     /// Resident keys (see the module doc).
@@ -174,8 +178,8 @@ pub struct PlenopticMaterial {
     /// Their bin offsets ([`volume::PackVolumes::bins`]).
     #[storage(3, read_only)]
     pub volume_bins: Handle<ShaderBuffer>,
-    /// The image-mode frame ([`image::ImageFrame`]), shown instead of the lookups while the
-    /// camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
+    /// The camera's image-mode frame ([`image::ImageFrame`]), shown instead of the lookups
+    /// while the camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
     /// The resident keys' lighting and non-diffuse radiance ([`KeyTexture::shading`]).
@@ -315,7 +319,7 @@ fn attach_materials(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
-    image_frame: Res<image::ImageFrame>,
+    cameras: Query<&image::ImageFrame>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
@@ -328,6 +332,9 @@ fn attach_materials(
     }
     for (entity, parent, of) in &proxies {
         let Ok(scene) = roots.get(parent.parent()) else {
+            continue;
+        };
+        let Ok(image_frame) = cameras.get(scene.camera) else {
             continue;
         };
         let (Some(tex), Some(vol), Some(pack)) = (
@@ -529,16 +536,15 @@ fn warped(mode: ReconMode) -> bool {
     matches!(mode, ReconMode::Image | ReconMode::Volume)
 }
 
-/// Fills every proxy material's lookups for its pack's (first) camera, and every
-/// background's environment key.
+/// Fills every proxy material's lookups for its camera, and every background's environment
+/// key.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn update_materials(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
     cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    job: Res<image::ImageJob>,
-    cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
+    cameras: Query<(&PlenopticCamera, &GlobalTransform, &image::ImageJob)>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(&ChildOf, &ProxyOf, &MeshMaterial3d<PlenopticMaterial>)>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
@@ -547,28 +553,15 @@ fn update_materials(
         &MeshMaterial3d<background::PlenopticBackgroundMaterial>,
     )>,
     mut background_materials: ResMut<Assets<background::PlenopticBackgroundMaterial>>,
-    mut warned: Local<HashSet<AssetId<RadiancePack>>>,
 ) {
-    // The per-object materials carry one camera's lookups: say so, once per pack, when more
-    // cameras show it (issue: per-view state in the render world).
-    let mut seen: HashMap<AssetId<RadiancePack>, usize> = HashMap::new();
-    for (cam, _) in &cameras {
-        let n = seen.entry(cam.pack.id()).or_default();
-        *n += 1;
-        if *n == 2 && warned.insert(cam.pack.id()) {
-            warn!(
-                "plenoptic: several cameras show one pack; its proxies are reconstructed for \
-                 the first camera's position, time and mode only, so the others show that \
-                 camera's frame on them (the background is per camera)"
-            );
-        }
-    }
-    let mut frames: HashMap<AssetId<RadiancePack>, FrameLookups> = HashMap::new();
-    let mut frame = |id: AssetId<RadiancePack>, cam: &PlenopticCamera, at: Vec3| {
+    // Each camera's lookups, computed once per frame.
+    let mut frames: HashMap<Entity, FrameLookups> = HashMap::new();
+    let mut frame = |camera: Entity, cam: &PlenopticCamera, at: Vec3| {
+        let id = cam.pack.id();
         let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
         Some(
             frames
-                .entry(id)
+                .entry(camera)
                 .or_insert_with(|| {
                     frame_lookups(id, pack, tex, &cache, &cam.settings, at, cam.time)
                 })
@@ -579,14 +572,14 @@ fn update_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let id = scene.pack.id();
-        let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.pack.id() == id) else {
+        let Ok((cam, transform, job)) = cameras.get(scene.camera) else {
             continue;
         };
+        let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
         };
-        let Some(f) = frame(id, cam, transform.translation()) else {
+        let Some(f) = frame(scene.camera, cam, transform.translation()) else {
             continue;
         };
         let image_mode = warped(cam.mode) && job.0.is_some();
@@ -657,7 +650,7 @@ fn update_materials(
         }
     }
     for (bg, handle) in &backgrounds {
-        let Ok((cam, transform)) = cameras.get(bg.camera) else {
+        let Ok((cam, transform, job)) = cameras.get(bg.camera) else {
             continue;
         };
         if bg.cpu {
@@ -665,7 +658,7 @@ fn update_materials(
         }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
-        let layer = frame(id, cam, transform.translation())
+        let layer = frame(bg.camera, cam, transform.translation())
             .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
         let image_mode = warped(cam.mode) && job.0.is_some();
         let env = packs

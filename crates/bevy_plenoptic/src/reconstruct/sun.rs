@@ -5,11 +5,15 @@
 //! camera's time × the cosine × the visibility.
 //!
 //! The visibility comes from Bevy's own cascaded shadow map of a [`DirectionalLight`] the
-//! plugin spawns per such pack ([`PlenopticSun`]), aimed along the sun's track at the time of
-//! the pack's first camera, shadows on: the proxies cast shadows as any mesh does. That light
-//! also lights the app's own `StandardMaterial` meshes like the pack's sun. The CPU casts
-//! shadow rays against the proxies instead, so the two agree away from shadow edges and
-//! differ at them by the shadow map's resolution and filter.
+//! plugin spawns per camera on such a pack ([`PlenopticSun`]), aimed along the sun's track at
+//! the camera's time, shadows on: the camera's proxies cast shadows as any mesh does. The
+//! light is on the camera's own render layer ([`crate::camera::layers`]): Bevy gives a view
+//! only the directional lights that share a layer with it, and a light's shadow casters are
+//! the meshes on its layers, so each camera is lit and shadowed by its own sun at its own
+//! time. That light also lights the app's own `StandardMaterial` meshes in that camera like
+//! the pack's sun, but they cast no shadow from it (they are not on the camera's layer). The
+//! CPU casts shadow rays against the proxies instead, so the two agree away from shadow edges
+//! and differ at them by the shadow map's resolution and filter.
 
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
@@ -17,12 +21,13 @@ use bevy::prelude::*;
 use super::ReconParams;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::camera::layers::ViewLayer;
 
-/// The directional light the plugin keeps for the runtime sun of `pack`.
+/// The directional light the plugin keeps for the runtime sun of a camera's pack.
 #[derive(Component, Debug, Clone)]
 pub struct PlenopticSun {
-    /// The pack whose sun it is.
-    pub pack: AssetId<RadiancePack>,
+    /// The camera it lights.
+    pub camera: Entity,
 }
 
 /// The sun of `pack` at time `t`, when its lighting leaves the sun to the runtime: unit
@@ -41,24 +46,22 @@ pub(super) fn fill(params: &mut ReconParams, pack: &RadiancePack, t: f32) {
     }
 }
 
-/// Spawns, aims and removes the [`PlenopticSun`] lights: one per pack with a runtime sun that
-/// a camera shows, at its first camera's time.
+/// Spawns, aims and removes the [`PlenopticSun`] lights: one per camera whose pack has a
+/// runtime sun, at the camera's time.
 pub(super) fn update_suns(
     mut commands: Commands,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<&PlenopticCamera>,
+    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer)>,
     mut suns: Query<(Entity, &PlenopticSun, &mut Transform, &mut DirectionalLight)>,
 ) {
-    let mut wanted: Vec<(AssetId<RadiancePack>, Vec3, Vec3, f32)> = Vec::new();
-    for cam in &cameras {
-        let id = cam.pack.id();
-        if wanted.iter().any(|w| w.0 == id) {
+    let mut wanted: Vec<(Entity, ViewLayer, Vec3, Vec3, f32)> = Vec::new();
+    for (camera, cam, layer) in &cameras {
+        let Some(pack) = packs.get(cam.pack.id()) else {
             continue;
-        }
-        let Some(pack) = packs.get(id) else { continue };
+        };
         if let Some((towards, e)) = sun_at(pack, cam.time) {
             let b = &pack.reader.manifest().scene_bounds;
-            wanted.push((id, towards, e, (b.max - b.min).length()));
+            wanted.push((camera, *layer, towards, e, (b.max - b.min).length()));
         }
     }
     let lux = |e: Vec3| 0.2126 * e.x + 0.7152 * e.y + 0.0722 * e.z;
@@ -76,9 +79,9 @@ pub(super) fn update_suns(
         Transform::default().looking_to(-towards, up)
     };
     for (entity, sun, mut transform, mut light) in &mut suns {
-        match wanted.iter().position(|w| w.0 == sun.pack) {
+        match wanted.iter().position(|w| w.0 == sun.camera) {
             Some(i) => {
-                let (_, towards, e, _) = wanted.swap_remove(i);
+                let (_, _, towards, e, _) = wanted.swap_remove(i);
                 *transform = aim(towards);
                 light.illuminance = lux(e);
                 light.color = colour(e);
@@ -86,10 +89,11 @@ pub(super) fn update_suns(
             None => commands.entity(entity).despawn(),
         }
     }
-    for (pack, towards, e, diagonal) in wanted {
+    for (camera, layer, towards, e, diagonal) in wanted {
         commands.spawn((
             Name::new("plenoptic sun"),
-            PlenopticSun { pack },
+            PlenopticSun { camera },
+            layer.layers(),
             DirectionalLight {
                 illuminance: lux(e),
                 color: colour(e),

@@ -11,7 +11,7 @@
 //! at least three samples). The cubes (radiance as RGB9E5, distance, object id) are written
 //! into one `Rgba32Uint` 2D-array texture, six layers per view ([`VolumeCubes`]), and the
 //! image-mode passes ([`super::image`]) warp them as each view's single key (weight 1), blend
-//! the views and fill the background.
+//! the views and fill the background. Every volume-mode camera has its own [`VolumeCubes`].
 //!
 //! The cubes are rebuilt when the camera's time, its views or their weights change, once all
 //! the views' volume blocks of the window are resident in the stream cache. The rebuild is a
@@ -39,8 +39,9 @@ use crate::camera::ReconSettings;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::streaming::StreamCache;
 
-/// The volume-mode cubes of the first volume-mode camera, six layers per view.
-#[derive(Resource, Default)]
+/// A volume-mode camera's cubes, six layers per view (a component of the camera, added when
+/// it first enters volume mode on the GPU backend).
+#[derive(Component, Default)]
 pub struct VolumeCubes {
     /// The texture (`Rgba32Uint`, [`VolumeCubes::face`]² per layer), once built.
     pub image: Option<Handle<Image>>,
@@ -125,31 +126,55 @@ fn texels((radiance, distance, ids): &Cubes) -> Vec<u8> {
     out
 }
 
-/// Rebuilds [`VolumeCubes`] for the first volume-mode camera on the GPU backend when its time
-/// or views change and their volume blocks are resident.
+/// Rebuilds each volume-mode camera's [`VolumeCubes`] on the GPU backend when its time or
+/// views change and their volume blocks are resident.
 pub(super) fn prepare_cubes(
+    mut commands: Commands,
     backend: Res<ResolvedBackend>,
     cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<(&PlenopticCamera, &GlobalTransform)>,
+    mut cameras: Query<(
+        Entity,
+        &PlenopticCamera,
+        &GlobalTransform,
+        Option<&mut VolumeCubes>,
+    )>,
     mut images: ResMut<Assets<Image>>,
-    mut cubes: ResMut<VolumeCubes>,
 ) {
     if backend.0 != Backend::Gpu {
         return;
     }
+    for (entity, cam, transform, cubes) in &mut cameras {
+        if cam.mode != ReconMode::Volume {
+            continue;
+        }
+        match cubes {
+            Some(mut cubes) => prepare(&cache, &packs, cam, transform, &mut cubes, &mut images),
+            None => {
+                commands.entity(entity).insert(VolumeCubes::default());
+            }
+        }
+    }
+}
+
+/// [`prepare_cubes`] for one camera.
+fn prepare(
+    cache: &StreamCache,
+    packs: &Assets<RadiancePack>,
+    cam: &PlenopticCamera,
+    transform: &GlobalTransform,
+    cubes: &mut VolumeCubes,
+    images: &mut Assets<Image>,
+) {
     // A rebuild in flight: apply it when done; start no other meanwhile.
     if let Some((_, task)) = cubes.task.as_mut() {
         let Some(result) = check_ready(task) else {
             return;
         };
         if let Some((key, _)) = cubes.task.take() {
-            apply(&mut cubes, &mut images, key, result);
+            apply(cubes, images, key, result);
         }
     }
-    let Some((cam, transform)) = cameras.iter().find(|(c, _)| c.mode == ReconMode::Volume) else {
-        return;
-    };
     let id = cam.pack.id();
     let Some(pack) = packs.get(id) else {
         return;
