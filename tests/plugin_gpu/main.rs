@@ -7,6 +7,7 @@
 //!   a budget; GPU against CPU in every mode.
 //! - [`pack_asset`]: the `RadiancePack` asset and its failures.
 //! - [`sky`]: the sky, its ground and the glazing on the GPU.
+//! - [`lit`]: the app's own meshes lit by the pack's radiance around the camera.
 //! - [`many_cameras`]: several plenoptic cameras in one app (two modes and times, a stereo
 //!   pair, a runtime sun per camera), each equal to its CPU frame.
 
@@ -17,6 +18,7 @@ mod common;
 #[path = "../../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
+mod lit;
 mod many_cameras;
 mod pack_asset;
 mod scene_render;

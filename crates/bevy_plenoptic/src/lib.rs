@@ -57,6 +57,7 @@
 
 pub mod asset;
 pub mod camera;
+pub mod lit;
 pub mod proxy;
 pub mod reconstruct;
 pub mod streaming;
@@ -101,6 +102,7 @@ impl Plugin for PlenopticPlugin {
                 streaming::PlenopticStreamingPlugin,
                 reconstruct::PlenopticReconstructPlugin,
                 reconstruct::cpu::PlenopticCpuPlugin,
+                lit::PlenopticLitPlugin,
             ));
     }
 }
@@ -120,6 +122,10 @@ pub struct PlenopticSettings {
     /// geometry on a layer of its own, the lowest free one from here up
     /// ([`camera::layers`]). Choose it above the layers the app uses itself.
     pub first_render_layer: usize,
+    /// Light the app's own meshes with the pack: each plenoptic camera without an
+    /// environment light of its own gets one made from the pack's radiance around it at its
+    /// time ([`lit`]).
+    pub environment_light: bool,
 }
 
 /// Where frames are reconstructed.
@@ -151,6 +157,7 @@ impl Default for PlenopticSettings {
             prefetch_seconds: 0.5,
             backend: Backend::Auto,
             first_render_layer: 16,
+            environment_light: true,
         }
     }
 }
