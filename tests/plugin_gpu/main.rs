@@ -18,6 +18,7 @@ mod common;
 #[path = "../../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
+mod harness;
 mod lit;
 mod many_cameras;
 mod pack_asset;

@@ -7,8 +7,8 @@
 use std::sync::{Arc, Mutex};
 
 use crate::common::*;
+use crate::harness::compare;
 use crate::pack::{Materials, PackSpec, open_room, room, write_pack};
-use crate::scene_render::compare;
 use bevy::camera::Hdr;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
