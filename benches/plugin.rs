@@ -9,11 +9,14 @@
 //!   frame read back from the GPU (build the app and renderer, load the pack, spawn the proxy
 //!   geometry, stream the working set, compile the pipelines, render, read back). The frame
 //!   counts once the working set is resident and the read-back image shows the
-//!   reconstruction (no clear colour left, more than the placeholder's one colour).
+//!   reconstruction (no clear colour left, more than the placeholder's one colour), at
+//!   320 × 240 with one camera and at 1280 × 720 with one and with two cameras;
+//! - `plugin/frame`: one `App::update` of a settled app at 1280 × 720 with one and with two
+//!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes).
 //!
-//! GPU frame time is not measured here: the only adapter on CI is Mesa's software Vulkan
-//! driver (lavapipe), whose timings say nothing about real GPUs, and time to first frame on
-//! it is dominated by compiling the shaders on the CPU.
+//! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
+//! how the cost grows with pixels and cameras, not what a real GPU takes, and time to first
+//! frame on it is dominated by compiling the shaders on the CPU.
 //!
 //! `cargo bench --no-default-features --features bevy --bench plugin` (the `bevy` feature is
 //! required; the window feature is not).
@@ -75,12 +78,8 @@ fn decode(c: &mut Criterion) {
     g.finish();
 }
 
-const WIDTH: u32 = 320;
-const HEIGHT: u32 = 240;
-
-/// One headless app from nothing to its first reconstructed frame; returns the elapsed time.
-fn first_frame_once(assets: &std::path::Path) -> Duration {
-    let start = Instant::now();
+/// An app on the default plugins without a window, with plenoptic, loading from `assets`.
+fn headless_app(assets: &std::path::Path) -> App {
     let mut app = App::new();
     let plugins = DefaultPlugins
         .set(WindowPlugin {
@@ -99,50 +98,92 @@ fn first_frame_once(assets: &std::path::Path) -> Duration {
     app.add_plugins((plugins, PlenopticPlugin));
     app.finish();
     app.cleanup();
+    app
+}
+
+/// `cameras` plenoptic cameras on `room.pack`, each rendering `size` into its own image
+/// (split-screen players 0.5 m apart), with a read-back of each image into a slot.
+struct Scene {
+    app: App,
+    cameras: Vec<Entity>,
+    latest: Vec<Arc<Mutex<Option<Vec<u8>>>>>,
+}
+
+fn scene(assets: &std::path::Path, cameras: usize, size: UVec2) -> Scene {
+    let mut app = headless_app(assets);
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
-    let image = {
-        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba8Unorm, None);
-        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        app.world_mut().resource_mut::<Assets<Image>>().add(img)
-    };
-    let camera = app
-        .world_mut()
-        .spawn((
-            Camera {
-                clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
-                ..default()
-            },
-            RenderTarget::Image(image.clone().into()),
-            Tonemapping::None,
-            bevy::camera::Exposure {
-                ev100: bevy_plenoptic::camera::EV100_UNIT,
-            },
-            Transform::from_xyz(0.3, 1.3, 1.0).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
-            PlenopticCamera {
-                playback: Playback::Manual,
-                time: 0.7,
-                ..PlenopticCamera::new(handle)
-            },
-        ))
-        .id();
-    let latest: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
-    let sink = latest.clone();
-    app.world_mut()
-        .spawn(Readback::texture(image))
-        .observe(move |event: On<ReadbackComplete>| {
-            *sink.lock().unwrap() = Some(event.data.clone());
-        });
-    for _ in 0..100_000 {
-        app.update();
-        let complete = app.world().get::<StreamState>(camera).unwrap().complete;
-        let Some(data) = latest.lock().unwrap().take() else {
-            continue;
+    let mut entities = Vec::new();
+    let mut latest = Vec::new();
+    for n in 0..cameras {
+        let image = {
+            let mut img =
+                Image::new_target_texture(size.x, size.y, TextureFormat::Rgba8Unorm, None);
+            img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+            app.world_mut().resource_mut::<Assets<Image>>().add(img)
         };
-        if complete && shows_reconstruction(&data) {
-            return start.elapsed();
-        }
+        let eye = Vec3::new(0.3 - 0.5 * n as f32, 1.3, 1.0);
+        let camera = app
+            .world_mut()
+            .spawn((
+                Camera {
+                    clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
+                    order: n as isize,
+                    ..default()
+                },
+                RenderTarget::Image(image.clone().into()),
+                Tonemapping::None,
+                bevy::camera::Exposure {
+                    ev100: bevy_plenoptic::camera::EV100_UNIT,
+                },
+                Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
+                PlenopticCamera {
+                    playback: Playback::Manual,
+                    time: 0.7,
+                    ..PlenopticCamera::new(handle.clone())
+                },
+            ))
+            .id();
+        let slot: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
+        let sink = slot.clone();
+        app.world_mut().spawn(Readback::texture(image)).observe(
+            move |event: On<ReadbackComplete>| {
+                *sink.lock().unwrap() = Some(event.data.clone());
+            },
+        );
+        entities.push(camera);
+        latest.push(slot);
     }
-    panic!("no reconstructed frame");
+    Scene {
+        app,
+        cameras: entities,
+        latest,
+    }
+}
+
+impl Scene {
+    /// Updates until every camera's working set is resident and every read-back shows the
+    /// reconstruction.
+    fn until_reconstructed(&mut self) {
+        let mut shown = vec![false; self.cameras.len()];
+        for _ in 0..100_000 {
+            self.app.update();
+            for (n, &camera) in self.cameras.iter().enumerate() {
+                let complete = self
+                    .app
+                    .world()
+                    .get::<StreamState>(camera)
+                    .unwrap()
+                    .complete;
+                if let Some(data) = self.latest[n].lock().unwrap().take() {
+                    shown[n] = complete && shows_reconstruction(&data);
+                }
+            }
+            if shown.iter().all(|s| *s) {
+                return;
+            }
+        }
+        panic!("no reconstructed frame");
+    }
 }
 
 /// No red clear colour left and more distinct colours than the placeholder material's one.
@@ -155,24 +196,74 @@ fn shows_reconstruction(rgba: &[u8]) -> bool {
     !cleared && colours.len() > 16
 }
 
-fn first_frame(c: &mut Criterion) {
+/// The room pack the frame benchmarks show, in a temporary folder.
+fn room_pack() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     pack::write_pack(
         &pack::room(true),
         &pack::PackSpec::segment(3, vec![0.0, 1.0, 2.0], 32),
         &dir.path().join("room.pack"),
     );
+    dir
+}
+
+/// Frame sizes and camera counts measured: the small first frame of earlier runs, and one
+/// and two cameras at 1280 × 720 (each camera reconstructs its own frame).
+const CASES: [(&str, UVec2, usize); 3] = [
+    ("room_face32_320x240", UVec2::new(320, 240), 1),
+    ("room_face32_1280x720_1camera", UVec2::new(1280, 720), 1),
+    ("room_face32_1280x720_2cameras", UVec2::new(1280, 720), 2),
+];
+
+fn first_frame(c: &mut Criterion) {
+    let dir = room_pack();
     let mut g = c.benchmark_group("plugin/time_to_first_frame");
     // Seconds per iteration: one iteration per sample, few samples.
     g.sample_size(10)
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(1))
         .measurement_time(Duration::from_secs(10));
-    g.bench_function("room_face32_320x240", |b| {
-        b.iter_custom(|iters| (0..iters).map(|_| first_frame_once(dir.path())).sum())
-    });
+    for (name, size, cameras) in CASES {
+        g.bench_function(name, |b| {
+            b.iter_custom(|iters| {
+                (0..iters)
+                    .map(|_| {
+                        let start = Instant::now();
+                        scene(dir.path(), cameras, size).until_reconstructed();
+                        start.elapsed()
+                    })
+                    .sum()
+            })
+        });
+    }
     g.finish();
 }
 
-criterion_group!(benches, decode, first_frame);
+/// One frame of a settled app (every working set resident, pipelines compiled, the frame
+/// reconstructed): `App::update`, main world and render world (pipelined) together,
+/// read-backs included.
+fn frame(c: &mut Criterion) {
+    let dir = room_pack();
+    let mut g = c.benchmark_group("plugin/frame");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(10));
+    for (name, size, cameras) in &CASES[1..] {
+        // Set up on the first call only (criterion calls the closure once per sample), and
+        // not at all when a filter leaves this case out.
+        let mut settled: Option<Scene> = None;
+        g.bench_function(*name, |b| {
+            let s = settled.get_or_insert_with(|| {
+                let mut s = scene(dir.path(), *cameras, *size);
+                s.until_reconstructed();
+                s
+            });
+            b.iter(|| s.app.update())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, decode, first_frame, frame);
 criterion_main!(benches);
