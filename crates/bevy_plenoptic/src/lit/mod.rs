@@ -22,6 +22,15 @@
 //!
 //! A camera that already has an `EnvironmentMapLight` or a `GeneratedEnvironmentMapLight`
 //! of its own keeps it; [`crate::PlenopticSettings::environment_light`] turns this off.
+//!
+//! Meshes near a base view are lit by that view's own cube instead, through a light probe
+//! at the base view ([`probes`]; where the device has binding arrays); the camera's light
+//! serves the meshes outside every probe. Their diffuse light comes from an irradiance
+//! volume over the scene, each voxel taking the ambient cube of its nearest base view
+//! ([`volume`]), on every device.
+
+pub mod probes;
+pub mod volume;
 
 use std::collections::HashMap;
 
@@ -52,8 +61,15 @@ impl Plugin for PlenopticLitPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             Update,
-            update_environment_lights.after(PlenopticSystems::Streaming),
-        );
+            (
+                update_environment_lights,
+                probes::update_probes,
+                volume::update_volumes,
+            )
+                .chain()
+                .after(PlenopticSystems::Streaming),
+        )
+        .init_resource::<probes::ProbeKeys>();
     }
 }
 
@@ -68,7 +84,7 @@ pub struct PackEnvironmentLight {
 }
 
 /// What a source cubemap holds: pack, view, and (key, weight bits) of each blended key.
-type Source = (AssetId<RadiancePack>, u32, Vec<(u32, u32)>);
+pub(crate) type Source = (AssetId<RadiancePack>, u32, Vec<(u32, u32)>);
 
 /// The radiance of key `data` as linear RGB per texel, if its format is one the pack writes.
 fn radiance(data: &DecodedKey) -> Option<Vec<Vec3>> {
@@ -143,6 +159,59 @@ pub fn source_image(face: u32, keys: &[(Vec<Vec3>, f32)], map: &[usize]) -> Imag
     image
 }
 
+/// Radiance cubes (per texel) with their weights.
+pub(crate) type WeightedCubes = Vec<(Vec<Vec3>, f32)>;
+
+/// Base view `v` of `pack` at time `t` from the resident keys: what its blended source
+/// would hold (time weights quantised to `1 / steps`), its face and each key's radiance with
+/// its weight; `None` when none of its bracketing keys is resident or readable.
+pub(crate) fn view_source(
+    cache: &StreamCache,
+    id: AssetId<RadiancePack>,
+    pack: &RadiancePack,
+    v: usize,
+    t: f32,
+    steps: f32,
+) -> Option<(Source, u32, WeightedCubes)> {
+    let m = pack.reader.manifest();
+    let (k0, k1, f) = bracketing(&m.base_views.get(v)?.time_keys, t)?;
+    let mut wanted = vec![(k0, 1.0 - f)];
+    if k1 != k0 {
+        wanted.push((k1, f));
+    }
+    // The resident ones, their weights renormalised.
+    let resident: Vec<_> = wanted
+        .into_iter()
+        .filter(|&(_, w)| w > 1e-4)
+        .filter_map(|(k, w)| Some((k, w, cache.get(id, (v as u32, k as u32))?.data.clone())))
+        .collect();
+    let total: f32 = resident.iter().map(|r| r.1).sum();
+    if resident.is_empty() || total <= 0.0 {
+        return None;
+    }
+    // Quantised, so that a playing camera rewrites the cubemap `steps` times per key
+    // interval at most.
+    let source: Source = (
+        id,
+        v as u32,
+        resident
+            .iter()
+            .map(|r| (r.0 as u32, ((r.1 / total) * steps).round() as u32))
+            .collect(),
+    );
+    let face = resident[0].2.face_size;
+    let keys = resident
+        .iter()
+        .map(|(_, w, data)| {
+            (data.face_size == face)
+                .then(|| radiance(data))
+                .flatten()
+                .map(|r| (r, w / total))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some((source, face, keys))
+}
+
 /// A camera and what it has of an environment light.
 type LitCamera<'a> = (
     Entity,
@@ -183,49 +252,12 @@ fn update_environment_lights(
         let Some(&(v, _)) = views.first() else {
             continue;
         };
-        let Some((k0, k1, f)) = bracketing(&m.base_views[v].time_keys, cam.time) else {
+        let Some((source, face, keys)) = view_source(&cache, id, pack, v, cam.time, 256.0) else {
             continue;
         };
-        let mut wanted = vec![(k0, 1.0 - f)];
-        if k1 != k0 {
-            wanted.push((k1, f));
-        }
-        // The resident ones, their weights renormalised.
-        let resident: Vec<_> = wanted
-            .into_iter()
-            .filter(|&(_, w)| w > 1e-4)
-            .filter_map(|(k, w)| Some((k, w, cache.get(id, (v as u32, k as u32))?.data.clone())))
-            .collect();
-        let total: f32 = resident.iter().map(|r| r.1).sum();
-        if resident.is_empty() || total <= 0.0 {
-            continue;
-        }
-        // Quantised so that a playing camera rewrites the cubemap 256 times per key interval
-        // at most.
-        let source: Source = (
-            id,
-            v as u32,
-            resident
-                .iter()
-                .map(|r| (r.0 as u32, ((r.1 / total) * 256.0).round() as u32))
-                .collect(),
-        );
         if ours.as_ref().and_then(|o| o.built_for.as_ref()) == Some(&source) {
             continue;
         }
-        let face = resident[0].2.face_size;
-        let Some(keys) = resident
-            .iter()
-            .map(|(_, w, data)| {
-                (data.face_size == face)
-                    .then(|| radiance(data))
-                    .flatten()
-                    .map(|r| (r, w / total))
-            })
-            .collect::<Option<Vec<_>>>()
-        else {
-            continue;
-        };
         let map = maps
             .entry((face, source_face(face)))
             .or_insert_with(|| texel_map(face, source_face(face)));
