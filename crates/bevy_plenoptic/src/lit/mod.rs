@@ -71,6 +71,27 @@ impl Plugin for PlenopticLitPlugin {
         )
         .init_resource::<probes::ProbeKeys>();
     }
+
+    fn finish(&self, app: &mut App) {
+        // Bevy's own test (bevy_pbr's `binding_arrays_are_usable`, not public): without
+        // binding arrays it ignores reflection probes, so the probes' cubemaps would be
+        // filtered every frame for nothing.
+        let usable = app
+            .get_sub_app(bevy::render::RenderApp)
+            .and_then(|r| {
+                r.world()
+                    .get_resource::<bevy::render::renderer::RenderDevice>()
+            })
+            .is_some_and(|d| {
+                use bevy::render::settings::WgpuFeatures;
+                d.features().contains(
+                    WgpuFeatures::TEXTURE_BINDING_ARRAY
+                        | WgpuFeatures::SAMPLED_TEXTURE_AND_STORAGE_BUFFER_ARRAY_NON_UNIFORM_INDEXING,
+                ) && d.limits().max_binding_array_elements_per_shader_stage >= 24
+                    && d.limits().max_binding_array_sampler_elements_per_shader_stage >= 24
+            });
+        app.insert_resource(probes::ReflectionProbes(usable));
+    }
 }
 
 /// The pack's environment light of a camera: the source cubemap the plugin writes and what

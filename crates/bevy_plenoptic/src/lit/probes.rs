@@ -16,6 +16,9 @@
 //! [`PROBE_FACE`] texels a face ([`ProbeKeys`]), two keys per base view at a time (6 · 64² ·
 //! 12 bytes, 295 KB, per key), outside the streaming budget.
 //!
+//! Where the device has no binding arrays Bevy ignores reflection probes ([`ReflectionProbes`]):
+//! the probes then keep only their ambient cubes, for the irradiance volume.
+//!
 //! Bevy's light probes are world entities, not per view: two cameras at different times of
 //! one pack share the first camera's probes (their own environment lights are their own).
 //! A probe whose keys are evicted keeps its last cubemap until they return.
@@ -81,6 +84,12 @@ fn read_key(reader: &PackReader, v: u32, k: u32) -> Option<ProbeCube> {
     Some((out, downsample(cube.face_size, &cube.texels, out)))
 }
 
+/// Whether the device lets Bevy apply reflection probes (binding arrays). Without, the
+/// probes keep their ambient cubes for the irradiance volume ([`super::volume`]) but get no
+/// Bevy light probe (its cubemap would be filtered every frame for nothing).
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct ReflectionProbes(pub bool);
+
 /// A light probe the plugin keeps at a base view.
 #[derive(Component, Debug, Clone)]
 pub struct PlenopticProbe {
@@ -88,8 +97,9 @@ pub struct PlenopticProbe {
     pub pack: AssetId<RadiancePack>,
     /// The base view it stands at.
     pub view: u32,
-    /// Its source cubemap.
-    pub image: Handle<Image>,
+    /// Its source cubemap (none where Bevy cannot apply reflection probes:
+    /// [`ReflectionProbes`]).
+    pub image: Option<Handle<Image>>,
     /// The ambient cube of its radiance (+X, −X, +Y, −Y, +Z, −Z; [`super::volume`]).
     pub ambient: [Vec3; 6],
     built_for: Source,
@@ -118,6 +128,7 @@ pub(super) fn update_probes(
     mut commands: Commands,
     settings: Res<PlenopticSettings>,
     mut keys: ResMut<ProbeKeys>,
+    support: Option<Res<ReflectionProbes>>,
     packs: Res<Assets<RadiancePack>>,
     cameras: Query<&PlenopticCamera>,
     mut probes: Query<(Entity, &mut PlenopticProbe)>,
@@ -207,26 +218,31 @@ pub(super) fn update_probes(
             if current.as_ref().is_some_and(|(_, p)| p.built_for == source) {
                 continue;
             }
-            let map = maps
-                .entry((face, source_face(face)))
-                .or_insert_with(|| texel_map(face, source_face(face)));
             let weighted: Vec<(Vec<Vec3>, f32)> =
                 cubes.iter().map(|(c, w)| (c.1.clone(), *w)).collect();
-            let image = source_image(face, &weighted, map);
             let blended: Vec<Vec3> = (0..weighted[0].0.len())
                 .map(|i| weighted.iter().map(|(c, w)| c[i] * *w).sum())
                 .collect();
             let ambient = super::volume::ambient_cube(face, &blended);
+            let reflections = support.as_ref().is_some_and(|s| s.0);
+            let image = reflections.then(|| {
+                let map = maps
+                    .entry((face, source_face(face)))
+                    .or_insert_with(|| texel_map(face, source_face(face)));
+                source_image(face, &weighted, map)
+            });
             match current {
                 Some((_, mut probe)) => {
-                    images.insert(&probe.image, image).ok();
+                    if let (Some(image), Some(handle)) = (image, &probe.image) {
+                        images.insert(handle, image).ok();
+                    }
                     probe.built_for = source;
                     probe.ambient = ambient;
                 }
                 None => {
-                    let handle = images.add(image);
                     let side = probe_side(&positions, v, diagonal);
-                    commands.spawn((
+                    let handle = image.map(|i| images.add(i));
+                    let mut probe = commands.spawn((
                         Name::new(format!("plenoptic probe {v}")),
                         PlenopticProbe {
                             pack: id,
@@ -235,14 +251,18 @@ pub(super) fn update_probes(
                             ambient,
                             built_for: source,
                         },
-                        LightProbe::default(),
-                        GeneratedEnvironmentMapLight {
-                            environment_map: handle,
-                            intensity: 1.0,
-                            ..default()
-                        },
                         Transform::from_translation(positions[v]).with_scale(Vec3::splat(side)),
                     ));
+                    if let Some(handle) = handle {
+                        probe.insert((
+                            LightProbe::default(),
+                            GeneratedEnvironmentMapLight {
+                                environment_map: handle,
+                                intensity: 1.0,
+                                ..default()
+                            },
+                        ));
+                    }
                 }
             }
         }
