@@ -16,6 +16,8 @@
 //! stays), and a mesh outside the volume's box ([`volume_box`]) gets no diffuse light from
 //! the pack.
 
+use std::collections::HashMap;
+
 use bevy::asset::RenderAssetUsages;
 use bevy::light::{IrradianceVolume, LightProbe};
 use bevy::prelude::*;
@@ -68,25 +70,44 @@ pub fn resolution(size: Vec3, spacing: f32) -> UVec3 {
     UVec3::new(n(size.x), n(size.y), n(size.z))
 }
 
-/// Bevy's irradiance-volume texture of `res` voxels over the box `(min, max)`: each voxel
-/// takes the ambient cube of the nearest of `views` (position, ambient cube). Layout (as
-/// Bevy's `irradiance_volume.wgsl` samples it): a 3D texture of `(Rx, 2Ry, 3Rz)`, the
-/// positive directions in rows `0..Ry` and the negative ones in `Ry..2Ry`, X, Y and Z in
-/// slices `0..Rz`, `Rz..2Rz`, `2Rz..3Rz`.
-pub fn voxel_image(min: Vec3, max: Vec3, res: UVec3, views: &[(Vec3, [Vec3; 6])]) -> Image {
-    let (w, h, d) = (res.x, 2 * res.y, 3 * res.z);
-    let mut data = vec![0u8; (w * h * d) as usize * 8];
+/// For each voxel of a volume of `res` voxels over the box `(min, max)` (x fastest, then y,
+/// then z), the index of the nearest of `views`.
+pub fn nearest_views(min: Vec3, max: Vec3, res: UVec3, views: &[Vec3]) -> Vec<usize> {
     let size = max - min;
+    let mut out = Vec::with_capacity((res.x * res.y * res.z) as usize);
     for z in 0..res.z {
         for y in 0..res.y {
             for x in 0..res.x {
                 let centre = min + size * (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
-                let Some((_, cube)) = views
-                    .iter()
-                    .min_by(|a, b| a.0.distance(centre).total_cmp(&b.0.distance(centre)))
-                else {
-                    continue;
-                };
+                let nearest = (0..views.len())
+                    .min_by(|&a, &b| {
+                        views[a]
+                            .distance(centre)
+                            .total_cmp(&views[b].distance(centre))
+                    })
+                    .unwrap_or(0);
+                out.push(nearest);
+            }
+        }
+    }
+    out
+}
+
+/// Bevy's irradiance-volume texture of `res` voxels: voxel `i` (in [`nearest_views`]'
+/// order) takes `cubes[nearest[i]]`, an ambient cube (+X, −X, +Y, −Y, +Z, −Z). Layout (as
+/// Bevy's `irradiance_volume.wgsl` samples it): a 3D texture of `(Rx, 2Ry, 3Rz)`, the
+/// positive directions in rows `0..Ry` and the negative ones in `Ry..2Ry`, X, Y and Z in
+/// slices `0..Rz`, `Rz..2Rz`, `2Rz..3Rz`.
+pub fn voxel_image(res: UVec3, nearest: &[usize], cubes: &[[Vec3; 6]]) -> Image {
+    let (w, h, d) = (res.x, 2 * res.y, 3 * res.z);
+    let mut data = vec![0u8; (w * h * d) as usize * 8];
+    let mut voxel = 0;
+    for z in 0..res.z {
+        for y in 0..res.y {
+            for x in 0..res.x {
+                let cube = nearest.get(voxel).and_then(|&n| cubes.get(n));
+                voxel += 1;
+                let Some(cube) = cube else { continue };
                 for (side, value) in cube.iter().enumerate() {
                     let (axis, negative) = (side / 2, side % 2 == 1);
                     let t = y + if negative { res.y } else { 0 };
@@ -136,14 +157,26 @@ pub fn volume_box(bounds: (Vec3, Vec3), views: &[Vec3], spacing: f32) -> (Vec3, 
     (min - grow, max + grow)
 }
 
-/// Keeps one irradiance volume per pack with probes, rebuilt when a probe changes.
+/// A pack's volume layout: its box and resolution (from all its usable base views, so it
+/// does not move as probes arrive), and for the probes present (their views, sorted) each
+/// voxel's nearest.
+pub(super) struct Layout {
+    min: Vec3,
+    max: Vec3,
+    res: UVec3,
+    views: Vec<u32>,
+    nearest: Vec<usize>,
+}
+
+/// Keeps one irradiance volume per pack with probes, rebuilt when one of its probes changes.
 pub(super) fn update_volumes(
     mut commands: Commands,
     packs: Res<Assets<RadiancePack>>,
     probes: Query<&PlenopticProbe>,
-    changed: Query<(), Changed<PlenopticProbe>>,
+    changed: Query<&PlenopticProbe, Changed<PlenopticProbe>>,
     volumes: Query<(Entity, &PlenopticIrradianceVolume)>,
     mut images: ResMut<Assets<Image>>,
+    mut layouts: Local<HashMap<AssetId<RadiancePack>, Layout>>,
 ) {
     let mut ids: Vec<AssetId<RadiancePack>> = probes.iter().map(|p| p.pack).collect();
     ids.sort();
@@ -153,31 +186,45 @@ pub(super) fn update_volumes(
             commands.entity(entity).despawn();
         }
     }
-    if changed.is_empty() {
-        return;
-    }
+    layouts.retain(|id, _| ids.contains(id));
     for id in ids {
+        if !changed.iter().any(|p| p.pack == id) {
+            continue;
+        }
         let Some(pack) = packs.get(id) else { continue };
         let m = pack.reader.manifest();
-        let views: Vec<(Vec3, [Vec3; 6])> = probes
-            .iter()
-            .filter(|p| p.pack == id)
-            .map(|p| (m.base_views[p.view as usize].position, p.ambient))
-            .collect();
-        let positions: Vec<Vec3> = views.iter().map(|v| v.0).collect();
-        let spacing = (0..positions.len())
-            .map(|v| super::probes::probe_side(&positions, v, 0.0))
-            .fold(f32::INFINITY, f32::min);
-        let (min, max) = volume_box(
-            (m.scene_bounds.min, m.scene_bounds.max),
-            &positions,
-            spacing,
-        );
-        let size = max - min;
-        let res = resolution(size, 0.5 * spacing.min(size.max_element()));
-        let image = voxel_image(min, max, res, &views);
-        let existing = volumes.iter().find(|(_, v)| v.pack == id);
-        match existing {
+        let mut present: Vec<&PlenopticProbe> = probes.iter().filter(|p| p.pack == id).collect();
+        present.sort_by_key(|p| p.view);
+        let views: Vec<u32> = present.iter().map(|p| p.view).collect();
+        let layout = layouts.entry(id).or_insert_with(|| {
+            let all: Vec<Vec3> = (0..m.base_views.len())
+                .filter(|&v| pack.usable_views.get(v).copied().unwrap_or(false))
+                .map(|v| m.base_views[v].position)
+                .collect();
+            let spacing = (0..all.len())
+                .map(|v| super::probes::probe_side(&all, v, 0.0))
+                .fold(f32::INFINITY, f32::min);
+            let (min, max) = volume_box((m.scene_bounds.min, m.scene_bounds.max), &all, spacing);
+            let size = max - min;
+            Layout {
+                min,
+                max,
+                res: resolution(size, 0.5 * spacing.min(size.max_element())),
+                views: Vec::new(),
+                nearest: Vec::new(),
+            }
+        });
+        if layout.views != views {
+            let positions: Vec<Vec3> = views
+                .iter()
+                .map(|&v| m.base_views[v as usize].position)
+                .collect();
+            layout.nearest = nearest_views(layout.min, layout.max, layout.res, &positions);
+            layout.views = views;
+        }
+        let cubes: Vec<[Vec3; 6]> = present.iter().map(|p| p.ambient).collect();
+        let image = voxel_image(layout.res, &layout.nearest, &cubes);
+        match volumes.iter().find(|(_, v)| v.pack == id) {
             Some((_, volume)) => {
                 images.insert(&volume.voxels, image).ok();
             }
@@ -195,7 +242,8 @@ pub(super) fn update_volumes(
                         intensity: 1.0,
                         ..default()
                     },
-                    Transform::from_translation(0.5 * (min + max)).with_scale(size),
+                    Transform::from_translation(0.5 * (layout.min + layout.max))
+                        .with_scale(layout.max - layout.min),
                 ));
             }
         }
@@ -230,11 +278,10 @@ mod tests {
         let side = |x: f32| [Vec3::splat(x); 6];
         let mut a = side(1.0);
         a[3] = Vec3::splat(0.5); // −Y of the view at x = 0
-        let views = [
-            (Vec3::new(0.0, 0.0, 0.0), a),
-            (Vec3::new(2.0, 0.0, 0.0), side(3.0)),
-        ];
-        let image = voxel_image(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0), res, &views);
+        let views = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0)];
+        let nearest = nearest_views(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0), res, &views);
+        assert_eq!(nearest, [0, 1]);
+        let image = voxel_image(res, &nearest, &[a, side(3.0)]);
         assert_eq!(image.texture_descriptor.size.width, 2);
         assert_eq!(image.texture_descriptor.size.height, 2);
         assert_eq!(image.texture_descriptor.size.depth_or_array_layers, 3);
