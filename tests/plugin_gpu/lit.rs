@@ -11,7 +11,7 @@ use bevy::light::GlobalAmbientLight;
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::lit::PackEnvironmentLight;
-use bevy_plenoptic::lit::probes::PlenopticProbe;
+use bevy_plenoptic::lit::probes::{PlenopticProbe, ReflectionProbes};
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
 use plenoptic_pack::cube::texel_direction;
@@ -137,22 +137,8 @@ fn sphere_scene(
         .map(|(p, t)| (p.view, t.translation, t.scale.x))
         .collect();
     probes.sort_by_key(|p| p.0);
-    // Bevy's own test (bevy_pbr's `binding_arrays_are_usable`, not public): without these,
-    // it disables reflection probes and every mesh takes the view's environment map.
-    let binding_arrays = {
-        use bevy::render::settings::WgpuFeatures;
-        let dev = app
-            .world()
-            .resource::<bevy::render::renderer::RenderDevice>();
-        dev.features().contains(
-            WgpuFeatures::TEXTURE_BINDING_ARRAY
-                | WgpuFeatures::SAMPLED_TEXTURE_AND_STORAGE_BUFFER_ARRAY_NON_UNIFORM_INDEXING,
-        ) && dev.limits().max_binding_array_elements_per_shader_stage >= 24
-            && dev
-                .limits()
-                .max_binding_array_sampler_elements_per_shader_stage
-                >= 24
-    };
+    // The plugin's reading of Bevy's own test (binding arrays), made once in `finish`.
+    let binding_arrays = app.world().resource::<ReflectionProbes>().0;
 
     // The expected radiance of the sphere's pixels, from the pack itself: each asked view at
     // t, its bracketing keys blended.

@@ -218,10 +218,9 @@ pub(super) fn update_probes(
             if current.as_ref().is_some_and(|(_, p)| p.built_for == source) {
                 continue;
             }
-            let weighted: Vec<(Vec<Vec3>, f32)> =
-                cubes.iter().map(|(c, w)| (c.1.clone(), *w)).collect();
-            let blended: Vec<Vec3> = (0..weighted[0].0.len())
-                .map(|i| weighted.iter().map(|(c, w)| c[i] * *w).sum())
+            // Blended once: the ambient cube and the cubemap both read this.
+            let blended: Vec<Vec3> = (0..cubes[0].0.1.len())
+                .map(|i| cubes.iter().map(|(c, w)| c.1[i] * *w).sum())
                 .collect();
             let ambient = super::volume::ambient_cube(face, &blended);
             let reflections = support.as_ref().is_some_and(|s| s.0);
@@ -229,7 +228,7 @@ pub(super) fn update_probes(
                 let map = maps
                     .entry((face, source_face(face)))
                     .or_insert_with(|| texel_map(face, source_face(face)));
-                source_image(face, &weighted, map)
+                source_image(face, &[(blended, 1.0)], map)
             });
             match current {
                 Some((_, mut probe)) => {
