@@ -62,7 +62,9 @@
 //!   the tour, each mode's reconstruction of them, errors, plot, montage and figures, at
 //!   `--width`/`--height` (default 320 × 180); and a crop at full resolution of frame
 //!   `--crop-frame K` (default [`CROP_FRAME`]) against a reference of `--crop-spp N`
-//!   (default 256) samples per pixel and half.
+//!   (default 256) samples per pixel and half. The reconstructions are supersampled
+//!   `--supersampling N` × N per pixel (default [`results::SUPERSAMPLING`]), a box filter over
+//!   the pixel as the references have.
 
 mod results;
 #[allow(dead_code, reason = "some items are for tests/tour_scene.rs")]
@@ -105,6 +107,7 @@ struct Options {
     spp: u32,
     crop_frame: Option<usize>,
     crop_spp: u32,
+    supersampling: u32,
     screenshot: Option<PathBuf>,
     screenshot_at: f32,
     streaming: bool,
@@ -115,7 +118,7 @@ const CROP_FRAME: usize = 4;
 
 const USAGE: &str = "usage: architectural_tour [--headless] [--cpu] [--frames N] [--width W] \
                      [--height H] [--out DIR] [--pack FILE] [--recipe FILE] [--mode geometry|image|volume] \
-                     [--plan] [--streaming] [--quiet] [--results DIR [--spp N] [--crop-frame K] [--crop-spp N]] [--screenshot FILE [--screenshot-at S]]";
+                     [--plan] [--streaming] [--quiet] [--results DIR [--spp N] [--crop-frame K] [--crop-spp N] [--supersampling N]] [--screenshot FILE [--screenshot-at S]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -134,6 +137,7 @@ fn parse_args() -> Result<Options, String> {
         spp: 128,
         crop_frame: None,
         crop_spp: 256,
+        supersampling: results::SUPERSAMPLING,
         screenshot: None,
         screenshot_at: 4.0,
         streaming: false,
@@ -169,6 +173,9 @@ fn parse_args() -> Result<Options, String> {
                 );
             }
             "--crop-spp" => o.crop_spp = number("--crop-spp", value("--crop-spp")?)?,
+            "--supersampling" => {
+                o.supersampling = number("--supersampling", value("--supersampling")?)?
+            }
             "--screenshot" => o.screenshot = Some(value("--screenshot")?.into()),
             "--screenshot-at" => {
                 let v = value("--screenshot-at")?;
@@ -311,6 +318,7 @@ fn run(options: &Options) -> Result<(), BoxError> {
                 height: options.height.unwrap_or(180),
                 crop_frame: options.crop_frame.unwrap_or(CROP_FRAME),
                 crop_spp: options.crop_spp,
+                supersampling: options.supersampling,
                 progress: !options.quiet,
             },
         );

@@ -116,6 +116,10 @@ enum Command {
         /// as version-1 packs were shown).
         #[arg(long, default_value = "materials")]
         shading: String,
+        /// Samples per pixel along each axis, box-filtered (1: the pixel centre; a path-traced
+        /// reference's pixels are box-filtered, so compare with 2–4).
+        #[arg(long, default_value_t = 1)]
+        supersampling: u32,
         /// Output directory.
         #[arg(long, default_value = "frames")]
         out: PathBuf,
@@ -255,6 +259,7 @@ fn run(command: Command) -> Result<()> {
             path,
             mode,
             shading,
+            supersampling,
             out,
         } => {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
@@ -273,6 +278,7 @@ fn run(command: Command) -> Result<()> {
                 let camera_path = plenoptic_recon::CameraPath::load(&path)?;
                 let mut rec = plenoptic_recon::Reconstructor::open(&pack)?;
                 rec.settings.shading = shading;
+                rec.settings.supersampling = supersampling;
                 plenoptic_eval::tools::render_path_with(
                     &rec,
                     &camera_path,

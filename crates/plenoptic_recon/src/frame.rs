@@ -34,6 +34,33 @@ impl Frame {
     }
 }
 
+/// `fine`, a frame of n × n samples per pixel, filtered to one value per pixel: the mean
+/// radiance over each pixel's samples (a box filter over its area), and the depth and object
+/// id of the sample nearest its centre. `fine`'s size must be a multiple of n.
+pub(crate) fn box_filter(fine: &Frame, n: u32) -> Frame {
+    let (w, h) = (fine.width / n, fine.height / n);
+    let mut out = Frame::new(w, h);
+    let centre = (n / 2) as usize;
+    let n = n as usize;
+    let scale = 1.0 / (n * n) as f32;
+    let fw = fine.width as usize;
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            let mut sum = Vec3::ZERO;
+            for sy in 0..n {
+                let row = (y * n + sy) * fw + x * n;
+                sum += fine.radiance[row..row + n].iter().copied().sum::<Vec3>();
+            }
+            let i = y * w as usize + x;
+            let c = (y * n + centre) * fw + x * n + centre;
+            out.radiance[i] = sum * scale;
+            out.depth[i] = fine.depth[c];
+            out.object[i] = fine.object[c];
+        }
+    }
+    out
+}
+
 /// The reconstruction modes (docs/architecture.md, "Reconstruction").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -142,5 +169,30 @@ impl Report {
     /// True when something needed was missing.
     pub fn degraded(&self) -> bool {
         !self.missing.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_filter_averages_each_pixels_samples_and_keeps_the_centre_sample_id() {
+        // 4 × 2 samples, 2 × 2 per pixel: a bright edge covering a quarter of the left pixel.
+        let mut fine = Frame::new(4, 2);
+        fine.radiance[0] = Vec3::splat(8.0);
+        for (i, (d, o)) in fine.depth.iter_mut().zip(&mut fine.object).enumerate() {
+            *d = i as f32;
+            *o = i as u32 + 10;
+        }
+        fine.radiance[2] = Vec3::new(1.0, 2.0, 3.0);
+        fine.radiance[7] = Vec3::new(3.0, 2.0, 1.0);
+        let out = box_filter(&fine, 2);
+        assert_eq!((out.width, out.height), (2, 1));
+        assert!((out.radiance[0] - Vec3::splat(2.0)).abs().max_element() < 1e-6);
+        assert!((out.radiance[1] - Vec3::splat(1.0)).abs().max_element() < 1e-6);
+        // The sample nearest each pixel's centre: (1, 1) of the 2 × 2 block.
+        assert_eq!(out.object, vec![15, 17]);
+        assert_eq!(out.depth, vec![5.0, 7.0]);
     }
 }

@@ -44,8 +44,11 @@ pub struct Reconstructor {
     packed: Mutex<HashMap<(u32, u32, Channel), Arc<PackedTexels>>>,
     /// The pack's materials, proxy UVs and decoded textures, loaded on first use.
     materials: std::sync::OnceLock<crate::material::Materials>,
-    /// The runtime sun and its shadow geometry, built on first use.
+    /// The runtime sun, read on first use.
     sun: std::sync::OnceLock<Option<crate::sun::RuntimeSun>>,
+    /// The proxies as rays see them (the sun's shadow rays, reflected rays that leave the
+    /// scene), built on first use.
+    rays: std::sync::OnceLock<Option<crate::shadow::ShadowScene>>,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -68,6 +71,9 @@ pub(crate) struct KeyCubes {
     /// Normals, when readable (sharpen the distance test at grazing angles).
     pub normal: Option<Arc<CubeImage<Vec3>>>,
 }
+
+/// The most samples per pixel along each axis [`ReconSettings::supersampling`] is taken at.
+pub const MAX_SUPERSAMPLING: u32 = 8;
 
 impl Reconstructor {
     /// Opens the pack at `path` with default settings.
@@ -92,6 +98,7 @@ impl Reconstructor {
             packed: Mutex::new(HashMap::new()),
             materials: std::sync::OnceLock::new(),
             sun: std::sync::OnceLock::new(),
+            rays: std::sync::OnceLock::new(),
         }
     }
 
@@ -117,10 +124,19 @@ impl Reconstructor {
     }
 
     /// The pack's runtime sun, when its lighting leaves the sun's direct light out (pack 3)
-    /// and it has proxies to cast shadows; its shadow BVHs are built on first use.
+    /// and it has proxies to cast shadows.
     pub fn runtime_sun(&self) -> Option<&crate::sun::RuntimeSun> {
+        self.proxy.as_ref()?;
         self.sun
-            .get_or_init(|| crate::sun::RuntimeSun::load(&self.pack, self.proxy.as_ref()))
+            .get_or_init(|| crate::sun::RuntimeSun::load(&self.pack))
+            .as_ref()
+    }
+
+    /// The proxies' ray-cast geometry (BVHs built on first use), when the pack has proxies.
+    pub(crate) fn proxy_rays(&self) -> Option<&crate::shadow::ShadowScene> {
+        let proxy = self.proxy.as_ref()?;
+        self.rays
+            .get_or_init(|| Some(crate::shadow::ShadowScene::new(proxy)))
             .as_ref()
     }
 
@@ -366,8 +382,25 @@ impl Reconstructor {
         self.settings.view_weights(m, &usable, position)
     }
 
-    /// Reconstructs the frame `camera` sees at time `t` in `mode`.
+    /// Reconstructs the frame `camera` sees at time `t` in `mode`, with
+    /// [`ReconSettings::supersampling`] samples per pixel along each axis.
     pub fn render(&self, camera: &Camera, t: f32, mode: Mode) -> Result<(Frame, Report)> {
+        camera.validate()?;
+        let n = self.settings.supersampling.clamp(1, MAX_SUPERSAMPLING);
+        if n == 1 {
+            return self.render_samples(camera, t, mode);
+        }
+        let fine = Camera {
+            width: camera.width * n,
+            height: camera.height * n,
+            ..camera.clone()
+        };
+        let (frame, report) = self.render_samples(&fine, t, mode)?;
+        Ok((crate::frame::box_filter(&frame, n), report))
+    }
+
+    /// [`Reconstructor::render`] with one sample per pixel (its centre).
+    fn render_samples(&self, camera: &Camera, t: f32, mode: Mode) -> Result<(Frame, Report)> {
         camera.validate()?;
         let mut report = Report {
             mode,

@@ -56,6 +56,14 @@ pub struct ReconSettings {
     /// through the distance cubes ([`crate::specular`]; the default, for mirrors and glossy
     /// metals). The plugin's GPU path follows the camera's setting.
     pub specular: Specular,
+    /// Samples per pixel along each axis (1: the pixel centre). With n > 1 a frame is
+    /// reconstructed at n × its size and each pixel is the mean of its n × n samples: the box
+    /// filter over the pixel's area that the path tracer's references use, so that edges
+    /// against bright windows are not aliased (on the tour, point-sampled edges of windows
+    /// were most of the error of some frames; docs/architecture.md, "Measuring"). Cost grows
+    /// with n². Depth and object id come from the sample nearest the pixel's centre. The
+    /// plugin's GPU path ignores it: there Bevy's `Msaa` antialiases the proxies' edges.
+    pub supersampling: u32,
 }
 
 /// What the geometry-assisted mode shows on objects with a material ([`crate::shading`]).
@@ -104,6 +112,7 @@ impl Default for ReconSettings {
             shading: Shading::Materials,
             sun_shadow_rays: 4,
             specular: Specular::default(),
+            supersampling: 1,
         }
     }
 }

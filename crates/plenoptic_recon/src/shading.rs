@@ -149,7 +149,8 @@ pub(crate) fn render(
     let start = std::time::Instant::now();
     let sun = rec
         .runtime_sun()
-        .map(|s| s.at(proxy, t, rec.settings.sun_shadow_rays));
+        .zip(rec.proxy_rays())
+        .map(|(s, rays)| s.at(rays, proxy, t, rec.settings.sun_shadow_rays));
     let glossy = specular::glossy_allowed(rec);
     let (surface, raster_ms) =
         surface_image(rec, materials, camera, t, layer, sun.is_some(), glossy);

@@ -21,7 +21,14 @@
 //!   cubes and weighted by its time weight, as the GPU's per-(view, key) lookups are.
 //! - Steps follow the cube's texels: each advances the projected point by about
 //!   [`STEP_TEXELS`] texels.
-//! - A ray that meets nothing within the scene's bounds sees the environment.
+//! - A ray that meets no proxy triangle sees the environment (a ray cast through the proxies'
+//!   BVHs, [`crate::shadow`], before any march). The march alone cannot tell: a ray leaving
+//!   through a window is, from every base view but one on its line, first behind the wall
+//!   beside the window (a silhouette), so no view answered and the pixel kept the baked
+//!   reflection of another place. On the tour, the mirror of room A showed its windows at
+//!   0.47–0.51 of the path tracer's luminance and in the wrong place (frames 14–15).
+//! - A ray marched to the scene's far distance without meeting a stored surface sees the
+//!   environment too (packs without proxies).
 //! - Roughness: a glossy surface marches [`GLOSSY_RAYS`] rays reflected about half-vectors
 //!   drawn from the GGX distribution (α = roughness², a Hammersley set turned per pixel),
 //!   and each hit's radiance is averaged over a cone of half-angle 0.7α as it appears from
@@ -48,6 +55,7 @@ use plenoptic_pack::{CubeImage, LightKind, Manifest, plenoptic_sky::PlacedEnviro
 
 use crate::Reconstructor;
 use crate::brdf::{DELTA_ROUGHNESS, SurfaceMaterial, fresnel_dielectric, fresnel_schlick};
+use crate::shadow::PlacedShadows;
 use crate::temporal::bracketing;
 
 /// How the geometry-assisted mode shows the specular part of surfaces with a material.
@@ -123,6 +131,9 @@ pub fn march_distance(manifest: &Manifest) -> f32 {
     }
 }
 
+/// How far (m) a reflected ray starts off its surface when it is cast against the proxies.
+const RAY_OFFSET: f32 = 1e-3;
+
 /// Rays per pixel on a glossy surface ([`Reflections::lobe`]).
 pub const GLOSSY_RAYS: usize = 8;
 /// Most march steps per view.
@@ -147,8 +158,10 @@ struct MarchView {
 }
 
 /// The base views' cubes at one time, ready to answer reflected rays.
-pub(crate) struct Reflections {
+pub(crate) struct Reflections<'r> {
     views: Vec<MarchView>,
+    /// The proxies placed at the frame's time: a ray that meets none leaves the scene.
+    rays: Option<PlacedShadows<'r>>,
     environment: PlacedEnvironment,
     /// How far a ray is marched before it counts as leaving the scene.
     far: f32,
@@ -156,10 +169,10 @@ pub(crate) struct Reflections {
     angular_power: f32,
 }
 
-impl Reflections {
+impl<'r> Reflections<'r> {
     /// The cubes of the views blended for a camera at `position` at time `t` (unreadable
     /// keys are listed in `missing` and left out).
-    pub fn new(rec: &Reconstructor, position: Vec3, t: f32, missing: &mut Vec<String>) -> Self {
+    pub fn new(rec: &'r Reconstructor, position: Vec3, t: f32, missing: &mut Vec<String>) -> Self {
         let manifest = rec.pack().manifest();
         let mut views = Vec::new();
         for (v, w) in rec.view_weights(position) {
@@ -189,8 +202,13 @@ impl Reflections {
                 });
             }
         }
+        let rays = rec
+            .proxy_rays()
+            .zip(rec.proxy())
+            .map(|(r, proxy)| r.at(proxy, t));
         Reflections {
             views,
+            rays,
             environment: rec.environment().at(t),
             far: march_distance(manifest),
             depth_tolerance: rec.settings.depth_tolerance,
@@ -201,6 +219,12 @@ impl Reflections {
     /// Radiance arriving at `origin` along unit direction `dir`, averaged over a cone of
     /// half-angle `cone` (radians): `None` where no base view can tell.
     pub fn incoming(&self, origin: Vec3, dir: Vec3, cone: f32) -> Option<Vec3> {
+        // Off the surface the ray starts on before it is cast.
+        if let Some(rays) = &self.rays
+            && !rays.occluded(origin + dir * RAY_OFFSET, dir, self.far)
+        {
+            return Some(self.environment.radiance(dir));
+        }
         let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
         let mut escaped = false;
         for v in &self.views {
@@ -422,8 +446,13 @@ mod tests {
     }
 
     /// One view at the origin with these cubes, under a uniform environment.
-    fn one_view(distance: CubeImage<f32>, radiance: CubeImage<Vec3>, sky: Vec3) -> Reflections {
+    fn one_view(
+        distance: CubeImage<f32>,
+        radiance: CubeImage<Vec3>,
+        sky: Vec3,
+    ) -> Reflections<'static> {
         Reflections {
+            rays: None,
             views: vec![MarchView {
                 centre: Vec3::ZERO,
                 weight: 1.0,

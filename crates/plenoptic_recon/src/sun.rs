@@ -37,7 +37,6 @@ pub const MAX_SUN_RAYS: u32 = 64;
 pub struct RuntimeSun {
     track: SunTrack,
     angular_radius: f32,
-    shadows: ShadowScene,
 }
 
 /// A [`RuntimeSun`] at one time.
@@ -52,19 +51,24 @@ pub struct PlacedSun<'s> {
 }
 
 impl RuntimeSun {
-    /// The runtime sun of `pack`, when its lighting leaves the sun out and it has proxies.
-    pub fn load(pack: &PackReader, proxy: Option<&ProxyGeometry>) -> Option<Self> {
+    /// The runtime sun of `pack`, when its lighting leaves the sun out.
+    pub fn load(pack: &PackReader) -> Option<Self> {
         let (track, sun) = pack.direct_sun()?;
         Some(Self {
             track: track.clone(),
             angular_radius: sun.angular_radius,
-            shadows: ShadowScene::new(proxy?),
         })
     }
 
-    /// The sun at time `t`, its shadow rays against `proxy` placed then; `rays` shadow rays
-    /// per pixel (clamped to 1..=[`MAX_SUN_RAYS`]).
-    pub fn at<'s>(&'s self, proxy: &ProxyGeometry, t: f32, rays: u32) -> PlacedSun<'s> {
+    /// The sun at time `t`, its shadow rays against `shadows` (of `proxy`) placed then;
+    /// `rays` shadow rays per pixel (clamped to 1..=[`MAX_SUN_RAYS`]).
+    pub fn at<'s>(
+        &self,
+        shadows: &'s ShadowScene,
+        proxy: &ProxyGeometry,
+        t: f32,
+        rays: u32,
+    ) -> PlacedSun<'s> {
         let (towards, illuminance) = self.track.at(t);
         let towards = towards.normalize_or(Vec3::Y);
         PlacedSun {
@@ -73,7 +77,7 @@ impl RuntimeSun {
             frame: towards.any_orthonormal_pair(),
             cos_max: self.angular_radius.min(0.5).cos(),
             rays: rays.clamp(1, MAX_SUN_RAYS),
-            shadows: self.shadows.at(proxy, t),
+            shadows: shadows.at(proxy, t),
         }
     }
 }
