@@ -11,11 +11,16 @@
 //! 2. *glazing*: the glazing proxies alone. Their lookups accept only the texels whose rays
 //!    stopped at the pane, so they give the pane's own radiance (its reflection and tint).
 //!
-//! Where a glazing surface is nearer than what lies behind it, the pixel is
-//! `c · L_glazing + (1 − c) · L_behind`, with the glazing's depth and object id; this is the
-//! mean over the coverage the path tracer samples. One pane is composited (the nearest);
-//! panes behind panes see the far one as opaque. Image and volume modes warp the range
-//! images whole and keep showing the baked texels (the thesis's baselines).
+//! Where a glazing surface is nearer than what lies behind it, the pixel's ray crosses k
+//! glazing surfaces before it (counted by a ray cast through the glazing proxies' BVH: a
+//! pane modelled as a thin box is two surfaces, and the path tracer's ray meets each with
+//! probability c), and the pixel is `(1 − (1 − c)^k) · L_glazing + (1 − c)^k · L_behind`,
+//! with the glazing's depth and object id: the mean over the coverage the path tracer
+//! samples, with every crossed surface taken to shine as the nearest does. With one crossing
+//! (c · L_glazing + (1 − c) · L_behind) the tour's glazed east window came out 18–20 %
+//! brighter than the path tracer's. The GPU draws both faces in the transparent pass, which
+//! blends the same way. Image and volume modes warp the range images whole and keep showing
+//! the baked texels (the thesis's baselines).
 
 use glam::Vec3;
 
@@ -23,6 +28,8 @@ use crate::background::{self, Coverage};
 use crate::frame::{Frame, Report};
 use crate::geometry::Layer;
 use crate::shading;
+use crate::shadow::ShadowScene;
+use rayon::prelude::*;
 use crate::{Camera, Reconstructor, Result};
 
 /// The pack ids and coverages of the pack's see-through objects.
@@ -55,7 +62,24 @@ pub(crate) fn render(
     let start = std::time::Instant::now();
     let mut front_report = Report::default();
     let front = shading::render(rec, camera, t, None, Layer::Only(&ids), &mut front_report)?;
-    let covered = composite(&mut behind, &front, glazing);
+    let crossings = rec.proxy().map(|proxy| {
+        let scene = ShadowScene::of_objects(proxy, |id| ids.contains(&id));
+        let placed = scene.at(proxy, t);
+        let basis = camera.basis();
+        let w = camera.width as usize;
+        (0..front.object.len())
+            .into_par_iter()
+            .map(|j| {
+                if front.object[j] == 0 || front.depth[j] >= behind.depth[j] {
+                    return 0;
+                }
+                let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+                let tmax = behind.depth[j].min(FAR);
+                placed.crossings(basis.position, dir, tmax) as u8
+            })
+            .collect::<Vec<u8>>()
+    });
+    let covered = composite(&mut behind, &front, glazing, crossings.as_deref());
     report
         .stage_ms
         .push(("glazing".into(), start.elapsed().as_secs_f64() * 1e3));
@@ -68,10 +92,19 @@ pub(crate) fn render(
     Ok(behind)
 }
 
+/// How far (m) a pixel's ray is cast for glazing crossings when nothing lies behind.
+const FAR: f32 = 1e4;
+
 /// Composites the glazing layer `front` over `behind` in place: where a glazing object is
-/// nearer, `c · front + (1 − c) · behind`, with the glazing's depth and id. Returns how many
-/// pixels were covered.
-fn composite(behind: &mut Frame, front: &Frame, glazing: &[(u32, f32)]) -> usize {
+/// nearer, `(1 − (1 − c)^k) · front + (1 − c)^k · behind` with k the pixel's glazing
+/// `crossings` (at least 1; 1 without them), with the glazing's depth and id. Returns how
+/// many pixels were covered.
+fn composite(
+    behind: &mut Frame,
+    front: &Frame,
+    glazing: &[(u32, f32)],
+    crossings: Option<&[u8]>,
+) -> usize {
     let coverage = |o: u32| glazing.iter().find(|g| g.0 == o).map(|g| g.1);
     let mut covered = 0;
     for j in 0..behind.radiance.len() {
@@ -82,8 +115,10 @@ fn composite(behind: &mut Frame, front: &Frame, glazing: &[(u32, f32)]) -> usize
         if front.depth[j] >= behind.depth[j] {
             continue;
         }
+        let k = crossings.map_or(1, |k| k[j].max(1));
+        let through = (1.0 - c).powi(i32::from(k));
         let back: Vec3 = behind.radiance[j];
-        behind.radiance[j] = front.radiance[j] * c + back * (1.0 - c);
+        behind.radiance[j] = front.radiance[j] * (1.0 - through) + back * through;
         behind.depth[j] = front.depth[j];
         behind.object[j] = o;
         covered += 1;
@@ -117,7 +152,7 @@ mod tests {
             vec![3.0, 3.0, f32::INFINITY],
             vec![7, 7, 0],
         );
-        let n = composite(&mut behind, &front, &[(7, 0.25)]);
+        let n = composite(&mut behind, &front, &[(7, 0.25)], None);
         assert_eq!(n, 1);
         // Sky behind the pane: 0.25 · 0.8 + 0.75 · 4.
         assert!((behind.radiance[0].x - 3.2).abs() < 1e-6);
@@ -127,5 +162,14 @@ mod tests {
         assert_eq!(behind.object[1], 1);
         // No pane there.
         assert_eq!(behind.radiance[2], Vec3::splat(4.0));
+    }
+
+    #[test]
+    fn a_ray_through_both_faces_of_a_pane_is_blended_twice() {
+        let mut behind = frame(vec![Vec3::splat(4.0)], vec![f32::INFINITY], vec![0]);
+        let front = frame(vec![Vec3::splat(0.8)], vec![3.0], vec![7]);
+        composite(&mut behind, &front, &[(7, 0.25)], Some(&[2]));
+        // (1 − 0.75²) · 0.8 + 0.75² · 4.
+        assert!((behind.radiance[0].x - (0.4375 * 0.8 + 0.5625 * 4.0)).abs() < 1e-5);
     }
 }

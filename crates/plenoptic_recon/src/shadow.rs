@@ -65,6 +65,18 @@ impl TriangleBvh {
             .bvh
             .ray_traverse_miss(ray, |r, i| self.triangles[i].intersect(r))
     }
+
+    /// How many triangles the ray from `origin` along `dir` crosses closer than `tmax`.
+    fn crossings(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> u32 {
+        let ray = Ray::new(origin, dir + Vec3A::ZERO, 0.0, tmax);
+        let mut n = 0;
+        self.bvh.ray_traverse_anyhit(ray, |r, i| {
+            if self.triangles[i].intersect(r) < tmax {
+                n += 1;
+            }
+        });
+        n
+    }
 }
 
 /// The proxies as shadow rays see them.
@@ -93,6 +105,11 @@ pub struct PlacedShadows<'s> {
 impl ShadowScene {
     /// The shadow geometry of `proxy`.
     pub fn new(proxy: &ProxyGeometry) -> Self {
+        Self::of_objects(proxy, |_| true)
+    }
+
+    /// The geometry of the objects of `proxy` whose pack id `keep` accepts.
+    pub fn of_objects(proxy: &ProxyGeometry, keep: impl Fn(u32) -> bool) -> Self {
         let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
             m.triangles
                 .iter()
@@ -106,6 +123,9 @@ impl ShadowScene {
         let mut fixed = Vec::new();
         let mut moving = Vec::new();
         for (i, &id) in proxy.object_ids().iter().enumerate() {
+            if !keep(id) {
+                continue;
+            }
             let mesh = &proxy.meshes()[i];
             match &proxy.motions()[i] {
                 Some(m) if m.is_animated() => {
@@ -163,6 +183,34 @@ impl PlacedShadows<'_> {
                         tmax,
                     )
             })
+    }
+}
+
+impl PlacedShadows<'_> {
+    /// How many triangles the ray from `origin` along unit `dir` crosses closer than `tmax`
+    /// (both faces count).
+    pub fn crossings(&self, origin: Vec3, dir: Vec3, tmax: f32) -> u32 {
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        let fixed = self
+            .scene
+            .fixed
+            .as_ref()
+            .map_or(0, |b| b.crossings(o, d, tmax));
+        let moving: u32 = self
+            .scene
+            .moving
+            .iter()
+            .zip(&self.moving)
+            .filter(|(_, (_, lo, hi))| ray_meets_box(origin, dir, tmax, *lo, *hi))
+            .map(|((_, b), (to_object, _, _))| {
+                b.crossings(
+                    to_object.transform_point3a(o),
+                    to_object.transform_vector3a(d),
+                    tmax,
+                )
+            })
+            .sum();
+        fixed + moving
     }
 }
 

@@ -71,7 +71,7 @@ pub use multistage::{AmbientField, AmbientSettings, MultiStageRenderer, MultiSta
 /// The obvhs this crate uses.
 pub use obvhs;
 pub use pathtrace::{PathTracer, PathTracerSettings};
-pub use render::RadianceSample;
+pub use render::{PixelFilter, RadianceSample};
 
 /// Errors of the tracer.
 #[derive(Debug, thiserror::Error)]

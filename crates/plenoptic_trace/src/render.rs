@@ -88,6 +88,36 @@ where
     C: Camera + ?Sized,
     F: Fn(&Ray, &mut Sampler, bool) -> RadianceSample + Sync,
 {
+    render_camera_filtered(camera, spp, seed, PixelFilter::Box, f)
+}
+
+/// Which of a pixel's samples its means take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelFilter {
+    /// Every sample: the mean over the pixel's area (images to look at, references).
+    Box,
+    /// Only the samples that hit the object the pixel-centre ray hit (or missed, as it did):
+    /// a pixel's colour then belongs to the surface its distance and id describe, as a range
+    /// image's lookups take it. Where rays pass a see-through surface (BLEND coverage c), the
+    /// pixel is the surface's own radiance where the centre ray stopped at it, and what lies
+    /// behind where it passed, instead of the mix c · surface + (1 − c) · behind in both (the
+    /// tour's glazed window showed the sky through its own pane texels). At silhouettes, the
+    /// centre's object alone.
+    SameObject,
+}
+
+/// [`render_camera`] with the samples `filter` keeps (at least the centre ray's).
+pub fn render_camera_filtered<C, F>(
+    camera: &C,
+    spp: u32,
+    seed: u64,
+    filter: PixelFilter,
+    f: F,
+) -> Image<RadianceSample>
+where
+    C: Camera + ?Sized,
+    F: Fn(&Ray, &mut Sampler, bool) -> RadianceSample + Sync,
+{
     let (w, h) = camera.resolution();
     let spp = spp.max(1);
     Image::render(w, h, |x, y| {
@@ -97,6 +127,7 @@ where
         let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
+        let mut kept = 0u32;
         for k in 0..spp {
             let mut s = Sampler::new(seed, pixel, u64::from(k));
             let offset = if k == 0 {
@@ -107,11 +138,16 @@ where
             let Some(ray) = camera.ray(x, y, offset) else {
                 continue;
             };
-            any = true;
             let r = f(&ray, &mut s, k == 0);
             if k == 0 {
                 aux = r;
             }
+            // The centre ray (k = 0) is always kept, so `aux` is set before any comparison.
+            if filter == PixelFilter::SameObject && any && r.object != aux.object {
+                continue;
+            }
+            any = true;
+            kept += 1;
             sum += r.radiance;
             diffuse += r.diffuse;
             albedo += r.albedo;
@@ -131,15 +167,16 @@ where
         if !any {
             return RadianceSample::MISS;
         }
+        let n = kept as f32;
         RadianceSample {
-            radiance: sum / spp as f32,
-            diffuse: diffuse / spp as f32,
-            albedo: albedo / spp as f32,
-            sun: sun / spp as f32,
-            sun_diffuse: sun_diffuse / spp as f32,
-            lighting_variance: if spp > 1 {
-                // Unbiased sample variance, over spp for the variance of the mean.
-                let n = f64::from(spp);
+            radiance: sum / n,
+            diffuse: diffuse / n,
+            albedo: albedo / n,
+            sun: sun / n,
+            sun_diffuse: sun_diffuse / n,
+            lighting_variance: if kept > 1 {
+                // Unbiased sample variance, over n for the variance of the mean.
+                let n = f64::from(kept);
                 ((l2 - l1 * l1 / n).max(0.0) / (n - 1.0) / n) as f32
             } else {
                 0.0

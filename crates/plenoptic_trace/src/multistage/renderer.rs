@@ -33,7 +33,7 @@ use crate::camera::{Camera, CubeCamera};
 use crate::image::Image;
 use crate::light::{Competing, estimate_direct_split};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
-use crate::render::{RadianceSample, render_camera};
+use crate::render::{PixelFilter, RadianceSample, render_camera, render_camera_filtered};
 use crate::sampling::{Sampler, power_heuristic};
 
 /// Settings of the [`MultiStageRenderer`].
@@ -200,7 +200,9 @@ impl<'f> MultiStageRenderer<'f> {
         )
     }
 
-    /// Renders the six faces of a cube camera in KTX2 layer order (+X, −X, +Y, −Y, +Z, −Z).
+    /// Renders the six faces of a cube camera in KTX2 layer order (+X, −X, +Y, −Y, +Z, −Z);
+    /// each texel's means take only the samples that hit the centre ray's object
+    /// ([`PixelFilter::SameObject`]), as the range image's lookups read a texel.
     pub fn render_cube(
         &self,
         placed: &PlacedScene<'_>,
@@ -209,9 +211,13 @@ impl<'f> MultiStageRenderer<'f> {
         cube.faces().map(|face| {
             let seed =
                 self.settings.seed ^ (0x51ed_270b_u64.wrapping_mul(face.face.index() as u64 + 1));
-            render_camera(&face, self.settings.samples_per_pixel, seed, |ray, s, _| {
-                self.sample(placed, ray, s)
-            })
+            render_camera_filtered(
+                &face,
+                self.settings.samples_per_pixel,
+                seed,
+                PixelFilter::SameObject,
+                |ray, s, _| self.sample(placed, ray, s),
+            )
         })
     }
 }
