@@ -29,8 +29,8 @@ use crate::frame::{Frame, Report};
 use crate::geometry::Layer;
 use crate::shading;
 use crate::shadow::ShadowScene;
-use rayon::prelude::*;
 use crate::{Camera, Reconstructor, Result};
+use rayon::prelude::*;
 
 /// The pack ids and coverages of the pack's see-through objects.
 pub(crate) fn glazing_objects(rec: &Reconstructor) -> Vec<(u32, f32)> {
