@@ -60,7 +60,8 @@ pub(crate) enum Layer<'a> {
     All,
     /// The proxies except these pack ids (what lies behind glazing).
     Without(&'a [u32]),
-    /// Only these pack ids (the glazing).
+    /// Only these pack ids (the see-through layer: glazing, and transmissive glass, whose
+    /// reflection is then marched for the camera; [`crate::glazing`]).
     Only(&'a [u32]),
 }
 

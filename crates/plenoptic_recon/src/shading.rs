@@ -207,8 +207,14 @@ pub(crate) fn render(
                     }
                     Some(px.emission + specular::reflectance(&px.material, cos_o, eta) * incoming?)
                 });
-            *c = px.material.albedo() * lighting.radiance[j]
-                + specular.unwrap_or(non_diffuse.radiance[j]);
+            // Glass in the see-through layer that no view answers shows no reflection (its
+            // baked radiance holds what it lets through, which is composited apart).
+            let baked = if px.see_through {
+                Vec3::ZERO
+            } else {
+                non_diffuse.radiance[j]
+            };
+            *c = px.material.albedo() * lighting.radiance[j] + specular.unwrap_or(baked);
             if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {
                 *c += sun.radiance(px.position, px.ng, px.footprint, bsdf, j as u32);
             }
@@ -250,6 +256,8 @@ struct SurfacePixel {
     footprint: (Vec3, Vec3),
     /// Whether its specular part is marched for the camera ([`specular::Specular::marches`]).
     marched: bool,
+    /// Transmissive glass drawn in the see-through layer: only its reflection is shown.
+    see_through: bool,
     /// Emitted radiance at the pixel's UV, where the specular part is marched (which
     /// replaces the baked non-diffuse radiance that holds the emission); else zero.
     emission: Vec3,
@@ -375,7 +383,21 @@ fn surface_image(
                 (Vec3::ZERO, Vec3::ZERO)
             };
             let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
-            let marched = rec.settings.specular.marches(&material, glossy);
+            // In the see-through layer, transmissive glass shows its reflection alone: what
+            // it lets through is composited from the layer behind (crate::glazing).
+            let see_through = matches!(layer, Layer::Only(_)) && material.transmission > 0.0;
+            let reflection_of = SurfaceMaterial {
+                transmission: 0.0,
+                ..material
+            };
+            let marched = rec.settings.specular.marches(
+                if see_through {
+                    &reflection_of
+                } else {
+                    &material
+                },
+                glossy || see_through,
+            );
             let emission = if marched {
                 materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
             } else {
@@ -385,6 +407,7 @@ fn surface_image(
                 object: t.object,
                 material,
                 marched,
+                see_through,
                 emission,
                 position,
                 ng,
