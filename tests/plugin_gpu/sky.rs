@@ -7,7 +7,9 @@
 //! CPU's composite, with the sky's lit ground below the horizon.
 
 use crate::common::*;
-use crate::pack::{PackSpec, open_room, windowed_room, write_pack_with};
+use crate::pack::{
+    Materials, PackSpec, glass_window_room, open_room, windowed_room, write_pack_with,
+};
 use bevy::camera::{Exposure, Hdr};
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
@@ -408,6 +410,70 @@ fn gpu_window_open_or_glazed_matches_cpu() {
         let all: Vec<usize> = (0..mask.object.len()).collect();
         assert_gpu_matches(&gpu, &cpu.radiance, &all, &format!("{name}, whole frame"));
     }
+}
+
+/// A window glazed with clear transmissive glass (a pane 1 cm thick) is see-through on both
+/// backends: its reflection over the sky behind, which shows through both faces at T² (T =
+/// 0.96 for IOR 1.5), instead of the baked texels of the pane.
+#[test]
+fn gpu_glass_window_matches_cpu() {
+    let eye = Vec3::new(0.2, 1.3, -0.5);
+    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 1.4, 2.5), Vec3::Y);
+    let t = 0.7;
+    let sky = Environment::Sky(SkyParams {
+        scale: 1.0,
+        ground: true,
+        ..SkyParams::default()
+    });
+    let spec = PackSpec {
+        materials: Materials::Glass,
+        ..PackSpec::segment(2, vec![0.0, 2.0], 16)
+    };
+    let track = Some(crate::pack::moving_sun());
+    let (open_dir, dir) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let open_path = open_dir.path().join("sky.pack");
+    write_pack_with(
+        &windowed_room(None),
+        &spec,
+        &open_path,
+        Some((sky.clone(), track.clone())),
+    );
+    let path = dir.path().join("sky.pack");
+    write_pack_with(&glass_window_room(), &spec, &path, Some((sky, track)));
+    let cam = cpu_camera(eye, &transform);
+    let mut rec = Reconstructor::open(&path).unwrap();
+    let (cpu, report) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let pane = rec.pack().manifest().objects.len() as u32;
+    let mask = rec.proxy().unwrap().mask_raster(&cam, t);
+    let glass: Vec<usize> = (0..mask.object.len())
+        .filter(|&j| mask.object[j] == pane)
+        .collect();
+    assert!(
+        glass.len() > mask.object.len() / 10,
+        "{} pane pixels",
+        glass.len()
+    );
+    assert!(report.glazing_pixels >= glass.len() / 2, "{report:?}");
+    // Through the glass, the open window's sky at about T² = 0.92, plus a faint reflection.
+    let (open, _) = Reconstructor::open(&open_path)
+        .unwrap()
+        .render(&cam, t, Mode::GeometryAssisted)
+        .unwrap();
+    let mean = |f: &[Vec3]| glass.iter().map(|&j| f[j].element_sum()).sum::<f32>();
+    let ratio = mean(&cpu.radiance) / mean(&open.radiance);
+    assert!((0.88..1.05).contains(&ratio), "glass / open window {ratio}");
+    // The pane's baked texels (specular baked) are not what the see-through glass shows.
+    rec.settings.specular = plenoptic_recon::Specular::Baked;
+    let (baked, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    let (apart, _, _) = compare(&baked.radiance, &cpu.radiance, &glass);
+    assert!(apart > 0.05, "see-through and baked glass {apart} apart");
+
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+    let gpu = settle(&mut app, camera, &image);
+    let what = format!("glass pane ({} pixels), glass/open {ratio:.3}", glass.len());
+    assert_gpu_matches(&gpu, &cpu.radiance, &glass, &what);
+    let all: Vec<usize> = (0..mask.object.len()).collect();
+    assert_gpu_matches(&gpu, &cpu.radiance, &all, "glass window, whole frame");
 }
 
 /// One `ReconSettings` field, changed on the camera, changes the GPU frame and the CPU frame

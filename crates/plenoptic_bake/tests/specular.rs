@@ -236,10 +236,7 @@ fn mirror_and_steel_reflect_for_the_camera() {
         mirror_m < 3.0 * diffuse,
         "sun: mirror {mirror_m}, diffuse {diffuse}"
     );
-    assert!(
-        steel_m < 0.9 * steel_b,
-        "sun: steel {steel_b} -> {steel_m}"
-    );
+    assert!(steel_m < 0.9 * steel_b, "sun: steel {steel_b} -> {steel_m}");
     let ([mirror_b, steel_b, _], [mirror_m, steel_m, diffuse]) = (lamp[0], lamp[1]);
     assert!(
         mirror_m < 0.6 * mirror_b,

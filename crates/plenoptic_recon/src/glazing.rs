@@ -24,14 +24,17 @@
 //! Transmissive glass (glTF `KHR_materials_transmission`, shown with materials and marched
 //! reflections) is see-through the same way, as a thin wall: its layer shows only the
 //! surface's reflection for the camera (marched, [`crate::specular`]), and the pixel is
-//! `L_reflection + T^k ⊙ L_behind` with the per-surface transmittance
-//! `T = (1 − F₀) · transmission · base colour` (F₀ from the IOR, at normal incidence). Rays
+//! `L_reflection ⊙ (1 + T + … + T^(k−1)) + T^k ⊙ L_behind` (every surface crossed taken to
+//! reflect as the nearest does) with the per-surface transmittance
+//! `T = (1 − F₀) · transmission · base colour` (F₀ from the IOR, at normal incidence;
+//! [`crate::specular::see_through_transmittance`]). Rays
 //! go straight through: exact for panes and balustrades of parallel faces, where refraction
 //! only shifts the view by a fraction of the thickness; a solid block bends what is seen
 //! through it, which this leaves out. The baked radiance instead showed the base view's
 //! view through the glass, displaced and at cube resolution: the tour's glass balustrade
 //! was a dark smear over the brick wall behind it (0.43 of the path tracer's luminance).
-//! The GPU still shows the baked radiance for transmissive objects.
+//! The GPU draws such glass in Bevy's transparent pass with premultiplied alpha, both faces,
+//! its reflection over what lies behind with the mean of T (`bevy_plenoptic::reconstruct`).
 //!
 //! Image and volume modes warp the range images whole and keep showing the baked texels
 //! (the thesis's baselines).
@@ -60,10 +63,6 @@ pub(crate) enum SeeThrough {
 /// glazing (a coverage), and with materials shown and reflections marched, transmissive
 /// materials.
 pub(crate) fn glazing_objects(rec: &Reconstructor) -> Vec<(u32, SeeThrough)> {
-    let marched = matches!(
-        rec.settings.specular,
-        crate::specular::Specular::Marched { .. }
-    ) && rec.settings.shading == crate::Shading::Materials;
     rec.pack()
         .manifest()
         .objects
@@ -73,14 +72,8 @@ pub(crate) fn glazing_objects(rec: &Reconstructor) -> Vec<(u32, SeeThrough)> {
                 return Some((o.id, SeeThrough::Coverage(c.clamp(0.0, 1.0))));
             }
             let m = &rec.materials().object(o.id)?.material;
-            (marched && m.transmission > 0.0).then(|| {
-                let f0 = ((m.ior - 1.0) / (m.ior + 1.0)).powi(2);
-                let tint = m.base_colour.truncate().clamp(Vec3::ZERO, Vec3::ONE);
-                (
-                    o.id,
-                    SeeThrough::Transmission(tint * ((1.0 - f0) * m.transmission.min(1.0))),
-                )
-            })
+            crate::specular::see_through_transmittance(&rec.settings, m)
+                .map(|t| (o.id, SeeThrough::Transmission(t)))
         })
         .collect()
 }
@@ -141,7 +134,7 @@ const FAR: f32 = 1e4;
 /// Composites the see-through layer `front` over `behind` in place where a see-through
 /// object is nearer, with k the pixel's `crossings` (at least 1; 1 without them): glazing
 /// as `(1 − (1 − c)^k) · front + (1 − c)^k · behind`, transmissive glass as
-/// `front + T^k ⊙ behind`; with the object's depth and id. Returns how many pixels were
+/// `front ⊙ (1 + T + … + T^(k−1)) + T^k ⊙ behind`; with the object's depth and id. Returns how many pixels were
 /// covered.
 fn composite(
     behind: &mut Frame,
@@ -166,7 +159,16 @@ fn composite(
                 let through = (1.0 - c).powi(k);
                 front.radiance[j] * (1.0 - through) + back * through
             }
-            SeeThrough::Transmission(t) => front.radiance[j] + t.powf(k as f32) * back,
+            SeeThrough::Transmission(t) => {
+                // Each surface crossed reflects as the nearest does, seen through those
+                // before it: front · (1 + T + … + T^(k−1)) + T^k · behind.
+                let (mut sum, mut through) = (Vec3::ZERO, Vec3::ONE);
+                for _ in 0..k {
+                    sum += through;
+                    through *= t;
+                }
+                front.radiance[j] * sum + through * back
+            }
         };
         behind.depth[j] = front.depth[j];
         behind.object[j] = o;
@@ -230,5 +232,21 @@ mod tests {
         );
         // (1 − 0.75²) · 0.8 + 0.75² · 4.
         assert!((behind.radiance[0].x - (0.4375 * 0.8 + 0.5625 * 4.0)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn glass_shows_its_reflection_per_surface_and_lets_the_rest_through() {
+        let mut behind = frame(vec![Vec3::splat(4.0)], vec![f32::INFINITY], vec![0]);
+        let front = frame(vec![Vec3::splat(0.1)], vec![3.0], vec![7]);
+        let t = Vec3::splat(0.9);
+        composite(
+            &mut behind,
+            &front,
+            &[(7, SeeThrough::Transmission(t))],
+            Some(&[2]),
+        );
+        // 0.1 · (1 + 0.9) + 0.81 · 4.
+        assert!((behind.radiance[0].x - (0.19 + 3.24)).abs() < 1e-5);
+        assert_eq!(behind.object[0], 7);
     }
 }

@@ -131,6 +131,26 @@ pub fn march_distance(manifest: &Manifest) -> f32 {
     }
 }
 
+/// What a surface of transmissive glass with material `m` lets through per surface crossed,
+/// when `settings` show it see-through (reflections marched, materials shown, transmission
+/// above zero; `crate::glazing`): `(1 − F₀) · transmission · base colour`, F₀ from the IOR at
+/// normal incidence. `None` where the glass shows its baked radiance instead. Both backends
+/// call this.
+pub fn see_through_transmittance(
+    settings: &crate::ReconSettings,
+    m: &plenoptic_pack::MaterialEntry,
+) -> Option<Vec3> {
+    let shown = matches!(settings.specular, Specular::Marched { .. })
+        && settings.shading == crate::Shading::Materials
+        && m.transmission > 0.0;
+    shown.then(|| {
+        let ior = if m.ior > 0.0 { m.ior } else { 1.5 };
+        let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+        let tint = m.base_colour.truncate().clamp(Vec3::ZERO, Vec3::ONE);
+        tint * ((1.0 - f0) * m.transmission.min(1.0))
+    })
+}
+
 /// How far (m) a reflected ray starts off its surface when it is cast against the proxies.
 const RAY_OFFSET: f32 = 1e-3;
 

@@ -32,7 +32,9 @@ struct ReconParams {
     // frame, w: coverage of glazing.
     fill: vec4<f32>,
     // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
-    // y: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
+    // y: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials);
+    // z: 1 for see-through transmissive glass (its reflection over what lies behind), w: its
+    // mean transmittance per surface.
     flags: vec4<f32>,
     // The object's base-colour factor (xyz) and metallic factor (w) when flags.y is 1.
     albedo: vec4<f32>,
@@ -384,15 +386,26 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
             reflected = params.emissive.xyz + r.rgb;
         }
     }
-    var c = radiance(in, ng);
-    c = vec4<f32>(c.rgb + reflected, c.a);
+    var c: vec4<f32>;
+    if see_through() {
+        // Transmissive glass: its reflection alone (none where no lookup answers; the baked
+        // radiance holds what it lets through), what lies behind blended in by the
+        // premultiplied alpha below.
+        c = vec4<f32>(reflected, 1.0);
+    } else {
+        c = radiance(in, ng);
+        c = vec4<f32>(c.rgb + reflected, c.a);
+    }
     if lit() && params.sun.w == 1.0 && params.fill.z != 1.0 {
         c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
     }
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
     let glazing = params.fill.w > 0.0 && params.fill.w < 1.0 && params.fill.z != 1.0;
-    let alpha = select(c.a, params.fill.w, glazing);
+    var alpha = select(c.a, params.fill.w, glazing);
+    if see_through() {
+        alpha = 1.0 - params.flags.w;
+    }
     var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), alpha);
 #ifdef TONEMAP_IN_SHADER
     out = tone_mapping(out, view.color_grading);
@@ -630,8 +643,13 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
 // Whether this fragment's surface is marched: no transmission, an ideal mirror, or glossy
 // up to the roughest surface marched.
 fn marched() -> bool {
-    return params.specular.x == 1.0 && params.material.x <= 0.0
+    return params.specular.x == 1.0 && (params.material.x <= 0.0 || see_through())
         && (pixel_roughness < 0.02 || pixel_roughness <= params.specular.y);
+}
+
+// Whether this fragment is see-through transmissive glass (flags.z).
+fn see_through() -> bool {
+    return params.flags.z == 1.0 && params.fill.z != 1.0;
 }
 
 // Radiance arriving at `origin` along unit `dir`, over a cone of half-angle `cone`, from the

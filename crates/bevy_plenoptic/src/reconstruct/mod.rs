@@ -210,6 +210,13 @@ pub struct PlenopticMaterial {
     /// transparent pass, blended over what lies behind it with this alpha in
     /// geometry-assisted mode, as `plenoptic_recon`'s glazing module composites it.
     pub coverage: f32,
+    /// Whether the object's material in the pack is transmissive glass. Such glass is drawn
+    /// in Bevy's transparent pass with premultiplied alpha: where the camera's settings show
+    /// it see-through ([`plenoptic_recon::specular::see_through_transmittance`]), the
+    /// fragment is its reflection marched for the camera over what lies behind, which shows
+    /// through with the mean of the per-surface transmittance T, both faces drawn (T², as
+    /// `plenoptic_recon`'s glazing module composites a pane); elsewhere it is opaque (alpha 1).
+    pub transmissive: bool,
 }
 
 impl Material for PlenopticMaterial {
@@ -220,6 +227,8 @@ impl Material for PlenopticMaterial {
     fn alpha_mode(&self) -> AlphaMode {
         if self.coverage < 1.0 {
             AlphaMode::Blend
+        } else if self.transmissive {
+            AlphaMode::Premultiplied
         } else {
             AlphaMode::Opaque
         }
@@ -345,6 +354,9 @@ fn attach_materials(
             continue;
         };
         let factors = material_factors(pack, of.id);
+        let transmissive = factors
+            .as_ref()
+            .is_some_and(|f| f.material.transmission > 0.0);
         let environment_image = env_images.get(scene.pack.id(), pack, &mut images);
         let m = materials.add(PlenopticMaterial {
             cubes: tex.image.clone(),
@@ -359,6 +371,7 @@ fn attach_materials(
             environment_image,
             albedo: factors,
             coverage: object_coverage(pack, of.id),
+            transmissive,
         });
         commands
             .entity(entity)
@@ -640,6 +653,13 @@ fn update_materials(
                 f.fill(&mut params);
                 sun::fill(&mut params, pack, cam.time);
                 reflect::fill(&mut params, pack, &cam.settings, &f.material);
+                if let Some(t) =
+                    plenoptic_recon::specular::see_through_transmittance(&cam.settings, &f.material)
+                    && !image_mode
+                {
+                    params.flags.z = 1.0;
+                    params.flags.w = (t.x + t.y + t.z) / 3.0;
+                }
                 let environment =
                     background::EnvironmentUniform::new(&pack.environment.at(cam.time));
                 if mat.environment != environment {

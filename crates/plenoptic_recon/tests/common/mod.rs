@@ -66,6 +66,63 @@ pub fn windowed_room(glazing: Option<f32>) -> Scene {
     b.build()
 }
 
+/// [`windowed_room`] with its window glazed by a pane of clear transmissive glass
+/// (`KHR_materials_transmission` 1, IOR 1.5) 1 cm thick: both faces in one mesh. The pane is
+/// the last object; [`Materials::Glass`] writes its material.
+pub fn glass_window_room() -> Scene {
+    let mut b = room_builder(false, true, false);
+    let m = b.material(shapes::diffuse(Vec3::splat(0.7)));
+    let glass = b.material(shapes::glass(1.5, 0.0));
+    let (lo, hi) = WINDOW;
+    let front = Quat::from_rotation_arc(Vec3::Y, Vec3::NEG_Z);
+    let place = |x: (f32, f32), y: (f32, f32)| plenoptic_scene::Trs {
+        translation: Vec3::new(0.5 * (x.0 + x.1), 0.5 * (y.0 + y.1), 2.5),
+        rotation: front,
+        scale: Vec3::ONE,
+    };
+    let quad = |x: (f32, f32), y: (f32, f32)| shapes::quad(Vec2::new(x.1 - x.0, y.1 - y.0));
+    b.object_trs(
+        "front left",
+        quad((-2.0, lo.x), (0.0, 2.6)),
+        m,
+        place((-2.0, lo.x), (0.0, 2.6)),
+    );
+    b.object_trs(
+        "front right",
+        quad((hi.x, 2.0), (0.0, 2.6)),
+        m,
+        place((hi.x, 2.0), (0.0, 2.6)),
+    );
+    b.object_trs(
+        "sill",
+        quad((lo.x, hi.x), (0.0, lo.y)),
+        m,
+        place((lo.x, hi.x), (0.0, lo.y)),
+    );
+    b.object_trs(
+        "lintel",
+        quad((lo.x, hi.x), (hi.y, 2.6)),
+        m,
+        place((lo.x, hi.x), (hi.y, 2.6)),
+    );
+    // The back face 1 cm further out (the quad's local −y is the room's outside), wound the
+    // other way.
+    let mut pane = quad((lo.x, hi.x), (lo.y, hi.y));
+    let back = pane.clone();
+    let base = pane.positions.len() as u32;
+    pane.positions
+        .extend(back.positions.iter().map(|p| *p - Vec3::Y * 0.01));
+    pane.normals.extend(back.normals.iter().map(|n| -*n));
+    pane.uvs.extend(back.uvs.iter().copied());
+    pane.triangles.extend(
+        back.triangles
+            .iter()
+            .map(|t| [t[0] + base, t[2] + base, t[1] + base]),
+    );
+    b.object_trs("pane", pane, glass, place((lo.x, hi.x), (lo.y, hi.y)));
+    b.build()
+}
+
 fn room_with(moving: bool, ceiling: bool) -> Scene {
     room_builder(moving, ceiling, true).build()
 }
@@ -317,6 +374,9 @@ pub enum Materials {
     /// right wall glossy metal (roughness 0.3, base 0.8): the geometry-assisted mode marches
     /// their reflections for the camera ([`plenoptic_recon::Specular::Marched`]).
     Mirror,
+    /// [`Materials::Factors`], with the object named `pane` clear glass (transmission 1, IOR
+    /// 1.5, white, roughness 0): see-through in the geometry-assisted mode.
+    Glass,
 }
 
 impl PackSpec {
@@ -544,8 +604,10 @@ pub fn write_pack_with(
             let (base, metallic, roughness) = match (spec.materials, obj.name.as_str()) {
                 (Materials::Mirror, "left") => (Vec3::splat(0.9), 1.0, 0.0),
                 (Materials::Mirror, "right") => (Vec3::splat(0.8), 1.0, 0.3),
+                (Materials::Glass, "pane") => (Vec3::ONE, 0.0, 0.0),
                 _ => (object_colour(i as u32), 0.0, 0.5),
             };
+            let glass = spec.materials == Materials::Glass && obj.name == "pane";
             manifest.materials.push(plenoptic_pack::MaterialEntry {
                 base_colour: base.extend(1.0),
                 base_colour_texture: (spec.materials == Materials::Textured).then_some(
@@ -558,6 +620,8 @@ pub fn write_pack_with(
                 ),
                 metallic,
                 roughness,
+                transmission: if glass { 1.0 } else { 0.0 },
+                ior: 1.5,
                 ..Default::default()
             });
         }
