@@ -89,6 +89,7 @@ pub mod input;
 pub mod materials;
 pub mod plan;
 pub mod progress;
+pub mod quantise;
 pub mod reference;
 pub mod render;
 pub mod volume;

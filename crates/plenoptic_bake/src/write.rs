@@ -48,6 +48,7 @@ pub const FORMATS: CubeFormats = CubeFormats {
 /// The six cube chunks of a range image (lighting and non-diffuse radiance in the radiance
 /// format).
 pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<ItemChunk>> {
+    let image = &crate::quantise::coarsen(image);
     let c = |kind, bytes| ItemChunk {
         kind,
         base_view: bv,

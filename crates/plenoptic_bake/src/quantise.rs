@@ -1,0 +1,108 @@
+//! The precision the bake stores (docs/pack-format.md, "Range images"): texels are rounded
+//! to what their own noise can tell before they are encoded, so that zstd is not spent on
+//! noise bits.
+//!
+//! A draft range-image texel is the mean of a few samples (4 in the draft preset): its
+//! relative noise is several per cent, while RGB9E5 keeps 9 bits (0.2 %) and R32F 24 bits of
+//! every value. The low bits are noise that zstd cannot compress. Here, before encoding:
+//!
+//! - radiance and lighting keep [`COLOUR_BITS`] significant bits of the texel's largest
+//!   channel (each channel is rounded to a step of 2^(⌊log₂ max⌋ − COLOUR_BITS + 1)): at most
+//!   half a step, under 0.8 % of the largest channel;
+//! - the non-diffuse radiance is rounded to the same step as the texel's radiance, so where
+//!   it is a faint glossy sheen on a diffuse wall (most texels) it becomes 0;
+//! - distances keep [`DISTANCE_BITS`] bits of mantissa (relative error under 1e-4, far inside
+//!   the lookups' 3 % depth tolerance).
+//!
+//! Object ids and normals are stored as they are. The formats do not change: a reader sees
+//! ordinary RGB9E5 and R32F texels.
+
+use glam::Vec3;
+use plenoptic_pack::RangeImage;
+
+/// Significant bits kept of a colour texel's largest channel.
+pub const COLOUR_BITS: i32 = 7;
+/// Mantissa bits kept of a distance (of f32's 23).
+pub const DISTANCE_BITS: u32 = 13;
+
+/// The rounding step of a texel whose largest channel is `max` (0 for black).
+fn step_of(max: f32) -> f32 {
+    if max > 0.0 && max.is_finite() {
+        2f32.powi(max.log2().floor() as i32 - COLOUR_BITS + 1)
+    } else {
+        0.0
+    }
+}
+
+/// `c` rounded to multiples of `step` per channel (unchanged where `step` is 0).
+fn round_to(c: Vec3, step: f32) -> Vec3 {
+    if step > 0.0 {
+        (c / step).round() * step
+    } else {
+        c
+    }
+}
+
+/// `d` with its mantissa rounded to [`DISTANCE_BITS`] bits (infinity and NaN unchanged).
+pub fn coarse_distance(d: f32) -> f32 {
+    if !d.is_finite() {
+        return d;
+    }
+    let drop = 23 - DISTANCE_BITS;
+    let bits = d.to_bits();
+    let half = 1u32 << (drop - 1);
+    let rounded = (bits + half) & !((1u32 << drop) - 1);
+    f32::from_bits(rounded)
+}
+
+/// `image` with every texel rounded as the module doc says.
+pub fn coarsen(image: &RangeImage) -> RangeImage {
+    let mut out = image.clone();
+    for (i, c) in out.radiance.texels.iter_mut().enumerate() {
+        let step = step_of(c.max_element());
+        let nd = &mut out.non_diffuse.texels[i];
+        *nd = round_to(*nd, step);
+        *c = round_to(*c, step);
+    }
+    for c in &mut out.lighting.texels {
+        *c = round_to(*c, step_of(c.max_element()));
+    }
+    for d in &mut out.distance.texels {
+        *d = coarse_distance(*d);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colours_keep_their_largest_channel_within_a_percent() {
+        for &v in &[1e-4f32, 0.013, 0.5, 1.0, 3.7, 1234.5] {
+            let c = Vec3::new(v, 0.37 * v, 0.011 * v);
+            let r = round_to(c, step_of(c.max_element()));
+            assert!((r - c).abs().max_element() <= 0.008 * v, "{c} -> {r}");
+        }
+        assert_eq!(round_to(Vec3::ZERO, step_of(0.0)), Vec3::ZERO);
+    }
+
+    #[test]
+    fn faint_sheen_under_the_radiance_step_becomes_zero() {
+        let mut image = RangeImage::new(1);
+        image.radiance.texels.fill(Vec3::splat(1.0));
+        image.non_diffuse.texels.fill(Vec3::splat(0.003));
+        let out = coarsen(&image);
+        assert!(out.non_diffuse.texels.iter().all(|&c| c == Vec3::ZERO));
+        assert!(out.radiance.texels.iter().all(|&c| c == Vec3::ONE));
+    }
+
+    #[test]
+    fn distances_keep_four_significant_digits() {
+        for &d in &[0.01f32, 0.7, 1.0, 3.3333, 17.25, 250.0] {
+            let r = coarse_distance(d);
+            assert!(((r - d) / d).abs() < 1e-4, "{d} -> {r}");
+        }
+        assert_eq!(coarse_distance(f32::INFINITY), f32::INFINITY);
+    }
+}
