@@ -393,7 +393,7 @@ impl Reconstructor {
         let fine = Camera {
             width: camera.width * n,
             height: camera.height * n,
-            ..camera.clone()
+            ..*camera
         };
         let (frame, report) = self.render_samples(&fine, t, mode)?;
         Ok((crate::frame::box_filter(&frame, n), report))
