@@ -28,6 +28,19 @@ use plenoptic_bake::{BakeError, BakeOptions, Result, Shard, plan};
 use plenoptic_pack::PackReader;
 use plenoptic_trace::SceneAccel;
 
+/// `println!` that ends the program quietly when standard output is closed (`plenoptic
+/// inspect pack --chunks | head`), where `println!` would panic.
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($t)*)
+            && e.kind() == std::io::ErrorKind::BrokenPipe
+        {
+            std::process::exit(0);
+        }
+    }};
+}
+
 #[derive(Parser)]
 #[command(name = "plenoptic", version, about = "Bake and inspect radiance packs")]
 struct Cli {
@@ -216,20 +229,22 @@ fn run(command: Command) -> Result<()> {
             };
             let report = plenoptic_bake::bake_recipe(&recipe, &options)?;
             match (&report.output, shard) {
-                (Some(out), _) => println!(
+                (Some(out), _) => out!(
                     "wrote {} ({} items rendered, {} resumed)",
                     out.display(),
                     report.items_rendered,
                     report.items_skipped
                 ),
-                (None, Some(s)) => println!(
+                (None, Some(s)) => out!(
                     "shard {s}: {} items rendered, {} already done, of {} in the plan",
-                    report.items_rendered, report.items_skipped, report.items_total
+                    report.items_rendered,
+                    report.items_skipped,
+                    report.items_total
                 ),
                 (None, None) => {}
             }
             for (phase, secs) in &report.timings {
-                println!("  {phase:>14}: {secs:.3} s");
+                out!("  {phase:>14}: {secs:.3} s");
             }
             Ok(())
         }
@@ -245,7 +260,7 @@ fn run(command: Command) -> Result<()> {
             };
             let report = plenoptic_bake::merge_recipe(&recipe, &options)?;
             if let Some(out) = report.output {
-                println!("merged {} items into {}", report.items_total, out.display());
+                out!("merged {} items into {}", report.items_total, out.display());
             }
             Ok(())
         }
@@ -291,7 +306,7 @@ fn run(command: Command) -> Result<()> {
                 )
             };
             let summary = render().map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
-            println!(
+            out!(
                 "{} frames in {} ({:.1} ms per frame), report {}",
                 summary.frames,
                 out.display(),
@@ -334,7 +349,7 @@ fn run(command: Command) -> Result<()> {
                 .iter()
                 .map(|p| p.display().to_string())
                 .collect();
-            println!("wrote {} and {}", csv.display(), plots.join(", "));
+            out!("wrote {} and {}", csv.display(), plots.join(", "));
             Ok(())
         }
         Command::Reference {
@@ -370,18 +385,18 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
     }
     std::fs::write(&out, p.to_json()).map_err(|e| BakeError::io(&out, e))?;
     if json {
-        println!("{}", p.to_json());
+        out!("{}", p.to_json());
         return Ok(());
     }
-    println!("plan of {} (q = {})", p.recipe, p.quality.q);
-    println!(
+    out!("plan of {} (q = {})", p.recipe, p.quality.q);
+    out!(
         "  base views: {} (lattice {} per axis, {} cells tested, {} split)",
         p.base_views.len(),
         p.space_lattice,
         p.counters.space_cells_tested,
         p.counters.space_cells_split
     );
-    println!(
+    out!(
         "  time: {} .. {} s, animated: {}, light keys: {}, time keys: {}",
         p.start,
         p.end,
@@ -390,7 +405,7 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
         p.time_key_count()
     );
     for v in &p.base_views {
-        println!(
+        out!(
             "    view {:>4} at ({:.3}, {:.3}, {:.3}): {} keys, {} volume samples",
             v.id,
             v.position.x,
@@ -400,22 +415,22 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
             v.volume_samples
         );
     }
-    println!("  ambient key times: {:?}", p.ambient_keys);
-    println!("cost:");
-    println!("  range images:   {}", cost.range_images);
-    println!("  camera samples: {}", cost.camera_samples);
-    println!("  volume samples: {}", cost.volume_samples);
-    println!("  ambient fields: {}", cost.ambient_fields);
-    println!(
+    out!("  ambient key times: {:?}", p.ambient_keys);
+    out!("cost:");
+    out!("  range images:   {}", cost.range_images);
+    out!("  camera samples: {}", cost.camera_samples);
+    out!("  volume samples: {}", cost.volume_samples);
+    out!("  ambient fields: {}", cost.ambient_fields);
+    out!(
         "  estimated size: {:.1} MiB before compression",
         cost.estimated_bytes as f64 / (1024.0 * 1024.0)
     );
-    println!(
+    out!(
         "  estimated time: {:.0} s (at {:.2} Mrays/s measured while planning in {secs:.2} s)",
         cost.estimated_seconds,
         rate / 1e6
     );
-    println!("plan written to {}", out.display());
+    out!("plan written to {}", out.display());
     Ok(())
 }
 
@@ -434,7 +449,7 @@ fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> 
         let bytes = pack.chunk_bytes(n)?;
         let out = Path::new(&args[1]);
         std::fs::write(out, &bytes).map_err(|e| BakeError::io(out, e))?;
-        println!(
+        out!(
             "wrote chunk {n} ({} bytes) to {}",
             bytes.len(),
             out.display()
@@ -442,63 +457,78 @@ fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> 
         return Ok(());
     }
     let m = pack.manifest();
-    println!("{}: {} bytes", pack_path.display(), pack.file_length());
-    println!(
+    out!("{}: {} bytes", pack_path.display(), pack.file_length());
+    out!(
         "  time {} .. {} s, bucket span {} s ({} buckets)",
         m.time_range.start,
         m.time_range.end,
         m.bucket_span,
         m.bucket_count()
     );
-    println!("  view space: {:?}", m.view_space);
-    println!(
+    out!("  view space: {:?}", m.view_space);
+    out!(
         "  scene bounds: {:?} .. {:?}",
-        m.scene_bounds.min, m.scene_bounds.max
+        m.scene_bounds.min,
+        m.scene_bounds.max
     );
-    println!(
+    out!(
         "  bake: q = {}, face {} px, {} spp, {} volume samples per view",
         m.bake.quality,
         m.bake.cube_face_size,
         m.bake.samples_per_texel,
         m.bake.volume_samples_per_view
     );
-    println!("  base views: {}", m.base_views.len());
+    out!("  base views: {}", m.base_views.len());
     for v in &m.base_views {
-        println!(
+        out!(
             "    {:>4} at ({:.3}, {:.3}, {:.3}): keys {:?}",
-            v.id, v.position.x, v.position.y, v.position.z, v.time_keys
+            v.id,
+            v.position.x,
+            v.position.y,
+            v.position.z,
+            v.time_keys
         );
     }
-    println!("  objects: {}", m.objects.len());
+    out!("  objects: {}", m.objects.len());
     for o in &m.objects {
-        println!("    {:>4} {} ({:?})", o.id, o.name, o.motion);
+        out!("    {:>4} {} ({:?})", o.id, o.name, o.motion);
     }
-    println!(
+    out!(
         "  materials: {}, textures: {}",
         m.materials.len(),
         m.textures.len()
     );
     for (i, t) in m.textures.iter().enumerate() {
-        println!(
+        out!(
             "    texture {i}: {} x {}, {} levels, {:?}",
-            t.width, t.height, t.levels, t.colour_space
+            t.width,
+            t.height,
+            t.levels,
+            t.colour_space
         );
     }
-    println!("  lights: {}", m.lights.len());
-    println!("  chunks: {}", pack.entries().len());
+    out!("  lights: {}", m.lights.len());
+    out!("  chunks: {}", pack.entries().len());
     for (k, v) in &m.stats.bytes {
-        println!("    bytes {k}: {v}");
+        out!("    bytes {k}: {v}");
     }
     for (k, v) in &m.stats.sample_counts {
-        println!("    count {k}: {v}");
+        out!("    count {k}: {v}");
     }
     for (k, v) in &m.stats.phase_seconds {
-        println!("    seconds {k}: {v:.3}");
+        out!("    seconds {k}: {v:.3}");
     }
     if chunks {
-        println!(
+        out!(
             "  {:>6} {:<20} {:>6} {:>6} {:>12} {:>10} {:>12} {:>18}",
-            "index", "kind", "view", "key", "offset", "length", "uncompressed", "checksum"
+            "index",
+            "kind",
+            "view",
+            "key",
+            "offset",
+            "length",
+            "uncompressed",
+            "checksum"
         );
         for (i, e) in pack.entries().iter().enumerate() {
             let view = if e.base_view == plenoptic_pack::NO_BASE_VIEW {
@@ -506,7 +536,7 @@ fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> 
             } else {
                 e.base_view.to_string()
             };
-            println!(
+            out!(
                 "  {:>6} {:<20} {:>6} {:>6} {:>12} {:>10} {:>12} {:>#18x}",
                 i,
                 format!("{:?}", e.kind),
@@ -560,7 +590,7 @@ fn cmd_reference(
             &Progress::new(true),
         )?;
         exposure = Some(summary.exposure);
-        println!(
+        out!(
             "{} reference frames written to {} ({:.1} s per frame at {spp} spp, seed {seed})",
             summary.frames,
             dir.display(),
@@ -568,7 +598,7 @@ fn cmd_reference(
         );
     }
     if halves {
-        println!(
+        out!(
             "compare with: plenoptic compare --reference {0} --reference-b {0}_b …",
             out.display()
         );
