@@ -27,10 +27,10 @@
 //! `L_reflection ⊙ (1 + T + … + T^(k−1)) + T^k ⊙ L_behind` (every surface crossed taken to
 //! reflect as the nearest does) with the per-surface transmittance
 //! `T = (1 − F₀) · transmission · base colour` (F₀ from the IOR, at normal incidence;
-//! [`crate::specular::see_through_transmittance`]). Rays
-//! go straight through: exact for panes and balustrades of parallel faces, where refraction
-//! only shifts the view by a fraction of the thickness; a solid block bends what is seen
-//! through it, which this leaves out. The baked radiance instead showed the base view's
+//! [`crate::specular::see_through_transmittance`]). Glass that is also `BLEND` glazing is
+//! composited as glazing. Rays go straight through: exact for panes and balustrades of
+//! parallel faces, where refraction only shifts the view by a fraction of the thickness; a
+//! solid block bends what is seen through it, which this leaves out. The baked radiance instead showed the base view's
 //! view through the glass, displaced and at cube resolution: the tour's glass balustrade
 //! was a dark smear over the brick wall behind it (0.43 of the path tracer's luminance).
 //! The GPU draws such glass in Bevy's transparent pass with premultiplied alpha, both faces,
@@ -134,8 +134,8 @@ const FAR: f32 = 1e4;
 /// Composites the see-through layer `front` over `behind` in place where a see-through
 /// object is nearer, with k the pixel's `crossings` (at least 1; 1 without them): glazing
 /// as `(1 − (1 − c)^k) · front + (1 − c)^k · behind`, transmissive glass as
-/// `front ⊙ (1 + T + … + T^(k−1)) + T^k ⊙ behind`; with the object's depth and id. Returns how many pixels were
-/// covered.
+/// `front ⊙ (1 + T + … + T^(k−1)) + T^k ⊙ behind`; with the object's depth and id. Returns
+/// how many pixels were covered.
 fn composite(
     behind: &mut Frame,
     front: &Frame,

@@ -281,6 +281,19 @@ fn surface_image(
         return ((0..n).map(|_| None).collect(), 0.0);
     };
     let start = std::time::Instant::now();
+    // Glazing (coverage) is composited as such even where its material transmits
+    // (crate::glazing); only other transmissive glass shows its reflection alone.
+    let glazing: Vec<u32> = match layer {
+        Layer::Only(_) => rec
+            .pack()
+            .manifest()
+            .objects
+            .iter()
+            .filter(|o| o.coverage.is_some())
+            .map(|o| o.id)
+            .collect(),
+        _ => Vec::new(),
+    };
     let mut placed = proxy.placed_meshes(t);
     match layer {
         Layer::All => {}
@@ -385,7 +398,9 @@ fn surface_image(
             let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
             // In the see-through layer, transmissive glass shows its reflection alone: what
             // it lets through is composited from the layer behind (crate::glazing).
-            let see_through = matches!(layer, Layer::Only(_)) && material.transmission > 0.0;
+            let see_through = matches!(layer, Layer::Only(_))
+                && material.transmission > 0.0
+                && !glazing.contains(&t.object);
             let reflection_of = SurfaceMaterial {
                 transmission: 0.0,
                 ..material

@@ -184,9 +184,7 @@ impl PlacedShadows<'_> {
                     )
             })
     }
-}
 
-impl PlacedShadows<'_> {
     /// How many triangles the ray from `origin` along unit `dir` crosses closer than `tmax`
     /// (both faces count).
     pub fn crossings(&self, origin: Vec3, dir: Vec3, tmax: f32) -> u32 {

@@ -216,6 +216,7 @@ pub struct PlenopticMaterial {
     /// fragment is its reflection marched for the camera over what lies behind, which shows
     /// through with the mean of the per-surface transmittance T, both faces drawn (T², as
     /// `plenoptic_recon`'s glazing module composites a pane); elsewhere it is opaque (alpha 1).
+    /// Glazing (`coverage` < 1) is blended as glazing even where its material transmits.
     pub transmissive: bool,
 }
 
@@ -656,6 +657,7 @@ fn update_materials(
                 if let Some(t) =
                     plenoptic_recon::specular::see_through_transmittance(&cam.settings, &f.material)
                     && !image_mode
+                    && mat.coverage >= 1.0
                 {
                     params.flags.z = 1.0;
                     params.flags.w = (t.x + t.y + t.z) / 3.0;
