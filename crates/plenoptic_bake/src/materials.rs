@@ -75,6 +75,7 @@ pub fn pack_materials(scene: &Scene) -> Result<PackMaterials> {
                     emissive_texture: bind(&m.emissive_texture, ColourSpace::Srgb)?,
                     transmission: m.transmission,
                     ior: m.ior,
+                    thickness: m.thickness.max(0.0),
                     double_sided: m.double_sided,
                     alpha_mode: match m.alpha_mode {
                         plenoptic_scene::AlphaMode::Opaque => AlphaMode::Opaque,

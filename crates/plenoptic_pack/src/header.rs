@@ -12,7 +12,7 @@ pub const VERSION_MAJOR: u16 = 3;
 /// [`PackError::NeedsRebake`].
 pub const OLDEST_MAJOR: u16 = 2;
 /// The minor format version this crate writes. Readers accept any minor of their major.
-pub const VERSION_MINOR: u16 = 1;
+pub const VERSION_MINOR: u16 = 2;
 /// Size of the header in bytes.
 pub const HEADER_LEN: u64 = 128;
 

@@ -122,6 +122,11 @@ pub struct MaterialEntry {
     pub transmission: f32,
     /// `KHR_materials_ior` (1.5 when absent).
     pub ior: f32,
+    /// `KHR_materials_volume` thickness factor (format 3.2; absent: 0): 0 makes a
+    /// transmissive surface a thin wall that light crosses without bending, above 0 the mesh
+    /// bounds a refracting solid.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub thickness: f32,
     /// Whether back faces are shaded as front faces.
     pub double_sided: bool,
     /// Opaque, mask (with its cutoff) or blend.
@@ -144,10 +149,15 @@ impl Default for MaterialEntry {
             emissive_texture: None,
             transmission: 0.0,
             ior: 1.5,
+            thickness: 0.0,
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
         }
     }
+}
+
+fn is_zero(x: &f32) -> bool {
+    *x == 0.0
 }
 
 impl MaterialEntry {

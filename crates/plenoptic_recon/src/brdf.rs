@@ -2,7 +2,7 @@
 //! docs/architecture.md, "The runtime sun"). It is the tracer's glTF metallic-roughness model
 //! (`plenoptic_trace::material`: Lambert + GGX with separable Smith masking, the exact
 //! dielectric Fresnel for the IOR, Schlick's for metals, Walter et al. 2007's rough BTDF for
-//! transmission), evaluated only, not sampled. The runtime core does not depend on the
+//! transmission into a solid, the mirrored reflection lobe through a thin wall), evaluated only, not sampled. The runtime core does not depend on the
 //! tracer, so the formulas are repeated here; `tests/runtime_sun.rs` checks that both give
 //! the same value for random surfaces and directions.
 //!
@@ -29,6 +29,9 @@ pub struct SurfaceMaterial {
     pub transmission: f32,
     /// Index of refraction (> 0).
     pub ior: f32,
+    /// Whether transmission crosses a thin wall without bending (glTF's default; the pack's
+    /// thickness 0) rather than refracting into a solid.
+    pub thin_walled: bool,
 }
 
 impl SurfaceMaterial {
@@ -66,7 +69,11 @@ impl Bsdf {
             n = (n - wo * (n.dot(wo) - 1e-4)).normalize_or(ng);
         }
         let ior = if m.ior > 0.0 { m.ior } else { 1.5 };
-        let eta = if front_face { ior } else { 1.0 / ior };
+        let eta = if front_face || m.thin_walled {
+            ior
+        } else {
+            1.0 / ior
+        };
         let fd = fresnel_dielectric(wo.dot(n).clamp(1e-4, 1.0), eta);
         let lum = 0.2126 * m.base.x + 0.7152 * m.base.y + 0.0722 * m.base.z;
         Self {
@@ -118,6 +125,18 @@ impl Bsdf {
                 f += fr * (d * g / (4.0 * cos_o * cos_i).max(1e-8));
             }
             f
+        } else if m.thin_walled && !self.delta && tr > 0.0 && metal < 1.0 {
+            // The microfacet reflection mirrored through the wall's plane.
+            let wr = wi - n * (2.0 * cos_i);
+            let h = (wo + wr).normalize_or_zero();
+            if h == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            let voh = wo.dot(h).clamp(0.0, 1.0);
+            let fd = fresnel_dielectric(voh, self.eta);
+            let d = ggx_d(self.alpha, h.dot(n));
+            let g = smith_g1(self.alpha, cos_o) * smith_g1(self.alpha, -cos_i);
+            m.base * ((1.0 - metal) * tr * (1.0 - fd) * d * g / (4.0 * cos_o * -cos_i).max(1e-8))
         } else if !self.delta && tr > 0.0 && metal < 1.0 {
             let eta = self.eta;
             let mut h = (wo + wi * eta).normalize_or_zero();

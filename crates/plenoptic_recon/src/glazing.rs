@@ -28,9 +28,11 @@
 //! reflect as the nearest does) with the per-surface transmittance
 //! `T = (1 − F₀) · transmission · base colour` (F₀ from the IOR, at normal incidence;
 //! [`crate::specular::see_through_transmittance`]). Glass that is also `BLEND` glazing is
-//! composited as glazing. Rays go straight through: exact for panes and balustrades of
-//! parallel faces, where refraction only shifts the view by a fraction of the thickness; a
-//! solid block bends what is seen through it, which this leaves out. The baked radiance instead showed the base view's
+//! composited as glazing. Rays go straight through, as glTF's default *thin-walled*
+//! transmission has it (and the tracer, `plenoptic_trace::material`): exact for every surface
+//! without `KHR_materials_volume`. A solid of glass (the pack's material thickness above 0)
+//! would bend what is seen through it; it is shown as thin walls, its refraction left out.
+//! The baked radiance instead showed the base view's
 //! view through the glass, displaced and at cube resolution: the tour's glass balustrade
 //! was a dark smear over the brick wall behind it (0.43 of the path tracer's luminance).
 //! The GPU draws such glass in Bevy's transparent pass with premultiplied alpha, both faces,

@@ -135,6 +135,7 @@ impl Materials {
             roughness: roughness.clamp(0.0, 1.0),
             transmission: m.transmission.clamp(0.0, 1.0),
             ior: if m.ior > 0.0 { m.ior } else { 1.5 },
+            thin_walled: m.thickness <= 0.0,
         }
     }
 

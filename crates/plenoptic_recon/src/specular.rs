@@ -420,6 +420,7 @@ mod tests {
             roughness,
             transmission: 0.0,
             ior: 1.5,
+            thin_walled: true,
         }
     }
 

@@ -44,6 +44,8 @@ fn the_runtime_bsdf_is_the_tracers() {
             roughness,
             transmission: if case % 4 == 0 { rng.f() } else { 0.0 },
             ior: 1.0 + rng.f(),
+            // Transmission crossing a thin wall, and refracting into a solid.
+            thin_walled: case % 8 < 4,
         };
         let ng = rng.unit();
         // A shading normal near the geometric one, on its side.
@@ -61,6 +63,7 @@ fn the_runtime_bsdf_is_the_tracers() {
             emissive: Vec3::ZERO,
             transmission: m.transmission,
             ior: m.ior,
+            thin_walled: m.thin_walled,
             double_sided: true,
         };
         let hit = Hit {

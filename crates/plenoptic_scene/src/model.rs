@@ -84,6 +84,10 @@ pub struct Material {
     pub transmission: f32,
     /// `KHR_materials_ior` (1.5 when absent).
     pub ior: f32,
+    /// `KHR_materials_volume` thickness factor: 0 (the default, and when the extension is
+    /// absent) makes a transmissive surface a *thin wall*, which light crosses without
+    /// bending (glTF's default); above 0 the mesh bounds a solid that refracts.
+    pub thickness: f32,
     /// Whether back faces are shaded as front faces.
     pub double_sided: bool,
     /// How base-colour alpha is used: opaque, cut out, or coverage.
@@ -106,6 +110,7 @@ impl Default for Material {
             normal_scale: 1.0,
             transmission: 0.0,
             ior: 1.5,
+            thickness: 0.0,
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
         }

@@ -314,19 +314,24 @@ fn texture_transform_texcoord_override_and_bad_values() {
 fn unsupported_extensions_warn_naming_the_element_and_required_ones_fail() {
     let scene = edited(|doc| {
         doc["materials"][1]["extensions"] =
-            json!({"KHR_materials_volume": {"thicknessFactor": 0.01}});
+            json!({"KHR_materials_volume": {"thicknessFactor": 0.01},
+                   "KHR_materials_clearcoat": {"clearcoatFactor": 1.0}});
         doc["extensionsUsed"] = json!([
             "KHR_texture_transform",
             "KHR_materials_volume",
+            "KHR_materials_clearcoat",
             "EXT_mesh_gpu_instancing"
         ]);
     })
     .unwrap();
     let w = scene.warnings.join("\n");
     assert!(
-        w.contains("extensionsUsed: KHR_materials_volume is not supported and is ignored (used by material 1 'glass')"),
+        w.contains("extensionsUsed: KHR_materials_clearcoat is not supported and is ignored (used by material 1 'glass')"),
         "{w}"
     );
+    // The volume is read: the glass is a solid 1 cm thick rather than a thin wall.
+    assert!(!w.contains("KHR_materials_volume"), "{w}");
+    assert_eq!(scene.materials[1].thickness, 0.01);
     assert!(
         w.contains("EXT_mesh_gpu_instancing is not supported"),
         "{w}"
@@ -334,8 +339,8 @@ fn unsupported_extensions_warn_naming_the_element_and_required_ones_fail() {
     assert!(!w.contains("KHR_texture_transform"), "{w}");
 
     let e = edited(|doc| {
-        doc["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_volume"]);
-        doc["extensionsRequired"] = json!(["KHR_materials_volume"]);
+        doc["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_clearcoat"]);
+        doc["extensionsRequired"] = json!(["KHR_materials_clearcoat"]);
     })
     .unwrap_err()
     .to_string();

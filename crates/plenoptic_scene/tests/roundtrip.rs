@@ -15,7 +15,12 @@ fn close(a: Vec3, b: Vec3) -> bool {
 fn house() -> SceneBuilder {
     let mut b = SceneBuilder::new();
     let white = b.add_material(MaterialDesc::diffuse(Vec3::splat(0.8)).named("white"));
-    let glass = b.add_material(MaterialDesc::glass(1.45).named("glass").double_sided(true));
+    let glass = b.add_material(
+        MaterialDesc::glass(1.45)
+            .named("glass")
+            .double_sided(true)
+            .thickness(0.02),
+    );
     let lamp = b.add_material(
         MaterialDesc::emitter(Vec3::new(1.0, 0.9, 0.8), 20.0)
             .named("lamp")
@@ -119,10 +124,17 @@ fn check_house(scene: &Scene) {
     let glass = material("Window");
     assert_eq!(glass.name, "glass");
     assert_eq!(
-        (glass.transmission, glass.ior, glass.double_sided),
-        (1.0, 1.45, true)
+        (
+            glass.transmission,
+            glass.ior,
+            glass.thickness,
+            glass.double_sided
+        ),
+        (1.0, 1.45, 0.02, true)
     );
     let lamp = material("Lamp");
+    // No KHR_materials_volume: glTF's thin-walled default.
+    assert_eq!(lamp.thickness, 0.0);
     assert!(close(lamp.emissive, Vec3::new(20.0, 18.0, 16.0)));
     assert_eq!((lamp.metallic, lamp.roughness), (0.25, 0.75));
     assert_eq!(lamp.base_color, Vec4::new(0.0, 0.0, 0.0, 1.0));

@@ -5,10 +5,18 @@
 //! (KHR_materials_transmission). Specular reflection is GGX with height-correlated-free
 //! separable Smith masking; the dielectric Fresnel is the exact one for the material's IOR
 //! (so IOR 1 gives a pure Lambertian surface, F0 = ((ior−1)/(ior+1))² = 0.04 at IOR 1.5),
-//! the metal Fresnel is Schlick's with F0 = base colour. Transmission is a *thick* dielectric:
-//! rays refract into the solid and out again at its other faces (Walter et al. 2007 rough
-//! BTDF), so a slab shows inter-reflections. Roughness below [`DELTA_ROUGHNESS`] gives delta
-//! (mirror / ideal refraction) lobes.
+//! the metal Fresnel is Schlick's with F0 = base colour. Roughness below [`DELTA_ROUGHNESS`]
+//! gives delta (mirror / ideal refraction) lobes.
+//!
+//! Transmission follows glTF's two cases:
+//! - **thin-walled** (the default: no `KHR_materials_volume`, or thickness 0): the surface is
+//!   an infinitely thin wall between air and air. The transmitted ray leaves without bending,
+//!   along the microfacet reflection mirrored through the surface's plane (the straight line
+//!   when smooth), weighted by (1 − F)·transmission·base colour, and both faces see the IOR
+//!   from outside. A pane modelled as one quad, or as a box, shows what is behind it in place.
+//! - **thick** (`KHR_materials_volume` thickness above 0): the mesh bounds a solid dielectric;
+//!   rays refract into it and out again at its other faces (Walter et al. 2007 rough BTDF),
+//!   so a slab shows inter-reflections and a block bends what is seen through it.
 
 use glam::{Vec2, Vec3};
 use plenoptic_scene::Scene;
@@ -39,6 +47,8 @@ pub struct SurfaceProps {
     pub transmission: f32,
     /// Index of refraction.
     pub ior: f32,
+    /// Whether transmission crosses a thin wall (no bending) rather than entering a solid.
+    pub thin_walled: bool,
     /// Whether back faces emit.
     pub double_sided: bool,
 }
@@ -67,6 +77,7 @@ impl SurfaceProps {
             emissive,
             transmission: m.transmission.clamp(0.0, 1.0),
             ior: if m.ior > 0.0 { m.ior } else { 1.5 },
+            thin_walled: m.thickness <= 0.0,
             double_sided: m.double_sided,
         }
     }
@@ -173,8 +184,10 @@ pub struct Bsdf {
     metallic: f32,
     alpha: f32,
     transmission: f32,
-    /// n_other / n_wo-side.
+    /// n_other / n_wo-side (the IOR on both faces of a thin wall).
     eta: f32,
+    /// Thin-walled transmission: mirrored reflection instead of refraction.
+    thin: bool,
     delta: bool,
     /// Lobe selection weights: diffuse, specular reflection, transmission.
     p: [f32; 3],
@@ -196,7 +209,7 @@ impl Bsdf {
         }
         let frame = Frame::from_normal(n);
         let wo_local = frame.to_local(wo);
-        let eta = if hit.front_face {
+        let eta = if hit.front_face || props.thin_walled {
             props.ior
         } else {
             1.0 / props.ior
@@ -223,6 +236,7 @@ impl Bsdf {
             alpha,
             transmission: tr,
             eta,
+            thin: props.thin_walled,
             delta,
             p,
         }
@@ -297,6 +311,19 @@ impl Bsdf {
                 f += fr * (d * g / (4.0 * wo.z * wi_l.z).max(1e-8));
                 pdf += probs[1] * d * h.z / (4.0 * voh).max(1e-8);
             }
+        } else if self.thin && !self.delta && lobes != Lobes::Diffuse && tr > 0.0 && m < 1.0 {
+            // The microfacet reflection mirrored through the wall's plane.
+            let wr = Vec3::new(wi_l.x, wi_l.y, -wi_l.z);
+            let h = (wo + wr).normalize_or_zero();
+            if h == Vec3::ZERO {
+                return (Vec3::ZERO, 0.0);
+            }
+            let voh = wo.dot(h).clamp(0.0, 1.0);
+            let fd = fresnel_dielectric(voh, self.eta);
+            let d = ggx_d(self.alpha, h.z);
+            let g = smith_g1(self.alpha, wo.z) * smith_g1(self.alpha, wr.z);
+            f += self.base * ((1.0 - m) * tr * (1.0 - fd) * d * g / (4.0 * wo.z * wr.z).max(1e-8));
+            pdf += probs[2] * d * h.z / (4.0 * voh).max(1e-8);
         } else if !self.delta && lobes != Lobes::Diffuse && tr > 0.0 && m < 1.0 {
             let eta = self.eta;
             let mut h = (wo + wi_l * eta).normalize_or_zero();
@@ -341,6 +368,9 @@ impl Bsdf {
             let (wi_l, weight) = if lobe == 1 {
                 let fr = Vec3::splat((1.0 - m) * fd) + fresnel_schlick(self.base, cos) * m;
                 (Vec3::new(-wo.x, -wo.y, wo.z), fr / probs[1])
+            } else if self.thin {
+                let w = self.base * ((1.0 - m) * tr * (1.0 - fd));
+                (-wo, w / probs[2])
             } else {
                 let wi = refract(wo, Vec3::Z, self.eta)?;
                 let w = self.base * ((1.0 - m) * tr * (1.0 - fd) / (self.eta * self.eta));
@@ -366,6 +396,14 @@ impl Bsdf {
                     return None;
                 }
                 wi
+            }
+            _ if self.thin => {
+                let h = ggx_sample_h(self.alpha, u);
+                let wr = 2.0 * wo.dot(h) * h - wo;
+                if wr.z <= 0.0 {
+                    return None;
+                }
+                Vec3::new(wr.x, wr.y, -wr.z)
             }
             _ => {
                 let h = ggx_sample_h(self.alpha, u);

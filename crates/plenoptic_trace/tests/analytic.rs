@@ -276,3 +276,52 @@ fn glass_slab_at_normal_incidence() {
     // Specular depth 8 cuts paths after four round trips inside: bias < R⁴.
     check("slab MS", &img, t, 1e-5);
 }
+
+/// A 1 m glass cube (IOR 1.5, smooth) seen at 26.6° from the vertical, with a 10 cm emitter
+/// on the straight line through it, 0.5 m below. glTF's default transmission is thin-walled:
+/// the ray crosses both walls without bending and sees the emitter through two surfaces,
+/// (1 − F)² (the inter-reflections between the walls leave sideways, 1 m off). Declared a
+/// solid (`KHR_materials_volume`), the cube refracts the ray 19 cm aside and it misses.
+#[test]
+fn thin_walled_glass_does_not_bend_and_a_solid_does() {
+    let n = 1.5f32;
+    let render = |thickness: f32| {
+        let mut b = shapes::SceneBuilder::default();
+        let g = b.material(plenoptic_scene::Material {
+            thickness,
+            ..shapes::glass(n, 0.0)
+        });
+        let e = b.material(shapes::emitter(Vec3::ONE));
+        b.object("cube", shapes::cuboid(Vec3::ONE), g, Vec3::ZERO);
+        b.object(
+            "light",
+            shapes::quad(Vec2::splat(0.1)),
+            e,
+            Vec3::new(0.5, -1.0, 0.0),
+        );
+        let scene = b.build();
+        let accel = SceneAccel::new(&scene).unwrap();
+        let placed = accel.at_time(0.0);
+        let cam =
+            PinholeCamera::look_at(Vec3::new(-1.0, 2.0, 0.0), Vec3::ZERO, Vec3::Z, 0.01, 1, 1)
+                .unwrap();
+        // Each path picks reflection or transmission at each wall (weight 1): the estimate
+        // is a binomial fraction, σ = √(p(1 − p)/N) = 0.002 at N = 16384.
+        let img = pt(16384).render(&placed, &cam);
+        img.get(0, 0).radiance
+    };
+    let cos = 2.0 / 5.0f32.sqrt();
+    let f = plenoptic_trace::material::fresnel_dielectric(cos, n);
+    let expected = (1.0 - f) * (1.0 - f);
+    let thin = render(0.0);
+    println!("thin-walled: {thin} expected {expected}; F = {f}");
+    let sigma = (expected * (1.0 - expected) / 16384.0).sqrt();
+    assert!(
+        (thin - Vec3::splat(expected)).abs().max_element() < 4.0 * sigma,
+        "{thin} vs {expected} ± {}",
+        4.0 * sigma
+    );
+    let solid = render(1.0);
+    println!("solid: {solid}");
+    assert!(solid.max_element() < 0.01, "{solid}");
+}

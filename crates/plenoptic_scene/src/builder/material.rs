@@ -38,6 +38,9 @@ pub struct MaterialDesc {
     pub transmission: f32,
     /// `KHR_materials_ior`.
     pub ior: f32,
+    /// `KHR_materials_volume` thickness factor (m in the mesh's space): 0 writes no volume,
+    /// a thin-walled surface; above 0 the mesh bounds a refracting solid.
+    pub thickness: f32,
     /// Whether back faces are shaded too.
     pub double_sided: bool,
     /// glTF `alphaMode` (and `alphaCutoff` for [`AlphaMode::Mask`]).
@@ -62,6 +65,7 @@ impl Default for MaterialDesc {
             normal_texture: None,
             transmission: 0.0,
             ior: 1.5,
+            thickness: 0.0,
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
             texture_transform: None,
@@ -141,6 +145,12 @@ impl MaterialDesc {
         self.ior = ior;
         self
     }
+    /// Makes a transmissive material a refracting solid of about `thickness` (m)
+    /// (`KHR_materials_volume`); 0 keeps it a thin wall.
+    pub fn thickness(mut self, thickness: f32) -> Self {
+        self.thickness = thickness;
+        self
+    }
     /// Sets double-sidedness.
     pub fn double_sided(mut self, double_sided: bool) -> Self {
         self.double_sided = double_sided;
@@ -210,6 +220,7 @@ pub(super) fn materials(b: &SceneBuilder, used: &mut Vec<String>) -> Result<Vec<
                 m.emissive_strength,
                 m.transmission,
                 m.ior,
+                m.thickness,
             ],
         )?;
         let transform = m.texture_transform.filter(|t| !t.is_identity());
@@ -294,6 +305,12 @@ pub(super) fn materials(b: &SceneBuilder, used: &mut Vec<String>) -> Result<Vec<
         }
         if m.ior != 1.5 {
             ext.insert("KHR_materials_ior".into(), json!({"ior": m.ior}));
+        }
+        if m.thickness > 0.0 {
+            ext.insert(
+                "KHR_materials_volume".into(),
+                json!({"thicknessFactor": m.thickness}),
+            );
         }
         for key in ext.keys() {
             add_used(key);

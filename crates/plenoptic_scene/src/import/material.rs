@@ -143,6 +143,9 @@ impl Materials {
                 .transmission()
                 .map_or(0.0, |t| t.transmission_factor()),
             ior: material.ior().unwrap_or(1.5),
+            thickness: material
+                .volume()
+                .map_or(0.0, |v| v.thickness_factor().max(0.0)),
             double_sided: material.double_sided(),
             alpha_mode,
         })
