@@ -367,6 +367,7 @@ pub fn materials() -> (Vec<TextureEntry>, Vec<MaterialEntry>) {
         emissive_texture: Some(bind(0)),
         transmission: 0.5,
         ior: 1.45,
+        thickness: 0.01,
         double_sided: true,
         alpha_mode: AlphaMode::Mask { cutoff: 0.3 },
     };
