@@ -12,7 +12,8 @@
 //!   modes and `KHR_texture_transform`, and `COLOR_0`.
 //! - [`camera`]: pinhole, cube (KTX2/Vulkan face order and orientation) and fisheye cameras.
 //! - [`pathtrace`]: the reference path tracer (next-event estimation, multiple importance
-//!   sampling, GGX, thick dielectric transmission), the ground truth for every metric.
+//!   sampling, GGX, transmission thin-walled as glTF's default or a refracting solid with
+//!   `KHR_materials_volume`), the ground truth for every metric.
 //! - [`multistage`]: the multi-stage renderer of Nimeroff's thesis, chapter 5 ("Computing the
 //!   radiance distribution for an environment – multi-stage rendering", figure 5.1): indirect
 //!   diffuse light comes from an *ambient field* gathered on a scene simplified by a quality
