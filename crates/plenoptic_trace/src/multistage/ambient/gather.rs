@@ -23,9 +23,13 @@
 //! estimated geometrically from the last two increments (r/(1−r)·|ΔE|), falls below
 //! `tolerance` of |E|, or after `max_bounces`.
 //!
-//! A ray that meets the back face of a single-sided surface has entered a closed solid and
-//! carries no light (the field is shared by both sides of a triangle, so reading it there
-//! would leak the lit side's light through the wall). Points that lie inside a solid — more
+//! A ray that meets the back face of a single-sided opaque surface has entered a closed
+//! solid and carries no light (the field is shared by both sides of a triangle, so reading
+//! it there would leak the lit side's light through the wall). Transmissive surfaces are
+//! exempt: a glass balustrade modelled as one single-sided panel is seen from behind through
+//! open air, and a glass case's inner faces through its glass. Treated as solids, the tour's
+//! glass balustrade was a black wall for every gather ray that met its back, and the atrium's
+//! indirect light came out about 12 % low (frames at 0.89–0.93 of the path tracer's mean). Points that lie inside a solid — more
 //! than an eighth of their gather rays first meet such a back face, as on a box face running
 //! under a wall — are **invalid**: their own gather is
 //! dropped, and at every iteration they take the mean of their valid (or already filled)
@@ -140,7 +144,9 @@ fn gather_point(
                 break;
             };
             let props = SurfaceProps::at(scene, &hit);
-            if !hit.front_face && !props.double_sided {
+            // Transmissive surfaces are exempt: light reaches a pane's or a glass case's
+            // inner side through the glass, and the path tracer shades it there.
+            if !hit.front_face && !props.double_sided && props.transmission <= 0.0 {
                 // The inside of a closed solid: no light there. From the point itself it
                 // means the point is embedded in that solid.
                 if depth == 0 {
