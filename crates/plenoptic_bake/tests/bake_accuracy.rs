@@ -458,3 +458,21 @@ fn tour_base_views() {
         println!("{name}: {f}");
     }
 }
+
+/// The tour as its recipe bakes it (the sun study and the sky applied), at base view 13
+/// (0, 1.6, 2.5) looking north across the atrium at the time key t = 10.5: the view that
+/// found the glass balustrade blocking the field (docs/bake-accuracy.md, cause 5). Prints
+/// the figures for the issue note. Slow (minutes in release).
+#[test]
+#[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture atrium"]
+fn tour_atrium_under_its_daylight() {
+    let recipe = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/architectural_tour/assets/tour.toml");
+    let (_, scene) = plenoptic_bake::input::load_recipe(&recipe).unwrap();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let field = bake_field(&accel, &Quality::draft(), 10.5);
+    let name = "atrium north under daylight, t = 10.5";
+    let cam = camera(Vec3::new(0.0, 1.6, 2.5), 0.0, 0.0, 64, 40);
+    let f = base_view_frame(name, &accel, &field, &cam, 2048);
+    println!("{name}: {f}");
+}

@@ -2,8 +2,8 @@
 //! docs/architecture.md, "The runtime sun"). It is the tracer's glTF metallic-roughness model
 //! (`plenoptic_trace::material`: Lambert + GGX with separable Smith masking, the exact
 //! dielectric Fresnel for the IOR, Schlick's for metals, Walter et al. 2007's rough BTDF for
-//! transmission into a solid, the mirrored reflection lobe through a thin wall), evaluated only, not sampled. The runtime core does not depend on the
-//! tracer, so the formulas are repeated here; `tests/runtime_sun.rs` checks that both give
+//! transmission into a solid, the mirrored reflection lobe through a thin wall), evaluated
+//! only, not sampled. The runtime core does not depend on the tracer, so the formulas are repeated here; `tests/runtime_sun.rs` checks that both give
 //! the same value for random surfaces and directions.
 //!
 //! Everything is in world space: the model is isotropic, so only dot products with the
