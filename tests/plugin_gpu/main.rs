@@ -8,6 +8,7 @@
 //! - [`pack_asset`]: the `RadiancePack` asset and its failures.
 //! - [`sky`]: the sky, its ground and the glazing on the GPU.
 //! - [`lit`]: the app's own meshes lit by the pack's radiance around the camera.
+//! - [`own_scene`]: the tour's glb loaded by Bevy's glTF loader, lit by the pack.
 //! - [`many_cameras`]: several plenoptic cameras in one app (two modes and times, a stereo
 //!   pair, a runtime sun per camera), each equal to its CPU frame.
 
@@ -21,6 +22,7 @@ mod pack;
 mod harness;
 mod lit;
 mod many_cameras;
+mod own_scene;
 mod pack_asset;
 mod scene_render;
 mod sky;

@@ -107,7 +107,7 @@ fn plugin_frames(dir: &std::path::Path, eyes: &[Eye]) -> Vec<Vec<Vec3>> {
 /// The frames `targets` settle on together: each shown (drawn, not the red clear colour,
 /// something lit) and equal in three read-backs in a row, after at least 60 updates (the
 /// software driver compiles pipelines slowly and skips what is not compiled yet).
-fn settled_frames(app: &mut App, targets: &[Handle<Image>]) -> Vec<Vec<Vec3>> {
+pub(crate) fn settled_frames(app: &mut App, targets: &[Handle<Image>]) -> Vec<Vec<Vec3>> {
     let latest: Vec<Arc<Mutex<Option<Vec<u8>>>>> = targets.iter().map(|_| Arc::default()).collect();
     for (image, sink) in targets.iter().zip(&latest) {
         let sink = sink.clone();

@@ -119,8 +119,8 @@ pub struct PlenopticSettings {
     /// Where frames are reconstructed. Read when a pack's proxy geometry is first shown.
     pub backend: Backend,
     /// The first render layer given to plenoptic cameras: each camera draws its own proxy
-    /// geometry on a layer of its own, the lowest free one from here up
-    /// ([`camera::layers`]). Choose it above the layers the app uses itself.
+    /// geometry on a layer of its own, with a shadow-only layer above it, the lowest free pair
+    /// from here up ([`camera::layers`]). Choose it above the layers the app uses itself.
     pub first_render_layer: usize,
     /// Light the app's own meshes with the pack: each plenoptic camera without an
     /// environment light of its own gets one made from the pack's radiance around it at its

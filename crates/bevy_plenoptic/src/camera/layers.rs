@@ -18,7 +18,8 @@ use super::PlenopticCamera;
 use crate::PlenopticSettings;
 
 /// The render layer of a [`PlenopticCamera`]'s own proxies, background and sun (see the
-/// module doc), from [`PlenopticSettings::first_render_layer`] up, the lowest free one.
+/// module doc), from [`PlenopticSettings::first_render_layer`] up, the lowest free pair (the
+/// layer above is the camera's shadow-only layer, [`ViewLayer::shadow_only`]).
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ViewLayer(pub usize);
 
@@ -26,6 +27,18 @@ impl ViewLayer {
     /// The layer as `RenderLayers`, for the entities drawn for this camera.
     pub fn layers(self) -> RenderLayers {
         RenderLayers::layer(self.0)
+    }
+
+    /// The layer above it, which the camera does not see: proxies drawn only into the
+    /// camera's sun's shadow map (those of objects the app's own lit meshes show,
+    /// [`crate::lit::scene`]).
+    pub fn shadow_only(self) -> RenderLayers {
+        RenderLayers::layer(self.0 + 1)
+    }
+
+    /// The camera's sun's layers: its own and the shadow-only one.
+    pub fn light_layers(self) -> RenderLayers {
+        RenderLayers::from_layers(&[self.0, self.0 + 1])
     }
 }
 
@@ -49,9 +62,14 @@ pub fn assign_view_layers(
         let layer = match layer {
             Some(l) => *assigned.0.entry(entity).or_insert(l.0),
             None => {
+                // Two layers each: the camera's and its shadow-only one above it.
                 let mut l = settings.first_render_layer;
-                while assigned.0.values().any(|&taken| taken == l) {
-                    l += 1;
+                while assigned
+                    .0
+                    .values()
+                    .any(|&taken| taken == l || taken == l + 1 || taken + 1 == l)
+                {
+                    l += 2;
                 }
                 assigned.0.insert(entity, l);
                 commands.entity(entity).insert(ViewLayer(l));

@@ -30,6 +30,7 @@
 //! ([`volume`]), on every device.
 
 pub mod probes;
+pub mod scene;
 pub mod volume;
 
 use std::collections::HashMap;
@@ -70,6 +71,7 @@ impl Plugin for PlenopticLitPlugin {
                 .after(PlenopticSystems::Streaming),
         )
         .init_resource::<probes::ProbeKeys>();
+        scene::build(app);
     }
 
     fn finish(&self, app: &mut App) {

@@ -127,7 +127,7 @@ pub struct EnvironmentImages {
 
 impl EnvironmentImages {
     /// The texture of `pack`'s environment image, made on first use.
-    pub(super) fn get(
+    pub(crate) fn get(
         &mut self,
         id: AssetId<RadiancePack>,
         pack: &RadiancePack,

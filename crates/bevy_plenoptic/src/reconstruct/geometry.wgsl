@@ -13,6 +13,10 @@
 #import bevy_core_pipeline::tonemapping::tone_mapping
 #endif
 #import bevy_pbr::prepass_utils
+#ifdef PLENOPTIC_STANDARD
+#import bevy_pbr::pbr_fragment::pbr_input_from_standard_material
+#import bevy_pbr::pbr_functions::alpha_discard
+#endif
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
 #import plenoptic::environment::{Environment, environment}
@@ -70,6 +74,19 @@ struct ReconParams {
     volume_range: array<vec4<u32>, 8>,
 }
 
+#ifdef PLENOPTIC_STANDARD
+// An app mesh's StandardMaterial extended with the pack's lighting (lit/scene.rs): the
+// standard material's bindings come first, this extension's from 100 (the same bindings as
+// the proxy material's below, less its pack textures: the standard material has its own).
+@group(#{MATERIAL_BIND_GROUP}) @binding(100) var cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(101) var<uniform> params: ReconParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(102) var<storage, read> volume_samples: array<vec4<u32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(103) var<storage, read> volume_bins: array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(104) var image_frame: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(105) var shading_cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(110) var<uniform> env: Environment;
+@group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
+#else
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ReconParams;
 // Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object,
@@ -88,6 +105,7 @@ struct ReconParams {
 // The pack's environment at the camera's time, for reflected rays that leave the scene.
 @group(#{MATERIAL_BIND_GROUP}) @binding(10) var<uniform> env: Environment;
 @group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
+#endif
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).
 var<private> pixel_albedo: vec3<f32>;
@@ -124,6 +142,7 @@ fn level(footprint: f32, t: vec4<f32>, side: f32) -> f32 {
     return select(0.0, log2(texels), texels > 1.0);
 }
 
+#ifndef PLENOPTIC_STANDARD
 // The diffuse albedo at UV `uv`, whose pixel covers `footprint` UV units (√area):
 // (1 − metallic · mr.b)(1 − transmission) · base colour · texture.
 fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
@@ -149,6 +168,8 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
 }
 
 // plenoptic_pack::cube::oct_decode.
+#endif
+
 fn oct_decode(e: vec2<f32>) -> vec3<f32> {
     var v = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
     if v.z < 0.0 {
@@ -366,6 +387,25 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // (`view.exposure`, from its `Exposure`), kept inside the f16 HDR target's range; tonemapped
 // here for cameras without an HDR target, as Bevy's PBR does (HDR cameras are tonemapped by
 // Bevy's post-process pass).
+#ifdef PLENOPTIC_STANDARD
+// An app mesh: its own StandardMaterial's base colour, metalness, roughness and normal (its
+// textures and normal map, as Bevy's PBR reads them) with the pack's lighting at this
+// object's points, exactly as a proxy fragment of the same object is shaded.
+@fragment
+fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+    let ng = cross(dpdx(vertex.world_position.xyz), dpdy(vertex.world_position.xyz));
+    var pbr = pbr_input_from_standard_material(vertex, is_front);
+    pbr.material.base_color = alpha_discard(pbr.material, pbr.material.base_color);
+    pixel_base = pbr.material.base_color.rgb;
+    pixel_metallic = clamp(pbr.material.metallic, 0.0, 1.0);
+    pixel_roughness = clamp(pbr.material.perceptual_roughness, 0.0, 1.0);
+    pixel_albedo = pixel_base * ((1.0 - pixel_metallic) * (1.0 - params.material.x));
+    var in = vertex;
+    // The shading normal, normal-mapped (viewer() turns it towards the eye where needed).
+    in.world_normal = pbr.N;
+    return shade(in, ng);
+}
+#else
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     // The triangle's plane, before any non-uniform branch.
@@ -378,6 +418,13 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #else
     pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
 #endif
+    return shade(in, ng);
+}
+#endif
+
+// The fragment's output, once the private pixel_* values are set: its reflection, radiance
+// and sun light, times the exposure.
+fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
     var reflected = vec3<f32>(0.0);
     if lit() && params.fill.z != 1.0 && marched() {
         let r = reflection(in, ng);

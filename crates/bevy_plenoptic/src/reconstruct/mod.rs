@@ -51,6 +51,7 @@
 
 pub mod background;
 pub mod cpu;
+pub mod frame;
 pub mod image;
 pub mod reflect;
 pub mod sun;
@@ -65,13 +66,15 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
-use plenoptic_recon::temporal::bracketing;
 
 use crate::asset::RadiancePack;
-use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
+use crate::camera::PlenopticCamera;
+#[cfg(doc)]
+use crate::camera::{ReconMode, ReconSettings};
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::streaming::StreamCache;
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
+use frame::{FrameLookups, frame_lookups, warped};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
@@ -383,7 +386,7 @@ fn attach_materials(
 
 /// The coverage of the pack's object `id`: its manifest coverage if it is see-through
 /// glazing, else 1 (opaque).
-fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
+pub(crate) fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
     pack.reader
         .manifest()
         .objects
@@ -444,7 +447,7 @@ impl MaterialFactors {
 }
 
 /// The material of the pack's object `id` with its loaded textures; `None` without one.
-fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialFactors> {
+pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialFactors> {
     let m = pack.reader.object_material(id)?;
     let texture = |b: Option<plenoptic_pack::TextureBinding>| {
         let b = b?;
@@ -465,95 +468,10 @@ fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialFactors> {
     })
 }
 
-/// One lookup of a frame: a resident, uploaded (base view, time key).
-#[derive(Debug, Clone, Copy)]
-struct Lookup {
-    base: Vec3,
-    slot: u32,
-    weight: f32,
-    tau: f32,
-    normals: bool,
-}
-
-/// What every proxy of a pack looks up this frame.
-#[derive(Debug, Clone, Default)]
-struct FrameLookups {
-    /// (base view, normalised view weight), heaviest first.
-    views: Vec<(usize, f32)>,
-    /// At most [`MAX_LOOKUPS`].
-    lookups: Vec<Lookup>,
-    /// Index of the heaviest lookup (`plenoptic_recon`'s "background" and environment key).
-    heaviest: Option<usize>,
-}
-
-/// The lookups of a camera at `position` and time `t` on pack `id`, as `plenoptic_recon`'s
-/// geometry mode chooses them: the view-space weights of the nearest
-/// [`ReconSettings::max_views`] views, each at its bracketing keys with linear time
-/// weights, over the keys that are resident and uploaded.
-fn frame_lookups(
-    id: AssetId<RadiancePack>,
-    pack: &RadiancePack,
-    tex: &KeyTexture,
-    cache: &StreamCache,
-    settings: &ReconSettings,
-    position: Vec3,
-    t: f32,
-) -> FrameLookups {
-    let m = pack.reader.manifest();
-    let views = settings.view_weights(m, &pack.usable_views, position);
-    let mut out = FrameLookups::default();
-    // Weight of the heaviest lookup.
-    let mut heaviest = f32::NEG_INFINITY;
-    for &(v, w) in &views {
-        let bv = &m.base_views[v];
-        let Some((k0, k1, f)) = bracketing(&bv.time_keys, t) else {
-            continue;
-        };
-        let mut pairs = vec![(k0, 1.0 - f)];
-        if k1 != k0 {
-            pairs.push((k1, f));
-        }
-        let got: Vec<_> = pairs
-            .into_iter()
-            .filter_map(|(k, wt)| {
-                let r = cache.get(id, (v as u32, k as u32))?;
-                (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
-                    .then_some((k, wt, r.slot))
-            })
-            .collect();
-        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
-        for (k, wt, slot) in got {
-            let weight = w * wt / total;
-            if out.lookups.len() == MAX_LOOKUPS || weight <= 1e-4 {
-                continue;
-            }
-            // Ties go to the later lookup, as Iterator::max_by does on the CPU.
-            if weight >= heaviest {
-                heaviest = weight;
-                out.heaviest = Some(out.lookups.len());
-            }
-            out.lookups.push(Lookup {
-                base: bv.position,
-                slot,
-                weight,
-                tau: bv.time_keys[k],
-                normals: tex.normals.contains(&slot),
-            });
-        }
-    }
-    out.views = views;
-    out
-}
-
-/// Whether `mode` shows the frame of the image-mode passes (image and volume modes).
-fn warped(mode: ReconMode) -> bool {
-    matches!(mode, ReconMode::Image | ReconMode::Volume)
-}
-
 /// Fills every proxy material's lookups for its camera, and every background's environment
 /// key.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
-fn update_materials(
+pub(crate) fn update_materials(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
     cache: Res<StreamCache>,
@@ -596,72 +514,27 @@ fn update_materials(
         let Some(f) = frame(scene.camera, cam, transform.translation()) else {
             continue;
         };
-        let image_mode = warped(cam.mode) && job.0.is_some();
-        let m = pack.reader.manifest();
-        let proxy = pack.proxy(of.id);
-        let inv_now = proxy.map_or(Mat4::IDENTITY, |p| {
+        let ctx = frame::CameraFrame {
+            cam,
+            pack,
+            tex,
+            volumes: volumes.0.get(&id),
+            lookups: &f,
+            image_mode: warped(cam.mode) && job.0.is_some(),
+        };
+        let drawn_inverse = pack.proxy(of.id).map_or(Mat4::IDENTITY, |p| {
             p.transform_at(cam.time).to_matrix().inverse()
         });
-        let mut params = ReconParams {
-            header: Vec4::new(f.lookups.len() as f32, of.id as f32, tex.face as f32, 0.0),
-            tuning: Vec4::new(
-                cam.settings.depth_tolerance,
-                cam.settings.angular_power,
-                0.0,
-                0.0,
-            ),
-            fill: Vec4::new(
-                cam.settings.hole_fill_radius as f32,
-                f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
-                if image_mode { 1.0 } else { 0.0 },
-                // The material's coverage, set below.
-                1.0,
-            ),
-            flags: Vec4::new(
-                if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
-                    1.0
-                } else {
-                    0.0
-                },
-                0.0,
-                0.0,
-                0.0,
-            ),
-            ..default()
-        };
-        let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
-        volume::fill_params(
-            &mut params,
-            volumes.0.get(&id),
-            &f.views,
-            &positions,
-            cam.settings.volume_buckets(m, cam.time),
-            cam.time,
-            cam.settings.time_epsilon_on(m),
-        );
-        for (n, l) in f.lookups.iter().enumerate() {
-            params.base[n] = l.base.extend((l.slot * 6) as f32);
-            params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
-            params.motion[n] =
-                proxy.map_or(Mat4::IDENTITY, |p| p.transform_at(l.tau).to_matrix()) * inv_now;
-        }
         if let Some(mut mat) = materials.get_mut(&handle.0) {
-            // Looked up in the manifest once, when the material was attached.
-            params.fill.w = mat.coverage;
-            if let Some(f) = &mat.albedo
-                && cam.settings.shading == plenoptic_recon::Shading::Materials
-            {
-                f.fill(&mut params);
-                sun::fill(&mut params, pack, cam.time);
-                reflect::fill(&mut params, pack, &cam.settings, &f.material);
-                if let Some(t) =
-                    plenoptic_recon::specular::see_through_transmittance(&cam.settings, &f.material)
-                    && !image_mode
-                    && mat.coverage >= 1.0
-                {
-                    params.flags.z = 1.0;
-                    params.flags.w = (t.x + t.y + t.z) / 3.0;
-                }
+            // Coverage and material were looked up in the manifest once, when the material
+            // was attached.
+            let params = ctx.params(&frame::ObjectShading {
+                id: of.id,
+                drawn_inverse,
+                coverage: mat.coverage,
+                factors: mat.albedo.as_ref(),
+            });
+            if mat.albedo.is_some() && cam.settings.shading == plenoptic_recon::Shading::Materials {
                 let environment =
                     background::EnvironmentUniform::new(&pack.environment.at(cam.time));
                 if mat.environment != environment {
@@ -680,8 +553,7 @@ fn update_materials(
         }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
-        let layer = frame(bg.camera, cam, transform.translation())
-            .and_then(|f| f.heaviest.map(|h| 6 * f.lookups[h].slot));
+        let layer = frame(bg.camera, cam, transform.translation()).and_then(|f| f.heaviest_layer());
         let image_mode = warped(cam.mode) && job.0.is_some();
         let env = packs
             .get(id)

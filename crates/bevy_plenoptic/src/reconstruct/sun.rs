@@ -7,7 +7,9 @@
 //! The visibility comes from Bevy's own cascaded shadow map of a [`DirectionalLight`] the
 //! plugin spawns per camera on such a pack ([`PlenopticSun`]), aimed along the sun's track at
 //! the camera's time, shadows on: the camera's proxies cast shadows as any mesh does. The
-//! light is on the camera's own render layer ([`crate::camera::layers`]): Bevy gives a view
+//! light is on the camera's own render layer and its shadow-only one
+//! ([`crate::camera::layers`]; the proxies of objects the app's own lit meshes show are
+//! there, [`crate::lit::scene`]): Bevy gives a view
 //! only the directional lights that share a layer with it, and a light's shadow casters are
 //! the meshes on its layers, so each camera is lit and shadowed by its own sun at its own
 //! time. That light also lights the app's own `StandardMaterial` meshes in that camera like
@@ -93,7 +95,7 @@ pub(super) fn update_suns(
         commands.spawn((
             Name::new("plenoptic sun"),
             PlenopticSun { camera },
-            layer.layers(),
+            layer.light_layers(),
             DirectionalLight {
                 illuminance: lux(e),
                 color: colour(e),

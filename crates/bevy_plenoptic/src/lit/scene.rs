@@ -1,0 +1,465 @@
+//! Your own glTF scene lit by the pack, as a lightmap lights it: the meshes of a scene the
+//! app spawned with Bevy's own glTF loader (`WorldAssetRoot`) keep their `StandardMaterial`
+//! (base colour, normal and metallic-roughness textures, as Bevy's PBR reads them) and are
+//! shaded with the pack's reconstructed lighting at the camera's time instead of Bevy's
+//! lights (thesis §8.2.3, geometry-assisted lookups; `docs/architecture.md`, "The runtime
+//! plugin").
+//!
+//! - **Matching.** [`PlenopticLit`] on the scene's root names the plenoptic camera whose pack
+//!   and time light it. Each mesh under it is matched to the pack's object by glTF node path:
+//!   the names of the mesh's ancestors (Bevy names a node's entity after the glTF node,
+//!   `GltfNode{i}` when unnamed, which the baker calls `node{i}`) end with the object's
+//!   `node_path`, the longest such path winning; a node with several primitives picks the
+//!   object of the primitive the mesh's asset label names (`…/Primitive{k}`, the baker's
+//!   `#k`). A mesh that matches no object keeps its material and is lit by the light probes
+//!   ([`super`]), as any mesh not in the pack.
+//! - **Shading.** A matched mesh's material becomes an `ExtendedMaterial<StandardMaterial,
+//!   PlenopticLighting>` ([`LitMaterial`]), a copy of its own material made when it is matched
+//!   (later edits to the original do not reach it), whose fragment shader is the proxies'
+//!   (`reconstruct/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups, weights and
+//!   fallbacks, the same marched reflections and runtime sun, with the mesh's own base
+//!   colour, metalness, roughness and normal map per pixel. The uniform is filled by the
+//!   same code as a proxy's ([`crate::reconstruct::frame`]): only the transform that carries
+//!   a fragment's point into the pack's object frame differs (the mesh's own global transform
+//!   for an animated object, so the lighting follows the object wherever the app's animation
+//!   puts it; the identity for a static one, whose proxy is in world space).
+//! - **Proxies.** The camera's proxy of a matched object is moved from the camera's render
+//!   layer to its shadow-only layer ([`crate::camera::layers::ViewLayer::shadow_only`]): the
+//!   camera no longer draws it (the app's mesh is there instead, no depth fight), but the
+//!   plugin's runtime sun still sees it as a shadow caster.
+//!
+//! The scene's punctual lights (`KHR_lights_punctual`, which Bevy's loader spawns as lights)
+//! are hidden: their light is baked into the pack, and the meshes not in the pack get it from
+//! the light probes.
+//!
+//! What it assumes, as a lightmap does: the scene is spawned where it was baked (its root at
+//! the identity), and the matched meshes are the baked ones. A mesh is lit for one camera's
+//! time and lookups, whichever cameras see it (it is one entity for all of them); the
+//! lookups' angular weights and reflections are per view. Lit meshes are shaded on the GPU
+//! backend; on the CPU backend they keep their material.
+
+use std::collections::{HashMap, HashSet};
+
+use bevy::asset::AssetPath;
+use bevy::camera::visibility::RenderLayers;
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialExtensionKey};
+use bevy::prelude::*;
+use bevy::render::render_resource::AsBindGroup;
+use bevy::render::storage::ShaderBuffer;
+use bevy::shader::ShaderRef;
+
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+use crate::camera::layers::ViewLayer;
+use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::reconstruct::frame::{CameraFrame, ObjectShading, frame_lookups, warped};
+use crate::reconstruct::{
+    KeyTextures, MaterialFactors, ReconParams, ResolvedBackend, background, image,
+    material_factors, object_coverage, volume,
+};
+use crate::streaming::StreamCache;
+use crate::{Backend, PlenopticSystems};
+
+/// Lights the meshes under this entity (a `WorldAssetRoot`, or any ancestor of them) with the
+/// pack of a plenoptic camera at that camera's time (see the module doc).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlenopticLit {
+    /// The [`PlenopticCamera`] whose pack and time light the scene.
+    pub camera: Entity,
+}
+
+/// A mesh of a [`PlenopticLit`] scene matched to a pack object, shaded with the pack's
+/// lighting.
+#[derive(Component, Debug, Clone, PartialEq, Eq)]
+pub struct LitObject {
+    /// The camera whose pack and time light it.
+    pub camera: Entity,
+    /// The pack object it was matched to.
+    pub id: u32,
+    /// Its own material before it was lit (the lit material's base is a copy).
+    pub original: Handle<StandardMaterial>,
+}
+
+/// A mesh of a [`PlenopticLit`] scene that matches no pack object (checked once).
+#[derive(Component, Debug, Clone, Copy)]
+pub struct NotInPack;
+
+/// The material of a lit mesh: its own `StandardMaterial` and the pack's lighting.
+pub type LitMaterial = ExtendedMaterial<StandardMaterial, PlenopticLighting>;
+
+/// The pack's lighting for one lit mesh: the proxy material's bindings (from 100, after the
+/// standard material's), less its pack textures.
+#[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
+pub struct PlenopticLighting {
+    /// Resident keys ([`crate::reconstruct`]).
+    #[texture(100, dimension = "2d_array", sample_type = "u_int")]
+    pub cubes: Handle<Image>,
+    /// This frame's lookups for the mesh's object.
+    #[uniform(101)]
+    pub params: ReconParams,
+    /// Resident temporal-volume samples of the pack.
+    #[storage(102, read_only)]
+    pub volume_samples: Handle<ShaderBuffer>,
+    /// Their bin offsets.
+    #[storage(103, read_only)]
+    pub volume_bins: Handle<ShaderBuffer>,
+    /// The camera's image-mode frame, shown in image and volume modes.
+    #[texture(104, sample_type = "float", filterable = false)]
+    pub image_frame: Handle<Image>,
+    /// The resident keys' lighting and non-diffuse radiance.
+    #[texture(105, dimension = "2d_array", sample_type = "u_int")]
+    pub shading_cubes: Handle<Image>,
+    /// The pack's environment at the camera's time (reflected rays that leave the scene).
+    #[uniform(110)]
+    pub environment: background::EnvironmentUniform,
+    /// The pack's environment image.
+    #[texture(111, sample_type = "float", filterable = false)]
+    pub environment_image: Handle<Image>,
+    /// The object's material in the pack (its transmission, IOR and emission; the per-pixel
+    /// base colour, metalness and roughness are the standard material's).
+    pub factors: Option<MaterialFactors>,
+    /// The object's glazing coverage (1: opaque).
+    pub coverage: f32,
+}
+
+impl MaterialExtension for PlenopticLighting {
+    fn fragment_shader() -> ShaderRef {
+        "embedded://bevy_plenoptic/reconstruct/geometry.wgsl".into()
+    }
+
+    fn specialize(
+        _pipeline: &bevy::pbr::MaterialExtensionPipeline,
+        descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
+        _layout: &bevy::mesh::MeshVertexBufferLayoutRef,
+        _key: MaterialExtensionKey<Self>,
+    ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
+        if let Some(fragment) = descriptor.fragment.as_mut() {
+            fragment.shader_defs.push("PLENOPTIC_STANDARD".into());
+        }
+        Ok(())
+    }
+}
+
+/// Adds the lit-scene systems (part of [`super::PlenopticLitPlugin`]).
+pub(super) fn build(app: &mut App) {
+    app.add_plugins(MaterialPlugin::<LitMaterial>::default())
+        .add_systems(
+            Update,
+            (attach_lit_materials, update_lit_materials, proxy_layers)
+                .chain()
+                .after(PlenopticSystems::Streaming)
+                .after(crate::reconstruct::update_materials),
+        );
+}
+
+/// The node path the baker gives a mesh under `names` (its ancestors' names, the root's
+/// first): every suffix, longest first, as `/a/b/c`, with Bevy's `GltfNode{i}` for an
+/// unnamed node written as the baker's `node{i}`.
+pub fn node_paths(names: &[&str]) -> Vec<String> {
+    let names: Vec<String> = names
+        .iter()
+        .map(|n| match n.strip_prefix("GltfNode") {
+            Some(i) if !i.is_empty() && i.bytes().all(|b| b.is_ascii_digit()) => {
+                format!("node{i}")
+            }
+            _ => (*n).to_owned(),
+        })
+        .collect();
+    (0..names.len())
+        .map(|i| format!("/{}", names[i..].join("/")))
+        .collect()
+}
+
+/// The primitive index in a glTF mesh asset's label (`Mesh{m}/Primitive{k}`).
+pub fn primitive_index(path: Option<&AssetPath>) -> Option<usize> {
+    let label = path?.label()?;
+    label.rsplit_once("Primitive")?.1.parse().ok()
+}
+
+/// The pack object a mesh under ancestors `names` (root first) with primitive `primitive`
+/// is, if any (see the module doc).
+pub fn match_object(
+    objects: &[plenoptic_pack::ObjectEntry],
+    names: &[&str],
+    primitive: Option<usize>,
+) -> Option<u32> {
+    for path in node_paths(names) {
+        let at: Vec<_> = objects.iter().filter(|o| o.node_path == path).collect();
+        match at.as_slice() {
+            [] => continue,
+            [one] => return Some(one.id),
+            several => {
+                let k = primitive?;
+                return several
+                    .iter()
+                    .find(|o| {
+                        o.name
+                            .rsplit_once('#')
+                            .is_some_and(|(_, i)| i == k.to_string())
+                    })
+                    .map(|o| o.id);
+            }
+        }
+    }
+    None
+}
+
+/// Candidates of [`attach_lit_materials`]: meshes with a standard material not yet checked.
+type Unchecked<'a> = (&'a Mesh3d, &'a MeshMaterial3d<StandardMaterial>);
+
+/// Matches the meshes of every [`PlenopticLit`] scene to the pack's objects and gives the
+/// matched ones a [`LitMaterial`]. Runs every frame: a scene's meshes appear once its glTF
+/// has loaded.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+fn attach_lit_materials(
+    mut commands: Commands,
+    backend: Res<ResolvedBackend>,
+    keys: Res<KeyTextures>,
+    volumes: Res<volume::VolumeBuffers>,
+    roots: Query<(Entity, &PlenopticLit)>,
+    children: Query<&Children>,
+    parents: Query<&ChildOf>,
+    names: Query<&Name>,
+    unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
+    lights: Query<&Visibility, Or<(With<DirectionalLight>, With<PointLight>, With<SpotLight>)>>,
+    cameras: Query<(&PlenopticCamera, &image::ImageFrame)>,
+    packs: Res<Assets<RadiancePack>>,
+    standard: Res<Assets<StandardMaterial>>,
+    mut lit: ResMut<Assets<LitMaterial>>,
+    mut env_images: ResMut<background::EnvironmentImages>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    if backend.0 != Backend::Gpu {
+        return;
+    }
+    for (root, scene) in &roots {
+        let Ok((cam, image_frame)) = cameras.get(scene.camera) else {
+            continue;
+        };
+        let id = cam.pack.id();
+        let (Some(pack), Some(tex), Some(vol)) =
+            (packs.get(id), keys.0.get(&id), volumes.0.get(&id))
+        else {
+            continue;
+        };
+        for entity in children.iter_descendants(root) {
+            if lights.get(entity).is_ok_and(|v| *v != Visibility::Hidden) {
+                // Its light is in the pack: the app's meshes get it from there.
+                commands.entity(entity).insert(Visibility::Hidden);
+                continue;
+            }
+            let Ok((mesh, material)) = unchecked.get(entity) else {
+                continue;
+            };
+            let Some(base) = standard.get(&material.0) else {
+                // Its material has not loaded yet: next frame.
+                continue;
+            };
+            // The names of the mesh's ancestors below `root`, root first.
+            let mut chain: Vec<&str> = parents
+                .iter_ancestors(entity)
+                .take_while(|&a| a != root)
+                .filter_map(|a| names.get(a).ok().map(Name::as_str))
+                .collect();
+            chain.reverse();
+            let objects = &pack.reader.manifest().objects;
+            let Some(object) = match_object(objects, &chain, primitive_index(mesh.0.path())) else {
+                commands.entity(entity).insert(NotInPack);
+                continue;
+            };
+            let factors = material_factors(pack, object);
+            let coverage = object_coverage(pack, object);
+            let transmissive = factors
+                .as_ref()
+                .is_some_and(|f| f.material.transmission > 0.0);
+            let mut base = base.clone();
+            // Blended as the proxy would be (see `PlenopticMaterial::transmissive`).
+            if coverage < 1.0 {
+                base.alpha_mode = AlphaMode::Blend;
+            } else if transmissive {
+                base.alpha_mode = AlphaMode::Premultiplied;
+            }
+            let handle = lit.add(LitMaterial {
+                base,
+                extension: PlenopticLighting {
+                    cubes: tex.image.clone(),
+                    params: ReconParams::default(),
+                    volume_samples: vol.samples.clone(),
+                    volume_bins: vol.bins.clone(),
+                    image_frame: image_frame.0.clone(),
+                    shading_cubes: tex.shading.clone(),
+                    environment: background::EnvironmentUniform::default(),
+                    environment_image: env_images.get(id, pack, &mut images),
+                    factors,
+                    coverage,
+                },
+            });
+            commands
+                .entity(entity)
+                .remove::<MeshMaterial3d<StandardMaterial>>()
+                .insert((
+                    MeshMaterial3d(handle),
+                    LitObject {
+                        camera: scene.camera,
+                        id: object,
+                        original: material.0.clone(),
+                    },
+                ));
+        }
+    }
+}
+
+/// Fills every lit mesh's lookups for its camera, as the proxies' are filled.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+fn update_lit_materials(
+    keys: Res<KeyTextures>,
+    volumes: Res<volume::VolumeBuffers>,
+    cache: Res<StreamCache>,
+    packs: Res<Assets<RadiancePack>>,
+    cameras: Query<(&PlenopticCamera, &GlobalTransform, &image::ImageJob)>,
+    objects: Query<(&LitObject, &GlobalTransform, &MeshMaterial3d<LitMaterial>)>,
+    mut materials: ResMut<Assets<LitMaterial>>,
+) {
+    let mut frames = HashMap::new();
+    for (object, transform, handle) in &objects {
+        let Ok((cam, eye, job)) = cameras.get(object.camera) else {
+            continue;
+        };
+        let id = cam.pack.id();
+        let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
+            continue;
+        };
+        let lookups = frames.entry(object.camera).or_insert_with(|| {
+            frame_lookups(
+                id,
+                pack,
+                tex,
+                &cache,
+                &cam.settings,
+                eye.translation(),
+                cam.time,
+            )
+        });
+        let ctx = CameraFrame {
+            cam,
+            pack,
+            tex,
+            volumes: volumes.0.get(&id),
+            lookups,
+            image_mode: warped(cam.mode) && job.0.is_some(),
+        };
+        let animated = pack.proxy(object.id).is_some_and(|p| p.track.is_some());
+        let drawn_inverse = if animated {
+            transform.to_matrix().inverse()
+        } else {
+            Mat4::IDENTITY
+        };
+        let Some(mut mat) = materials.get_mut(&handle.0) else {
+            continue;
+        };
+        let ext = &mut mat.extension;
+        ext.params = ctx.params(&ObjectShading {
+            id: object.id,
+            drawn_inverse,
+            coverage: ext.coverage,
+            factors: ext.factors.as_ref(),
+        });
+        let environment = background::EnvironmentUniform::new(&pack.environment.at(cam.time));
+        if ext.environment != environment {
+            ext.environment = environment;
+        }
+    }
+}
+
+/// Puts each camera's proxy of an object its lit scene shows on the camera's shadow-only
+/// layer, and every other proxy on the camera's own layer.
+fn proxy_layers(
+    lit: Query<&LitObject>,
+    cameras: Query<&ViewLayer>,
+    roots: Query<&PlenopticScene>,
+    mut proxies: Query<(&ChildOf, &ProxyOf, &mut RenderLayers)>,
+) {
+    let shown: HashSet<(Entity, u32)> = lit.iter().map(|o| (o.camera, o.id)).collect();
+    for (parent, of, mut layers) in &mut proxies {
+        let Ok(scene) = roots.get(parent.parent()) else {
+            continue;
+        };
+        let Ok(layer) = cameras.get(scene.camera) else {
+            continue;
+        };
+        let wanted = if shown.contains(&(scene.camera, of.id)) {
+            layer.shadow_only()
+        } else {
+            layer.layers()
+        };
+        if *layers != wanted {
+            *layers = wanted;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn object(id: u32, name: &str, node_path: &str) -> plenoptic_pack::ObjectEntry {
+        plenoptic_pack::ObjectEntry {
+            id,
+            name: name.into(),
+            node_path: node_path.into(),
+            motion: plenoptic_pack::Motion::Static,
+            proxy_mesh: Some(id),
+            material: None,
+            coverage: None,
+        }
+    }
+
+    #[test]
+    fn meshes_match_objects_by_node_path_and_primitive() {
+        let objects = [
+            object(1, "Door", "/House/Door"),
+            object(2, "Door", "/Door"),
+            object(3, "Lamp#0", "/House/Lamp"),
+            object(4, "Lamp#1", "/House/Lamp"),
+            object(5, "node7", "/House/node7"),
+        ];
+        // Bevy's chain: the glTF scene's root entity, then the nodes.
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "Door"], None),
+            Some(1)
+        );
+        // The longest path wins over a shorter one that also ends the chain.
+        assert_eq!(match_object(&objects, &["House", "Door"], None), Some(1));
+        assert_eq!(match_object(&objects, &["Scene0", "Door"], None), Some(2));
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "Lamp"], Some(1)),
+            Some(4)
+        );
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "Lamp"], Some(0)),
+            Some(3)
+        );
+        // Several primitives and no label: no guess.
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "Lamp"], None),
+            None
+        );
+        // Bevy's name of an unnamed node is the baker's.
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "GltfNode7"], None),
+            Some(5)
+        );
+        assert_eq!(
+            match_object(&objects, &["Scene0", "House", "Chair"], None),
+            None
+        );
+    }
+
+    #[test]
+    fn primitive_indices_come_from_the_asset_label() {
+        let path = AssetPath::parse("tour.glb#Mesh3/Primitive2");
+        assert_eq!(primitive_index(Some(&path)), Some(2));
+        assert_eq!(primitive_index(Some(&AssetPath::parse("tour.glb"))), None);
+        assert_eq!(primitive_index(None), None);
+    }
+}

@@ -1,0 +1,210 @@
+//! What one camera looks up this frame on its pack, and the per-object uniform of the
+//! geometry-assisted shader filled from it: shared by the proxy materials ([`super`]) and the
+//! app's own meshes lit by the pack ([`crate::lit::scene`]), so that both are shaded from
+//! the same lookups (thesis §8.2.3; `docs/architecture.md`, "The runtime plugin").
+//!
+//! The lookups are those of `plenoptic_recon`'s geometry mode: the view-space weights of
+//! the nearest [`ReconSettings::max_views`] base views ([`ReconSettings::view_weights`]),
+//! each at its bracketing keys with linear time weights
+//! ([`plenoptic_recon::temporal::bracketing`]), over the keys that are resident and uploaded.
+
+use bevy::prelude::*;
+use plenoptic_recon::temporal::bracketing;
+
+use super::{KeyTexture, MAX_LOOKUPS, MaterialFactors, ReconParams, reflect, sun, volume};
+use crate::asset::RadiancePack;
+use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
+use crate::streaming::StreamCache;
+
+/// One lookup of a frame: a resident, uploaded (base view, time key).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Lookup {
+    base: Vec3,
+    slot: u32,
+    weight: f32,
+    tau: f32,
+    normals: bool,
+}
+
+/// What every object of a pack looks up this frame for one camera.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FrameLookups {
+    /// (base view, normalised view weight), heaviest first.
+    pub(crate) views: Vec<(usize, f32)>,
+    /// At most [`MAX_LOOKUPS`].
+    lookups: Vec<Lookup>,
+    /// Index of the heaviest lookup (`plenoptic_recon`'s "background" and environment key).
+    heaviest: Option<usize>,
+}
+
+impl FrameLookups {
+    /// The first array layer of the heaviest lookup's key, if there is one.
+    pub(crate) fn heaviest_layer(&self) -> Option<u32> {
+        self.heaviest.map(|h| 6 * self.lookups[h].slot)
+    }
+}
+
+/// The lookups of a camera at `position` and time `t` on pack `id` (see the module doc).
+pub(crate) fn frame_lookups(
+    id: AssetId<RadiancePack>,
+    pack: &RadiancePack,
+    tex: &KeyTexture,
+    cache: &StreamCache,
+    settings: &ReconSettings,
+    position: Vec3,
+    t: f32,
+) -> FrameLookups {
+    let m = pack.reader.manifest();
+    let views = settings.view_weights(m, &pack.usable_views, position);
+    let mut out = FrameLookups::default();
+    // Weight of the heaviest lookup.
+    let mut heaviest = f32::NEG_INFINITY;
+    for &(v, w) in &views {
+        let bv = &m.base_views[v];
+        let Some((k0, k1, f)) = bracketing(&bv.time_keys, t) else {
+            continue;
+        };
+        let mut pairs = vec![(k0, 1.0 - f)];
+        if k1 != k0 {
+            pairs.push((k1, f));
+        }
+        let got: Vec<_> = pairs
+            .into_iter()
+            .filter_map(|(k, wt)| {
+                let r = cache.get(id, (v as u32, k as u32))?;
+                (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
+                    .then_some((k, wt, r.slot))
+            })
+            .collect();
+        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
+        for (k, wt, slot) in got {
+            let weight = w * wt / total;
+            if out.lookups.len() == MAX_LOOKUPS || weight <= 1e-4 {
+                continue;
+            }
+            // Ties go to the later lookup, as Iterator::max_by does on the CPU.
+            if weight >= heaviest {
+                heaviest = weight;
+                out.heaviest = Some(out.lookups.len());
+            }
+            out.lookups.push(Lookup {
+                base: bv.position,
+                slot,
+                weight,
+                tau: bv.time_keys[k],
+                normals: tex.normals.contains(&slot),
+            });
+        }
+    }
+    out.views = views;
+    out
+}
+
+/// Whether `mode` shows the frame of the image-mode passes (image and volume modes).
+pub(crate) fn warped(mode: ReconMode) -> bool {
+    matches!(mode, ReconMode::Image | ReconMode::Volume)
+}
+
+/// One camera's frame on its pack: what every object's uniform is filled from.
+pub(crate) struct CameraFrame<'a> {
+    /// The camera.
+    pub(crate) cam: &'a PlenopticCamera,
+    /// Its pack.
+    pub(crate) pack: &'a RadiancePack,
+    /// The pack's key texture.
+    pub(crate) tex: &'a KeyTexture,
+    /// The pack's resident temporal volumes.
+    pub(crate) volumes: Option<&'a volume::PackVolumes>,
+    /// This frame's lookups.
+    pub(crate) lookups: &'a FrameLookups,
+    /// Whether the camera shows the image-mode passes' frame.
+    pub(crate) image_mode: bool,
+}
+
+/// What an object's uniform is made for.
+pub(crate) struct ObjectShading<'a> {
+    /// Pack object id.
+    pub(crate) id: u32,
+    /// The inverse of the transform that carries the object's local frame to where its
+    /// fragments are drawn: `M_o(t)⁻¹` for a proxy placed at the camera's time, the mesh
+    /// entity's own global transform inverted for an app mesh. A lookup at key τ carries the
+    /// fragment's point by `M_o(τ)` times this.
+    pub(crate) drawn_inverse: Mat4,
+    /// The object's glazing coverage (1: opaque).
+    pub(crate) coverage: f32,
+    /// Its material from the pack, if any.
+    pub(crate) factors: Option<&'a MaterialFactors>,
+}
+
+impl CameraFrame<'_> {
+    /// The uniform of one object for this camera.
+    pub(crate) fn params(&self, object: &ObjectShading) -> ReconParams {
+        let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
+        let m = pack.reader.manifest();
+        let mut params = ReconParams {
+            header: Vec4::new(
+                f.lookups.len() as f32,
+                object.id as f32,
+                tex.face as f32,
+                0.0,
+            ),
+            tuning: Vec4::new(
+                cam.settings.depth_tolerance,
+                cam.settings.angular_power,
+                0.0,
+                0.0,
+            ),
+            fill: Vec4::new(
+                cam.settings.hole_fill_radius as f32,
+                f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
+                if self.image_mode { 1.0 } else { 0.0 },
+                object.coverage,
+            ),
+            flags: Vec4::new(
+                if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
+                    1.0
+                } else {
+                    0.0
+                },
+                0.0,
+                0.0,
+                0.0,
+            ),
+            ..default()
+        };
+        let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
+        volume::fill_params(
+            &mut params,
+            self.volumes,
+            &f.views,
+            &positions,
+            cam.settings.volume_buckets(m, cam.time),
+            cam.time,
+            cam.settings.time_epsilon_on(m),
+        );
+        let proxy = pack.proxy(object.id);
+        for (n, l) in f.lookups.iter().enumerate() {
+            params.base[n] = l.base.extend((l.slot * 6) as f32);
+            params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
+            params.motion[n] = proxy.map_or(Mat4::IDENTITY, |p| p.transform_at(l.tau).to_matrix())
+                * object.drawn_inverse;
+        }
+        if let Some(factors) = object.factors
+            && cam.settings.shading == plenoptic_recon::Shading::Materials
+        {
+            factors.fill(&mut params);
+            sun::fill(&mut params, pack, cam.time);
+            reflect::fill(&mut params, pack, &cam.settings, &factors.material);
+            if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
+                &cam.settings,
+                &factors.material,
+            ) && !self.image_mode
+                && object.coverage >= 1.0
+            {
+                params.flags.z = 1.0;
+                params.flags.w = (t.x + t.y + t.z) / 3.0;
+            }
+        }
+        params
+    }
+}

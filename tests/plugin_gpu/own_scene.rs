@@ -1,0 +1,244 @@
+//! Your own glTF scene lit by the pack (`bevy_plenoptic::lit::scene`): the tour's glb,
+//! loaded by Bevy's own glTF loader with `StandardMaterial`s, shaded with the pack's lighting
+//! through `PlenopticLit`, against the proxies' frame of the same camera (the pack's own
+//! materials on its proxy meshes). The lit frame is the `own_scene` example's app
+//! (examples/own_scene/scene.rs), run headless for a few frames on a tiny bake.
+
+use crate::common::*;
+use crate::many_cameras::settled_frames;
+use bevy::camera::{Hdr, RenderTarget};
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::prelude::*;
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
+use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack};
+use bevy_plenoptic::prelude::*;
+use bevy_plenoptic::streaming::StreamState;
+
+fn assets() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/architectural_tour/assets")
+}
+
+/// A tiny bake of room A of the tour with the recipe's daylight (its sun left to the
+/// runtime): the corners of a 4 × 6 m rectangle, 16-px cubes, 2 samples per texel, the first
+/// two seconds. Written to `dir/tour.pack`, with the glb copied beside it.
+fn bake_room_a(dir: &std::path::Path) {
+    let recipe = std::fs::read_to_string(assets().join("tour.toml")).unwrap();
+    let daylight = &recipe[recipe.find("\n[sun]").expect("tour.toml has a sun study")..];
+    std::fs::copy(assets().join("tour.glb"), dir.join("tour.glb")).unwrap();
+    let recipe = format!(
+        "output = \"tour.pack\"\n\n[[scene]]\nfile = \"tour.glb\"\n\n[view_space]\nkind = \
+         \"rectangle\"\nmin = [-10.0, -3.0]\nmax = [-6.0, 3.0]\ny = 1.6\n\n[time]\nstart = 0.0\n\
+         end = 2.0\nframe_rate = 24.0\n\n[quality]\npreset = \"draft\"\nid_image_size = 16\n\
+         range_image_size = 16\nsamples_per_pixel = 2\nambient_samples = 32\n\
+         temporal_volume_samples = 2000\nmax_space_depth = 0\nmax_time_depth = 0\n{daylight}"
+    );
+    let path = dir.join("tour.toml");
+    std::fs::write(&path, recipe).unwrap();
+    plenoptic_bake::bake_recipe(&path, &plenoptic_bake::BakeOptions::default()).unwrap();
+}
+
+/// The example's own app code (examples/own_scene), run here headless on the tiny pack.
+#[path = "../../examples/own_scene/scene.rs"]
+#[allow(dead_code, reason = "the example's window path is not run here")]
+mod example;
+
+/// What one frame of the test showed.
+struct Shown {
+    frame: Vec<Vec3>,
+    lit: usize,
+    not_in_pack: usize,
+    /// How far the example's unbaked sphere moved while the frame was rendered.
+    sphere_moved: f32,
+}
+
+/// Where the camera stands and looks in room A.
+const EYE: (Vec3, Vec3) = (Vec3::new(-7.0, 1.6, 2.5), Vec3::new(-9.0, 0.6, -2.0));
+/// The shown time.
+const TIME: f32 = 0.5;
+
+/// The frame of a camera in room A at t = 0.5 on `dir/tour.pack`: the proxies alone, or
+/// (`own_scene`) the example's app: the glb's scene spawned by Bevy's loader and lit by the
+/// pack, with its unbaked sphere moving behind the camera.
+fn frame(dir: &std::path::Path, own_scene: bool) -> Shown {
+    frame_with(dir, own_scene, false)
+}
+
+/// [`frame`], with the lit meshes' own base colours halved (`darken`) once matched.
+fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
+    let mut app = headless_app_in(dir);
+    app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+    let image = {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
+        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        images.add(img)
+    };
+    let target = (
+        Camera3d::default(),
+        Camera {
+            clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
+            ..default()
+        },
+        RenderTarget::Image(image.clone().into()),
+        Tonemapping::None,
+        Hdr,
+        Msaa::Off,
+    );
+    if own_scene {
+        example::add(
+            &mut app,
+            example::OwnScene {
+                glb: "tour.glb".into(),
+                pack: "tour.pack".into(),
+                time: TIME,
+                eye: EYE,
+                orbit: (Vec3::new(-7.0, 1.0, 4.2), 0.4),
+                ev100: bevy_plenoptic::camera::EV100_UNIT,
+            },
+            target,
+        );
+    } else {
+        let pack = app
+            .world()
+            .resource::<AssetServer>()
+            .load::<RadiancePack>("tour.pack");
+        app.world_mut().spawn((
+            target,
+            Transform::from_translation(EYE.0).looking_at(EYE.1, Vec3::Y),
+            bevy::camera::Exposure {
+                ev100: bevy_plenoptic::camera::EV100_UNIT,
+            },
+            PlenopticCamera {
+                playback: Playback::Manual,
+                time: TIME,
+                ..PlenopticCamera::new(pack)
+            },
+        ));
+    }
+    let sphere = |app: &mut App| {
+        let world = app.world_mut();
+        world
+            .query_filtered::<&Transform, With<example::Unbaked>>()
+            .iter(world)
+            .next()
+            .map(|t| t.translation)
+    };
+    let mut complete = 0;
+    let mut start = None;
+    for _ in 0..2000 {
+        app.update();
+        start = start.or_else(|| sphere(&mut app));
+        let world = app.world_mut();
+        let streamed = world
+            .query::<&StreamState>()
+            .iter(world)
+            .next()
+            .is_some_and(|s| s.complete);
+        let lit = world.query::<&LitObject>().iter(world).count();
+        if streamed && (!own_scene || lit > 0) {
+            complete += 1;
+            if complete == 5 {
+                break;
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert_eq!(complete, 5, "the keys (and the scene) never arrived");
+    if darken {
+        let mut materials = app.world_mut().resource_mut::<Assets<LitMaterial>>();
+        let ids: Vec<_> = materials.ids().collect();
+        for id in ids {
+            let mut m = materials.get_mut(id).unwrap();
+            let c = m.base.base_color.to_linear();
+            m.base.base_color = Color::LinearRgba(c * 0.5).with_alpha(c.alpha);
+        }
+    }
+    let frame = settled_frames(&mut app, &[image]).remove(0);
+    if let Some(out) = std::env::var_os("PLENOPTIC_TEST_FRAMES") {
+        let name = match (own_scene, darken) {
+            (false, _) => "proxies",
+            (true, false) => "own_scene",
+            (true, true) => "own_scene_darkened",
+        };
+        let rgb: Vec<u8> = frame
+            .iter()
+            .flat_map(|c| {
+                (c.to_array()).map(|v| ((v * 8.0).clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8)
+            })
+            .collect();
+        image::RgbImage::from_raw(WIDTH, HEIGHT, rgb)
+            .unwrap()
+            .save(std::path::Path::new(&out).join(format!("{name}.png")))
+            .unwrap();
+    }
+    let end = sphere(&mut app);
+    let world = app.world_mut();
+    let lit = world.query::<&LitObject>().iter(world).count();
+    let not_in_pack = world.query::<&NotInPack>().iter(world).count();
+    Shown {
+        frame,
+        lit,
+        not_in_pack,
+        sphere_moved: start.zip(end).map_or(0.0, |(a, b)| a.distance(b)),
+    }
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The tour's glb loaded by Bevy and lit by the pack equals the proxies' frame: every mesh
+/// of the scene is matched to its pack object, and the mean radiance over the frame (every
+/// pixel shows a lit mesh, the proxies of matched objects being hidden) is within 5 % of the
+/// proxy path's.
+#[test]
+fn the_apps_own_gltf_scene_is_lit_by_the_pack_like_its_proxies() {
+    let dir = tempfile::tempdir().unwrap();
+    bake_room_a(dir.path());
+    let proxies = frame(dir.path(), false);
+    let own = frame(dir.path(), true);
+    assert_eq!(proxies.lit, 0);
+    eprintln!(
+        "meshes lit by the pack: {}, not in the pack: {}",
+        own.lit, own.not_in_pack
+    );
+    assert!(own.lit >= 40, "{} of the tour's meshes matched", own.lit);
+    assert!(own.sphere_moved > 0.01, "the example's sphere moves");
+    assert_eq!(own.not_in_pack, 0, "every mesh of the glb is in the pack");
+    let mean = |f: &[Vec3]| f.iter().map(|&c| luminance(c)).sum::<f32>() / f.len() as f32;
+    let (a, b) = (mean(&proxies.frame), mean(&own.frame));
+    let diff = proxies
+        .frame
+        .iter()
+        .zip(&own.frame)
+        .map(|(&p, &o)| (luminance(p) - luminance(o)).abs())
+        .sum::<f32>()
+        / proxies.frame.len() as f32;
+    eprintln!(
+        "mean luminance: proxies {a:.4}, own scene {b:.4} (ratio {:.4}); mean |difference| \
+         {:.4} of the mean",
+        b / a,
+        diff / a
+    );
+    assert!(a > 0.01, "the proxies' frame is lit");
+    assert!(
+        (b / a - 1.0).abs() < 0.05,
+        "own scene {b} against proxies {a}"
+    );
+    assert!(
+        diff / a < 0.25,
+        "per-pixel difference {} of the mean",
+        diff / a
+    );
+    // What is shown is the app's material: its base colours halved, the frame darkens (the
+    // lighting times half the albedo; the sun's specular and the emission stay).
+    let darker = mean(&frame_with(dir.path(), true, true).frame);
+    eprintln!(
+        "with the app's base colours halved: {darker:.4} ({:.3} of before)",
+        darker / b
+    );
+    assert!(
+        darker / b < 0.75 && darker / b > 0.4,
+        "{darker} against {b}"
+    );
+}
