@@ -23,6 +23,9 @@ pub struct OwnScene {
     pub orbit: (Vec3, f32),
     /// The camera's exposure (EV100).
     pub ev100: f32,
+    /// Whether the glb is spawned and lit (false: the pack's proxies show the scene, for
+    /// comparison).
+    pub own_scene: bool,
 }
 
 impl Default for OwnScene {
@@ -35,6 +38,7 @@ impl Default for OwnScene {
             eye: (Vec3::new(-6.5, 1.6, 3.0), Vec3::new(-8.5, 0.8, -1.0)),
             orbit: (Vec3::new(-8.0, 0.9, 0.5), 0.8),
             ev100: bevy_plenoptic::camera::EV100_UNIT - 1.0,
+            own_scene: true,
         }
     }
 }
@@ -70,12 +74,14 @@ pub fn add(app: &mut App, scene: OwnScene, camera: impl Bundle) {
                     ))
                     .id();
                 // The glb through Bevy's own glTF loader, lit by the camera's pack.
-                commands.spawn((
-                    WorldAssetRoot(
-                        assets.load(GltfAssetLabel::Scene(0).from_asset(scene.glb.clone())),
-                    ),
-                    PlenopticLit { camera: id },
-                ));
+                if scene.own_scene {
+                    commands.spawn((
+                        WorldAssetRoot(
+                            assets.load(GltfAssetLabel::Scene(0).from_asset(scene.glb.clone())),
+                        ),
+                        PlenopticLit { camera: id },
+                    ));
+                }
                 // Not in the pack: lit by the pack's light probes.
                 commands.spawn((
                     Unbaked,

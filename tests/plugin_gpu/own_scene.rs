@@ -94,6 +94,7 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
                 eye: EYE,
                 orbit: (Vec3::new(-7.0, 1.0, 4.2), 0.4),
                 ev100: bevy_plenoptic::camera::EV100_UNIT,
+                own_scene: true,
             },
             target,
         );
@@ -107,6 +108,7 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
             Transform::from_translation(EYE.0).looking_at(EYE.1, Vec3::Y),
             bevy::camera::Exposure {
                 ev100: bevy_plenoptic::camera::EV100_UNIT,
+                own_scene: true,
             },
             PlenopticCamera {
                 playback: Playback::Manual,

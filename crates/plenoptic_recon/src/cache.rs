@@ -18,6 +18,8 @@ pub(crate) enum Cached {
     Volume(Arc<VolumeBlock>),
     Connectivity(Arc<Vec<[u32; 4]>>),
     Failed(String),
+    /// A cube the reconstructor's [`crate::KeySource`] does not hold (not an error).
+    Absent,
 }
 
 impl Cached {
@@ -31,6 +33,7 @@ impl Cached {
             Cached::Volume(b) => b.samples.len() * 64,
             Cached::Connectivity(t) => t.len() * 16,
             Cached::Failed(s) => s.len(),
+            Cached::Absent => 0,
         }
     }
 }

@@ -95,6 +95,7 @@ pub mod settings;
 mod shading;
 pub mod shadow;
 pub mod specular;
+pub mod streamed;
 pub mod sun;
 pub mod temporal;
 pub mod viewspace;
@@ -109,6 +110,7 @@ pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
 pub use reconstructor::Reconstructor;
 pub use settings::{CubeFilter, ReconSettings, Shading};
 pub use specular::Specular;
+pub use streamed::{KeySource, StreamedCube};
 
 /// Errors of reconstruction.
 #[derive(Debug, thiserror::Error)]

@@ -25,6 +25,7 @@ use crate::shading::Channel;
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
+use crate::streamed::{KeySource, StreamedCube};
 use crate::{Error, Result};
 
 /// Reconstructs frames from one pack.
@@ -49,6 +50,10 @@ pub struct Reconstructor {
     /// The proxies as rays see them (the sun's shadow rays, reflected rays that leave the
     /// scene), built on first use.
     rays: std::sync::OnceLock<Option<crate::shadow::ShadowScene>>,
+    /// Where cube chunks come from when a runtime streams them ([`crate::streamed`]).
+    source: std::sync::RwLock<Option<Arc<dyn KeySource>>>,
+    /// Chunks read from the pack so far.
+    chunks_read: std::sync::atomic::AtomicU64,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -99,7 +104,20 @@ impl Reconstructor {
             materials: std::sync::OnceLock::new(),
             sun: std::sync::OnceLock::new(),
             rays: std::sync::OnceLock::new(),
+            source: std::sync::RwLock::new(None),
+            chunks_read: std::sync::atomic::AtomicU64::new(0),
         }
+    }
+
+    /// Takes every cube chunk from `source` from now on (`None`: from the pack again), so
+    /// that a runtime's streaming decides what is resident ([`crate::streamed`]).
+    pub fn set_key_source(&self, source: Option<Arc<dyn KeySource>>) {
+        *self.source.write().unwrap_or_else(|e| e.into_inner()) = source;
+    }
+
+    /// Chunks this reconstructor has read from the pack (each read once while cached).
+    pub fn chunks_read(&self) -> u64 {
+        self.chunks_read.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// The pack.
@@ -146,6 +164,18 @@ impl Reconstructor {
     }
 
     pub(crate) fn cached(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
+        if crate::streamed::is_cube(kind) {
+            let source = self.source.read().unwrap_or_else(|e| e.into_inner()).clone();
+            if let Some(source) = source {
+                return match source.cube(kind, view, key) {
+                    Some(StreamedCube::Colour(c)) => Cached::Radiance(c),
+                    Some(StreamedCube::Distance(c)) => Cached::Distance(c),
+                    Some(StreamedCube::Ids(c)) => Cached::Ids(c),
+                    Some(StreamedCube::Normal(c)) => Cached::Normal(c),
+                    None => Cached::Absent,
+                };
+            }
+        }
         {
             let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
             c.tick += 1;
@@ -156,6 +186,8 @@ impl Reconstructor {
             }
         }
         let what = |e: plenoptic_pack::PackError| Cached::Failed(e.to_string());
+        self.chunks_read
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let value = match kind {
             ChunkKind::RadianceCube => self
                 .pack

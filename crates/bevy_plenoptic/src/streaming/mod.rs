@@ -6,7 +6,8 @@
 //! of its Bézier segment) ("needed"), plus the same around where
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
-//! bytes) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
+//! bytes; on the CPU backend, the cubes `plenoptic_recon` looks up, which its reconstructor
+//! then takes from here instead of reading the pack, [`decode_cpu_key`]) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
 //! on a slow driver those compiles would queue the reads behind them); the main thread never
 //! waits on I/O. A key's bytes
 //! are reserved against the budget *before* its read starts, from the directory's
@@ -32,6 +33,7 @@ use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnost
 use bevy::prelude::*;
 use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
 use plenoptic_pack::{ChunkKind, PackReader, cube, ktx, range_image};
+use plenoptic_recon::streamed::{CUBE_KINDS, StreamedCube, read_cube};
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
@@ -120,6 +122,10 @@ pub struct DecodedKey {
     pub lighting: Option<Vec<u8>>,
     /// Non-diffuse radiance texels (pack 2.0; the radiance formats).
     pub non_diffuse: Option<Vec<u8>>,
+    /// On the CPU backend, the key's cubes decoded for `plenoptic_recon` instead of the
+    /// GPU's texel bytes above (which are then empty): what its reconstructor looks up
+    /// ([`decode_cpu_key`]).
+    pub cpu: Vec<(ChunkKind, StreamedCube)>,
 }
 
 impl DecodedKey {
@@ -131,6 +137,7 @@ impl DecodedKey {
             + self.normal.as_ref().map_or(0, Vec::len)
             + self.lighting.as_ref().map_or(0, Vec::len)
             + self.non_diffuse.as_ref().map_or(0, Vec::len)) as u64
+            + self.cpu.iter().map(|(_, c)| c.bytes()).sum::<u64>()
     }
 }
 
@@ -173,7 +180,64 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
         normal,
         lighting,
         non_diffuse,
+        cpu: Vec::new(),
     })
+}
+
+/// Reads and decodes one key for the CPU backend: its cubes as `plenoptic_recon` looks them
+/// up ([`plenoptic_recon::streamed`]), none of the GPU's texel bytes. The error names the
+/// failing chunk.
+pub fn decode_cpu_key(
+    pack: &PackReader,
+    (view, key): KeyRef,
+) -> Result<DecodedKey, (String, String)> {
+    let mut cpu = Vec::new();
+    for kind in CUBE_KINDS {
+        let name = || format!("{kind:?} view {view} key {key}");
+        match read_cube(pack, kind, view, key) {
+            Ok(Some(c)) => cpu.push((kind, c)),
+            Ok(None)
+                if matches!(
+                    kind,
+                    ChunkKind::RadianceCube | ChunkKind::DistanceCube | ChunkKind::ObjectIdCube
+                ) =>
+            {
+                return Err((name(), "not in the pack".to_string()));
+            }
+            Ok(None) => {}
+            Err(e) => return Err((name(), e.to_string())),
+        }
+    }
+    let face_size = match cpu.first() {
+        Some((_, StreamedCube::Colour(c))) => c.face_size,
+        _ => 0,
+    };
+    Ok(DecodedKey {
+        face_size,
+        radiance: Vec::new(),
+        distance: Vec::new(),
+        object_id: Vec::new(),
+        normal: None,
+        lighting: None,
+        non_diffuse: None,
+        cpu,
+    })
+}
+
+/// Bytes a key occupies once decoded for the CPU backend ([`decode_cpu_key`]), from the
+/// directory and the pack's face size (known before reading): 12 per texel of a colour or
+/// normal cube, 4 of a distance or id cube.
+pub fn cpu_key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
+    let face = u64::from(pack.manifest().bake.cube_face_size);
+    let texels = 6 * face * face;
+    CUBE_KINDS
+        .into_iter()
+        .filter(|&k| pack.find(k, view, key).is_some())
+        .map(|k| match k {
+            ChunkKind::DistanceCube | ChunkKind::ObjectIdCube => 4 * texels,
+            _ => 12 * texels,
+        })
+        .sum()
 }
 
 /// Bytes a key will occupy once decoded, from the directory (known before reading).
@@ -487,11 +551,14 @@ fn schedule_reads(
     mut cache: ResMut<StreamCache>,
     mut stats: ResMut<StreamingStats>,
     settings: Res<PlenopticSettings>,
+    backend: Option<Res<crate::reconstruct::ResolvedBackend>>,
     packs: Res<Assets<RadiancePack>>,
     time: Res<Time>,
     mut cameras: Query<(&PlenopticCamera, &mut StreamState, &GlobalTransform)>,
     mut diagnostics: Diagnostics,
 ) {
+    // The CPU backend's keys are decoded for plenoptic_recon, in the same budget.
+    let cpu = backend.is_some_and(|b| b.0 == crate::Backend::Cpu);
     cache.frame += 1;
     let frame = cache.frame;
     let budget = settings.memory_budget_bytes;
@@ -609,6 +676,7 @@ fn schedule_reads(
             continue;
         }
         let bytes = match unit {
+            Unit::Key(k) if cpu => cpu_key_bytes(&reader, k),
             Unit::Key(k) => key_bytes(&reader, k),
             Unit::Volume(v) => volume_bytes(&reader, v).unwrap_or(u64::MAX),
         };
@@ -625,7 +693,11 @@ fn schedule_reads(
                 let slot = cache.alloc_slot();
                 let task = pool.spawn(async move {
                     let start = Instant::now();
-                    let r = decode_key(&reader, k);
+                    let r = if cpu {
+                        decode_cpu_key(&reader, k)
+                    } else {
+                        decode_key(&reader, k)
+                    };
                     (r, start.elapsed())
                 });
                 cache.in_flight.insert(key, (bytes, slot, task));
