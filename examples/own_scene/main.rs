@@ -32,8 +32,8 @@ use bevy::asset::io::AssetSourceBuilder;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::window::ExitCondition;
 use bevy_plenoptic::lit::scene::LitObject;
 use bevy_plenoptic::prelude::*;
@@ -59,7 +59,9 @@ fn main() -> ExitCode {
         match (a.as_str(), args.next()) {
             ("--pack", Some(p)) => pack = PathBuf::from(p),
             ("--frames", Some(n)) if n.parse::<u32>().is_ok() => frames = n.parse().ok(),
-            ("--size", Some(wh)) if parse_size(&wh).is_some() => size = parse_size(&wh).unwrap_or(SIZE),
+            ("--size", Some(wh)) if parse_size(&wh).is_some() => {
+                size = parse_size(&wh).unwrap_or(SIZE)
+            }
             _ => {
                 eprintln!("usage: own_scene [--pack PATH] [--frames N] [--size WxH] [--proxies]");
                 return ExitCode::FAILURE;
@@ -106,7 +108,13 @@ fn main() -> ExitCode {
             app.run();
             ExitCode::SUCCESS
         }
-        Some(n) => headless(app, asset_plugin, scene, (n, size), &target.join("own_scene")),
+        Some(n) => headless(
+            app,
+            asset_plugin,
+            scene,
+            (n, size),
+            &target.join("own_scene"),
+        ),
     }
 }
 
@@ -203,13 +211,15 @@ fn headless(
         start.elapsed().as_secs_f64() * 1e3 / n.max(1) as f64
     );
     let file = out.join("frame.png");
-    let written = std::fs::create_dir_all(out).map_err(|e| e.to_string()).and_then(|()| {
-        let data = last.ok_or("no read-back of the last frame")?;
-        image::RgbaImage::from_raw(size.0, size.1, data)
-            .ok_or("read-back of the wrong size")?
-            .save(&file)
-            .map_err(|e| e.to_string())
-    });
+    let written = std::fs::create_dir_all(out)
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            let data = last.ok_or("no read-back of the last frame")?;
+            image::RgbaImage::from_raw(size.0, size.1, data)
+                .ok_or("read-back of the wrong size")?
+                .save(&file)
+                .map_err(|e| e.to_string())
+        });
     if let Err(e) = written {
         eprintln!("own_scene: {}: {e}", file.display());
         return ExitCode::FAILURE;

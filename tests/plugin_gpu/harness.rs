@@ -28,6 +28,10 @@ pub(crate) struct Frames {
     pub(crate) stats: StreamingStats,
     /// Key uploads at the end.
     pub(crate) uploads: KeyUploadStats,
+    /// Chunks the CPU backend's reconstructor read from the pack itself (0 on the GPU).
+    pub(crate) cpu_backend_reads: u64,
+    /// Bytes the streaming cache held resident at the end.
+    pub(crate) resident_bytes: u64,
 }
 
 /// Renders the 3-view room (with `volume_samples` temporal-volume samples per view and
@@ -216,6 +220,14 @@ pub(crate) fn plugin_and_cpu_frames_with(
         fallback: report.fallback,
         stats: app.world().resource::<StreamingStats>().clone(),
         uploads: *app.world().resource::<KeyUploadStats>(),
+        cpu_backend_reads: app
+            .world()
+            .resource::<bevy_plenoptic::cpu::CpuFrames>()
+            .chunks_read(cam_entity),
+        resident_bytes: app
+            .world()
+            .resource::<bevy_plenoptic::streaming::StreamCache>()
+            .committed_bytes(),
     }
 }
 

@@ -108,7 +108,6 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
             Transform::from_translation(EYE.0).looking_at(EYE.1, Vec3::Y),
             bevy::camera::Exposure {
                 ev100: bevy_plenoptic::camera::EV100_UNIT,
-                own_scene: true,
             },
             PlenopticCamera {
                 playback: Playback::Manual,

@@ -406,12 +406,28 @@ fn gpu_background_matches_cpu_where_there_is_no_geometry() {
 }
 
 /// The CPU backend shows plenoptic_recon's frame itself (through the proxies, in screen
-/// space): equal up to the f16 target's rounding.
+/// space): equal up to the f16 target's rounding. Its reconstructor reads no chunk of the pack:
+/// its keys are the streaming's, decoded for it inside the memory budget.
 #[test]
 fn cpu_backend_shows_the_cpu_frame() {
     let Frames {
-        gpu: shown, cpu, ..
+        gpu: shown,
+        cpu,
+        cpu_backend_reads,
+        resident_bytes,
+        stats,
+        ..
     } = plugin_and_cpu_frames(Backend::Cpu, 0, None);
+    eprintln!(
+        "CPU backend: {cpu_backend_reads} chunks read by its reconstructor, {} keys decoded by \
+         the streaming, {resident_bytes} bytes resident",
+        stats.decoded_keys
+    );
+    assert_eq!(
+        cpu_backend_reads, 0,
+        "the reconstructor read the pack itself"
+    );
+    assert!(stats.decoded_keys > 0 && resident_bytes > 0);
     let within = shown
         .iter()
         .zip(&cpu)

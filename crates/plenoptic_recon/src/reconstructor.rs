@@ -22,10 +22,10 @@ use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
 pub use crate::settings::{CubeFilter, ReconSettings, Shading};
 use crate::shading::Channel;
+use crate::streamed::{KeySource, StreamedCube};
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
-use crate::streamed::{KeySource, StreamedCube};
 use crate::{Error, Result};
 
 /// Reconstructs frames from one pack.
@@ -165,7 +165,11 @@ impl Reconstructor {
 
     pub(crate) fn cached(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
         if crate::streamed::is_cube(kind) {
-            let source = self.source.read().unwrap_or_else(|e| e.into_inner()).clone();
+            let source = self
+                .source
+                .read()
+                .unwrap_or_else(|e| e.into_inner())
+                .clone();
             if let Some(source) = source {
                 return match source.cube(kind, view, key) {
                     Some(StreamedCube::Colour(c)) => Cached::Radiance(c),

@@ -50,9 +50,7 @@ pub fn read_cube(
     Ok(Some(match kind {
         ChunkKind::RadianceCube => StreamedCube::Colour(Arc::new(pack.radiance(view, key)?)),
         ChunkKind::LightingCube => StreamedCube::Colour(Arc::new(pack.lighting(view, key)?)),
-        ChunkKind::NonDiffuseCube => {
-            StreamedCube::Colour(Arc::new(pack.non_diffuse(view, key)?))
-        }
+        ChunkKind::NonDiffuseCube => StreamedCube::Colour(Arc::new(pack.non_diffuse(view, key)?)),
         ChunkKind::DistanceCube => StreamedCube::Distance(Arc::new(pack.distance(view, key)?)),
         ChunkKind::ObjectIdCube => StreamedCube::Ids(Arc::new(pack.object_id(view, key)?)),
         _ => StreamedCube::Normal(Arc::new(pack.normal(view, key)?)),

@@ -83,7 +83,11 @@ fn a_key_source_replaces_the_packs_cubes() {
     let (frame, report) = partial.render(&cam, t, Mode::GeometryAssisted).unwrap();
     assert!(report.missing.is_empty(), "{:?}", report.missing);
     assert_eq!(partial.chunks_read(), 0);
-    let lit = frame.radiance.iter().filter(|c| c.max_element() > 0.0).count();
+    let lit = frame
+        .radiance
+        .iter()
+        .filter(|c| c.max_element() > 0.0)
+        .count();
     assert!(lit > frame.radiance.len() / 2, "{lit} pixels lit");
     assert_ne!(frame.radiance, expected.radiance);
 

@@ -114,6 +114,14 @@ fn radiance(data: &DecodedKey) -> Option<Vec<Vec3>> {
     let n = data.face_size as usize;
     let texels = 6 * n * n;
     let bytes = &data.radiance;
+    // Decoded for the CPU backend: the cube itself.
+    if let Some((_, plenoptic_recon::StreamedCube::Colour(c))) = data
+        .cpu
+        .iter()
+        .find(|(k, _)| *k == plenoptic_pack::ChunkKind::RadianceCube)
+    {
+        return (c.texels.len() == texels).then(|| c.texels.clone());
+    }
     if bytes.len() == 4 * texels {
         Some(
             bytes

@@ -4,6 +4,14 @@
 //! (`cpu.wgsl`), so depth compositing with Bevy meshes is the same as on the GPU path. The
 //! image lags the camera by the time a frame takes. Every camera has its own reconstructor,
 //! frame task and image.
+//!
+//! The reconstructor reads no cube from the pack: the streaming scheduler decodes the keys of
+//! every camera's working set for it, inside the same memory budget as the GPU's
+//! ([`crate::streaming::decode_cpu_key`]), and each frame task is handed the keys resident
+//! when it starts ([`ResidentKeys`], a `plenoptic_recon::KeySource`), so the CPU frame is
+//! reconstructed from exactly the keys the GPU would look up. A task holds its keys until it
+//! finishes, so for one frame an evicted key can outlive its place in the budget. Temporal
+//! volume blocks are still read by the reconstructor's own chunk cache.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -13,12 +21,14 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, Extent3d, TextureDimension, TextureFormat};
 use bevy::shader::ShaderRef;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
-use plenoptic_recon::{Camera as ReconCamera, Frame, Reconstructor};
+use plenoptic_pack::ChunkKind;
+use plenoptic_recon::{Camera as ReconCamera, Frame, KeySource, Reconstructor, StreamedCube};
 
 use super::ResolvedBackend;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::streaming::StreamCache;
 use crate::{Backend, PlenopticEvent, PlenopticSystems};
 
 /// Adds the CPU backend.
@@ -81,6 +91,47 @@ impl CpuFrames {
     /// Frames the CPU backend has completed for `camera`.
     pub fn frames_done(&self, camera: Entity) -> u64 {
         self.0.get(&camera).map_or(0, |f| f.done)
+    }
+
+    /// Chunks `camera`'s reconstructor has read from the pack itself (its cubes come from the
+    /// streaming, so only temporal-volume blocks count).
+    pub fn chunks_read(&self, camera: Entity) -> u64 {
+        self.0
+            .get(&camera)
+            .and_then(|f| f.rec.as_ref())
+            .map_or(0, |r| r.chunks_read())
+    }
+}
+
+/// The keys of one pack resident in the streaming cache, as a frame task's reconstructor
+/// looks them up.
+#[derive(Default)]
+pub struct ResidentKeys(HashMap<(ChunkKind, u32, u32), StreamedCube>);
+
+impl ResidentKeys {
+    /// The CPU-decoded keys of pack `id` resident in `cache`.
+    pub fn of(cache: &StreamCache, id: AssetId<RadiancePack>) -> Self {
+        let mut cubes = HashMap::new();
+        for (&(pack, view, key), r) in &cache.resident {
+            if pack != id {
+                continue;
+            }
+            for (kind, cube) in &r.data.cpu {
+                cubes.insert((*kind, view, key), cube.clone());
+            }
+        }
+        ResidentKeys(cubes)
+    }
+
+    /// Whether it holds no key.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+impl KeySource for ResidentKeys {
+    fn cube(&self, kind: ChunkKind, view: u32, key: u32) -> Option<StreamedCube> {
+        self.0.get(&(kind, view, key)).cloned()
     }
 }
 
@@ -151,8 +202,10 @@ fn attach_cpu_materials(
     }
 }
 
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn run_cpu_frames(
     mut frames: ResMut<CpuFrames>,
+    cache: Res<StreamCache>,
     cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
     mut images: ResMut<Assets<Image>>,
     mut materials: ResMut<Assets<CpuFrameMaterial>>,
@@ -233,6 +286,12 @@ fn run_cpu_frames(
         let Some(rec) = f.rec.clone() else {
             continue;
         };
+        // The keys the streaming has resident for this pack; none yet: no frame.
+        let keys = ResidentKeys::of(&cache, f.pack);
+        if keys.is_empty() {
+            continue;
+        }
+        rec.set_key_source(Some(Arc::new(keys)));
         let Some(size) = camera.physical_viewport_size() else {
             continue;
         };
