@@ -370,6 +370,7 @@ mod tests {
             normal: None,
             lighting: None,
             non_diffuse: None,
+            cpu: Vec::new(),
         };
         let a = radiance(&key(Vec3::new(1.0, 0.5, 0.25))).unwrap();
         let b = radiance(&key(Vec3::new(3.0, 0.5, 0.0))).unwrap();
@@ -389,5 +390,16 @@ mod tests {
             ..key(Vec3::ONE)
         };
         assert!(radiance(&broken).is_none());
+        // A key decoded for the CPU backend: its radiance cube itself.
+        let cube = plenoptic_pack::CubeImage::filled(1, Vec3::new(0.25, 0.5, 2.0));
+        let cpu = DecodedKey {
+            radiance: Vec::new(),
+            cpu: vec![(
+                plenoptic_pack::ChunkKind::RadianceCube,
+                plenoptic_recon::StreamedCube::Colour(std::sync::Arc::new(cube.clone())),
+            )],
+            ..key(Vec3::ONE)
+        };
+        assert_eq!(radiance(&cpu), Some(cube.texels));
     }
 }

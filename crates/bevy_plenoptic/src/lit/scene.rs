@@ -204,6 +204,9 @@ pub fn match_object(
     None
 }
 
+/// Bevy's punctual lights (what the glTF loader spawns for `KHR_lights_punctual`).
+type PunctualLight = Or<(With<DirectionalLight>, With<PointLight>, With<SpotLight>)>;
+
 /// Candidates of [`attach_lit_materials`]: meshes with a standard material not yet checked.
 type Unchecked<'a> = (&'a Mesh3d, &'a MeshMaterial3d<StandardMaterial>);
 
@@ -221,7 +224,7 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    lights: Query<&Visibility, Or<(With<DirectionalLight>, With<PointLight>, With<SpotLight>)>>,
+    lights: Query<&Visibility, PunctualLight>,
     cameras: Query<(&PlenopticCamera, &image::ImageFrame)>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
@@ -310,7 +313,6 @@ fn attach_lit_materials(
 }
 
 /// Fills every lit mesh's lookups for its camera, as the proxies' are filled.
-#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn update_lit_materials(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,

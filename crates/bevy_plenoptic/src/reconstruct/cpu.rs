@@ -202,7 +202,6 @@ fn attach_cpu_materials(
     }
 }
 
-#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn run_cpu_frames(
     mut frames: ResMut<CpuFrames>,
     cache: Res<StreamCache>,

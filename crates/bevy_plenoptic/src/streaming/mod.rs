@@ -547,6 +547,7 @@ fn collect_finished(
 /// Most reads in flight at once.
 const MAX_IN_FLIGHT: usize = 8;
 
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn schedule_reads(
     mut cache: ResMut<StreamCache>,
     mut stats: ResMut<StreamingStats>,
