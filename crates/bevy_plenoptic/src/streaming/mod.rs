@@ -242,18 +242,11 @@ pub fn cpu_key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
 
 /// Bytes a key will occupy once decoded, from the directory (known before reading).
 pub fn key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
-    [
-        ChunkKind::RadianceCube,
-        ChunkKind::DistanceCube,
-        ChunkKind::ObjectIdCube,
-        ChunkKind::NormalCube,
-        ChunkKind::LightingCube,
-        ChunkKind::NonDiffuseCube,
-    ]
-    .into_iter()
-    .filter_map(|k| pack.find(k, view, key))
-    .map(|i| pack.entries()[i].uncompressed_length)
-    .sum()
+    CUBE_KINDS
+        .into_iter()
+        .filter_map(|k| pack.find(k, view, key))
+        .map(|i| pack.entries()[i].uncompressed_length)
+        .sum()
 }
 
 /// Face size of the direction bins of a [`BinnedVolume`] (`plenoptic_recon`'s
