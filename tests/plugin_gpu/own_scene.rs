@@ -10,7 +10,7 @@ use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
-use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack};
+use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack, PlenopticLit};
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
 
@@ -176,6 +176,28 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
     let world = app.world_mut();
     let lit = world.query::<&LitObject>().iter(world).count();
     let not_in_pack = world.query::<&NotInPack>().iter(world).count();
+    if own_scene {
+        // The scene no longer lit: every mesh gets its own material back.
+        let roots: Vec<Entity> = world
+            .query_filtered::<Entity, With<PlenopticLit>>()
+            .iter(world)
+            .collect();
+        for r in roots {
+            world.entity_mut(r).remove::<PlenopticLit>();
+        }
+        app.update();
+        app.update();
+        let world = app.world_mut();
+        assert_eq!(world.query::<&LitObject>().iter(world).count(), 0);
+        let standard = world
+            .query_filtered::<(), With<MeshMaterial3d<StandardMaterial>>>()
+            .iter(world)
+            .count();
+        assert!(
+            standard >= lit,
+            "{standard} meshes back on their own material"
+        );
+    }
     Shown {
         frame,
         lit,

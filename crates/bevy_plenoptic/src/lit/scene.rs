@@ -32,6 +32,9 @@
 //! are hidden: their light is baked into the pack, and the meshes not in the pack get it from
 //! the light probes.
 //!
+//! When the camera is despawned or the scene's [`PlenopticLit`] removed, the meshes get their
+//! own materials back (the scene's lights stay hidden).
+//!
 //! What it assumes, as a lightmap does: the scene is spawned where it was baked (its root at
 //! the identity), and the matched meshes are the baked ones. A mesh is lit for one camera's
 //! time and lookups, whichever cameras see it (it is one entity for all of them); the
@@ -145,7 +148,12 @@ pub(super) fn build(app: &mut App) {
     app.add_plugins(MaterialPlugin::<LitMaterial>::default())
         .add_systems(
             Update,
-            (attach_lit_materials, update_lit_materials, proxy_layers)
+            (
+                release_lit_materials,
+                attach_lit_materials,
+                update_lit_materials,
+                proxy_layers,
+            )
                 .chain()
                 .after(PlenopticSystems::Streaming)
                 .after(crate::reconstruct::update_materials),
@@ -309,6 +317,30 @@ fn attach_lit_materials(
                     },
                 ));
         }
+    }
+}
+
+/// Gives a lit mesh its own material back once its camera is gone or its scene is no longer
+/// [`PlenopticLit`] (it is matched again if it is lit again).
+fn release_lit_materials(
+    mut commands: Commands,
+    cameras: Query<(), With<PlenopticCamera>>,
+    roots: Query<&PlenopticLit>,
+    parents: Query<&ChildOf>,
+    objects: Query<(Entity, &LitObject)>,
+) {
+    for (entity, object) in &objects {
+        let lit_by = parents
+            .iter_ancestors(entity)
+            .find_map(|a| roots.get(a).ok())
+            .map(|l| l.camera);
+        if lit_by == Some(object.camera) && cameras.contains(object.camera) {
+            continue;
+        }
+        commands
+            .entity(entity)
+            .remove::<(MeshMaterial3d<LitMaterial>, LitObject)>()
+            .insert(MeshMaterial3d(object.original.clone()));
     }
 }
 
