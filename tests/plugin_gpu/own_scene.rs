@@ -60,13 +60,14 @@ const TIME: f32 = 0.5;
 /// (`own_scene`) the example's app: the glb's scene spawned by Bevy's loader and lit by the
 /// pack, with its unbaked sphere moving behind the camera.
 fn frame(dir: &std::path::Path, own_scene: bool) -> Shown {
-    frame_with(dir, own_scene, false)
+    frame_with(dir, own_scene, false, Backend::Gpu)
 }
 
-/// [`frame`], with the lit meshes' own base colours halved (`darken`) once matched.
-fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
+/// [`frame`], with the lit meshes' own base colours halved (`darken`) once matched, on
+/// `backend`.
+fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool, backend: Backend) -> Shown {
     let mut app = headless_app_in(dir);
-    app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+    app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
     let image = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
         let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
@@ -156,10 +157,12 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool) -> Shown {
     }
     let frame = settled_frames(&mut app, &[image]).remove(0);
     if let Some(out) = std::env::var_os("PLENOPTIC_TEST_FRAMES") {
-        let name = match (own_scene, darken) {
-            (false, _) => "proxies",
-            (true, false) => "own_scene",
-            (true, true) => "own_scene_darkened",
+        let name = match (own_scene, darken, backend) {
+            (false, _, Backend::Cpu) => "proxies_cpu",
+            (false, _, _) => "proxies",
+            (true, _, Backend::Cpu) => "own_scene_cpu",
+            (true, false, _) => "own_scene",
+            (true, true, _) => "own_scene_darkened",
         };
         let rgb: Vec<u8> = frame
             .iter()
@@ -255,7 +258,7 @@ fn the_apps_own_gltf_scene_is_lit_by_the_pack_like_its_proxies() {
     );
     // What is shown is the app's material: its base colours halved, the frame darkens (the
     // lighting times half the albedo; the sun's specular and the emission stay).
-    let darker = mean(&frame_with(dir.path(), true, true).frame);
+    let darker = mean(&frame_with(dir.path(), true, true, Backend::Gpu).frame);
     eprintln!(
         "with the app's base colours halved: {darker:.4} ({:.3} of before)",
         darker / b
@@ -263,5 +266,19 @@ fn the_apps_own_gltf_scene_is_lit_by_the_pack_like_its_proxies() {
     assert!(
         darker / b < 0.75 && darker / b > 0.4,
         "{darker} against {b}"
+    );
+    // On the CPU backend the matched meshes show the CPU frame, as the proxies there do.
+    let cpu_proxies = mean(&frame_with(dir.path(), false, false, Backend::Cpu).frame);
+    let cpu = frame_with(dir.path(), true, false, Backend::Cpu);
+    let c = mean(&cpu.frame);
+    eprintln!(
+        "CPU backend: {} meshes show the CPU frame, mean {c:.4} ({:.4} of its proxies' {cpu_proxies:.4})",
+        cpu.lit,
+        c / cpu_proxies
+    );
+    assert_eq!(cpu.lit, own.lit);
+    assert!(
+        (c / cpu_proxies - 1.0).abs() < 0.05,
+        "CPU backend {c} against {cpu_proxies}"
     );
 }

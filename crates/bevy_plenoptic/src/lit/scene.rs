@@ -38,8 +38,9 @@
 //! What it assumes, as a lightmap does: the scene is spawned where it was baked (its root at
 //! the identity), and the matched meshes are the baked ones. A mesh is lit for one camera's
 //! time and lookups, whichever cameras see it (it is one entity for all of them); the
-//! lookups' angular weights and reflections are per view. Lit meshes are shaded on the GPU
-//! backend; on the CPU backend they keep their material.
+//! lookups' angular weights and reflections are per view. On the CPU backend a matched mesh
+//! shows the camera's CPU frame in screen space, as the proxies do there (the pack's own
+//! materials: the app's are not used).
 
 use std::collections::{HashMap, HashSet};
 
@@ -55,6 +56,7 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
 use crate::reconstruct::frame::{CameraFrame, ObjectShading, frame_lookups, warped};
 use crate::reconstruct::{
     KeyTextures, MaterialFactors, ReconParams, ResolvedBackend, background, image,
@@ -150,13 +152,16 @@ pub(super) fn build(app: &mut App) {
             Update,
             (
                 release_lit_materials,
+                hide_scene_lights,
                 attach_lit_materials,
+                attach_cpu_frames,
                 update_lit_materials,
                 proxy_layers,
             )
                 .chain()
                 .after(PlenopticSystems::Streaming)
-                .after(crate::reconstruct::update_materials),
+                .after(crate::reconstruct::update_materials)
+                .after(crate::reconstruct::cpu::run_cpu_frames),
         );
 }
 
@@ -215,6 +220,99 @@ pub fn match_object(
 /// Bevy's punctual lights (what the glTF loader spawns for `KHR_lights_punctual`).
 type PunctualLight = Or<(With<DirectionalLight>, With<PointLight>, With<SpotLight>)>;
 
+/// The pack object the mesh `entity` under the lit scene's `root` is, if any (the names of
+/// its ancestors below `root` and its primitive, [`match_object`]).
+fn mesh_object(
+    pack: &RadiancePack,
+    (root, entity): (Entity, Entity),
+    mesh: &Mesh3d,
+    parents: &Query<&ChildOf>,
+    names: &Query<&Name>,
+) -> Option<u32> {
+    let mut chain: Vec<&str> = parents
+        .iter_ancestors(entity)
+        .take_while(|&a| a != root)
+        .filter_map(|a| names.get(a).ok().map(Name::as_str))
+        .collect();
+    chain.reverse();
+    let objects = &pack.reader.manifest().objects;
+    match_object(objects, &chain, primitive_index(mesh.0.path()))
+}
+
+/// Hides the punctual lights of every [`PlenopticLit`] scene: their light is in the pack.
+fn hide_scene_lights(
+    mut commands: Commands,
+    roots: Query<Entity, With<PlenopticLit>>,
+    children: Query<&Children>,
+    lights: Query<&Visibility, PunctualLight>,
+) {
+    for root in &roots {
+        for entity in children.iter_descendants(root) {
+            if lights.get(entity).is_ok_and(|v| *v != Visibility::Hidden) {
+                commands.entity(entity).insert(Visibility::Hidden);
+            }
+        }
+    }
+}
+
+/// On the CPU backend, matched meshes show the camera's CPU frame in screen space, as the
+/// proxies there do (the CPU frame is the pack's reconstruction with the pack's own
+/// materials; the app's materials are not used).
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+fn attach_cpu_frames(
+    mut commands: Commands,
+    backend: Res<ResolvedBackend>,
+    frames: Res<CpuFrames>,
+    roots: Query<(Entity, &PlenopticLit)>,
+    children: Query<&Children>,
+    parents: Query<&ChildOf>,
+    names: Query<&Name>,
+    unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
+    cameras: Query<&PlenopticCamera>,
+    packs: Res<Assets<RadiancePack>>,
+    mut materials: ResMut<Assets<CpuFrameMaterial>>,
+) {
+    if backend.0 != Backend::Cpu {
+        return;
+    }
+    for (root, scene) in &roots {
+        let (Ok(cam), Some(frame)) = (cameras.get(scene.camera), frames.image(scene.camera)) else {
+            continue;
+        };
+        let Some(pack) = packs.get(cam.pack.id()) else {
+            continue;
+        };
+        let mut material = None;
+        for entity in children.iter_descendants(root) {
+            let Ok((mesh, original)) = unchecked.get(entity) else {
+                continue;
+            };
+            let Some(object) = mesh_object(pack, (root, entity), mesh, &parents, &names) else {
+                commands.entity(entity).insert(NotInPack);
+                continue;
+            };
+            let material = material
+                .get_or_insert_with(|| {
+                    materials.add(CpuFrameMaterial {
+                        frame: frame.clone(),
+                    })
+                })
+                .clone();
+            commands
+                .entity(entity)
+                .remove::<MeshMaterial3d<StandardMaterial>>()
+                .insert((
+                    MeshMaterial3d(material),
+                    LitObject {
+                        camera: scene.camera,
+                        id: object,
+                        original: original.0.clone(),
+                    },
+                ));
+        }
+    }
+}
+
 /// Candidates of [`attach_lit_materials`]: meshes with a standard material not yet checked.
 type Unchecked<'a> = (&'a Mesh3d, &'a MeshMaterial3d<StandardMaterial>);
 
@@ -232,7 +330,6 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    lights: Query<&Visibility, PunctualLight>,
     cameras: Query<(&PlenopticCamera, &image::ImageFrame)>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
@@ -254,11 +351,6 @@ fn attach_lit_materials(
             continue;
         };
         for entity in children.iter_descendants(root) {
-            if lights.get(entity).is_ok_and(|v| *v != Visibility::Hidden) {
-                // Its light is in the pack: the app's meshes get it from there.
-                commands.entity(entity).insert(Visibility::Hidden);
-                continue;
-            }
             let Ok((mesh, material)) = unchecked.get(entity) else {
                 continue;
             };
@@ -266,15 +358,7 @@ fn attach_lit_materials(
                 // Its material has not loaded yet: next frame.
                 continue;
             };
-            // The names of the mesh's ancestors below `root`, root first.
-            let mut chain: Vec<&str> = parents
-                .iter_ancestors(entity)
-                .take_while(|&a| a != root)
-                .filter_map(|a| names.get(a).ok().map(Name::as_str))
-                .collect();
-            chain.reverse();
-            let objects = &pack.reader.manifest().objects;
-            let Some(object) = match_object(objects, &chain, primitive_index(mesh.0.path())) else {
+            let Some(object) = mesh_object(pack, (root, entity), mesh, &parents, &names) else {
                 commands.entity(entity).insert(NotInPack);
                 continue;
             };
@@ -339,7 +423,11 @@ fn release_lit_materials(
         }
         commands
             .entity(entity)
-            .remove::<(MeshMaterial3d<LitMaterial>, LitObject)>()
+            .remove::<(
+                MeshMaterial3d<LitMaterial>,
+                MeshMaterial3d<CpuFrameMaterial>,
+                LitObject,
+            )>()
             .insert(MeshMaterial3d(object.original.clone()));
     }
 }

@@ -202,7 +202,7 @@ fn attach_cpu_materials(
     }
 }
 
-fn run_cpu_frames(
+pub(crate) fn run_cpu_frames(
     mut frames: ResMut<CpuFrames>,
     cache: Res<StreamCache>,
     cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
