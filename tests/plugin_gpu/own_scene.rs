@@ -12,6 +12,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack, PlenopticLit};
 use bevy_plenoptic::prelude::*;
+use bevy_plenoptic::proxy::ProxyOf;
 use bevy_plenoptic::streaming::StreamState;
 
 fn assets() -> std::path::PathBuf {
@@ -49,6 +50,8 @@ struct Shown {
     not_in_pack: usize,
     /// How far the example's unbaked sphere moved while the frame was rendered.
     sphere_moved: f32,
+    /// Proxies the camera does not draw (moved to its shadow-only layer).
+    hidden_proxies: usize,
 }
 
 /// Where the camera stands and looks in room A.
@@ -177,6 +180,17 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool, backend: Bac
     }
     let end = sphere(&mut app);
     let world = app.world_mut();
+    let layer = world
+        .query::<&bevy_plenoptic::camera::layers::ViewLayer>()
+        .iter(world)
+        .next()
+        .copied()
+        .expect("the camera has its layer");
+    let hidden_proxies = world
+        .query_filtered::<&bevy::camera::visibility::RenderLayers, With<ProxyOf>>()
+        .iter(world)
+        .filter(|l| **l == layer.shadow_only())
+        .count();
     let lit = world.query::<&LitObject>().iter(world).count();
     let not_in_pack = world.query::<&NotInPack>().iter(world).count();
     if own_scene {
@@ -206,6 +220,7 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool, backend: Bac
         lit,
         not_in_pack,
         sphere_moved: start.zip(end).map_or(0.0, |(a, b)| a.distance(b)),
+        hidden_proxies,
     }
 }
 
@@ -230,6 +245,12 @@ fn the_apps_own_gltf_scene_is_lit_by_the_pack_like_its_proxies() {
     );
     assert!(own.lit >= 40, "{} of the tour's meshes matched", own.lit);
     assert!(own.sphere_moved > 0.01, "the example's sphere moves");
+    // The camera draws the app's meshes, not the matched objects' proxies.
+    assert_eq!(proxies.hidden_proxies, 0);
+    assert_eq!(
+        own.hidden_proxies, own.lit,
+        "matched proxies on the shadow-only layer"
+    );
     assert_eq!(own.not_in_pack, 0, "every mesh of the glb is in the pack");
     let mean = |f: &[Vec3]| f.iter().map(|&c| luminance(c)).sum::<f32>() / f.len() as f32;
     let (a, b) = (mean(&proxies.frame), mean(&own.frame));
@@ -277,6 +298,7 @@ fn the_apps_own_gltf_scene_is_lit_by_the_pack_like_its_proxies() {
         c / cpu_proxies
     );
     assert_eq!(cpu.lit, own.lit);
+    assert_eq!(cpu.hidden_proxies, cpu.lit);
     assert!(
         (c / cpu_proxies - 1.0).abs() < 0.05,
         "CPU backend {c} against {cpu_proxies}"

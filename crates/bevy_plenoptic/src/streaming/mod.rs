@@ -7,7 +7,8 @@
 //! the camera and the playback will be [`PlenopticSettings::prefetch_seconds`] from now
 //! ("prefetch"). Missing keys are read and decoded (checksum, zstd, KTX2 → GPU-ready texel
 //! bytes; on the CPU backend, the cubes `plenoptic_recon` looks up, which its reconstructor
-//! then takes from here instead of reading the pack, [`decode_cpu_key`]) on the [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
+//! then takes from here instead of reading the pack, [`decode_cpu_key`]) on the
+//! [`IoTaskPool`] (not the async compute pool, where Bevy compiles pipelines:
 //! on a slow driver those compiles would queue the reads behind them); the main thread never
 //! waits on I/O. A key's bytes
 //! are reserved against the budget *before* its read starts, from the directory's
@@ -226,18 +227,19 @@ pub fn decode_cpu_key(
 
 /// Bytes a key occupies once decoded for the CPU backend ([`decode_cpu_key`]), from the
 /// directory and the pack's face size (known before reading): 12 per texel of a colour or
-/// normal cube, 4 of a distance or id cube.
+/// normal cube, 4 of a distance or id cube. Saturates (a hostile face size then exceeds any
+/// budget and the key is never read).
 pub fn cpu_key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
     let face = u64::from(pack.manifest().bake.cube_face_size);
-    let texels = 6 * face * face;
+    let texels = face.saturating_mul(face).saturating_mul(6);
     CUBE_KINDS
         .into_iter()
         .filter(|&k| pack.find(k, view, key).is_some())
         .map(|k| match k {
-            ChunkKind::DistanceCube | ChunkKind::ObjectIdCube => 4 * texels,
-            _ => 12 * texels,
+            ChunkKind::DistanceCube | ChunkKind::ObjectIdCube => texels.saturating_mul(4),
+            _ => texels.saturating_mul(12),
         })
-        .sum()
+        .fold(0u64, u64::saturating_add)
 }
 
 /// Bytes a key will occupy once decoded, from the directory (known before reading).
