@@ -80,6 +80,7 @@ pub mod brdf;
 mod cache;
 pub mod camera;
 pub mod delaunay3;
+pub mod flat_rays;
 pub mod frame;
 mod geometry;
 mod glazing;

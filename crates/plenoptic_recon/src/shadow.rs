@@ -110,35 +110,13 @@ impl ShadowScene {
 
     /// The geometry of the objects of `proxy` whose pack id `keep` accepts.
     pub fn of_objects(proxy: &ProxyGeometry, keep: impl Fn(u32) -> bool) -> Self {
-        let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
-            m.triangles
-                .iter()
-                .map(|t| {
-                    let [v0, v1, v2] =
-                        t.map(|i| xf.transform_point3a(m.positions[i as usize].into()));
-                    Triangle { v0, v1, v2 }
-                })
-                .collect()
-        };
-        let mut fixed = Vec::new();
-        let mut moving = Vec::new();
-        for (i, &id) in proxy.object_ids().iter().enumerate() {
-            if !keep(id) {
-                continue;
-            }
-            let mesh = &proxy.meshes()[i];
-            match &proxy.motions()[i] {
-                Some(m) if m.is_animated() => {
-                    if let Some(b) = TriangleBvh::new(triangles(mesh, Affine3A::IDENTITY)) {
-                        moving.push((id, b));
-                    }
-                }
-                _ => fixed.extend(triangles(mesh, proxy.transform(id, 0.0))),
-            }
-        }
+        let (fixed, moving) = split_triangles(proxy, keep);
         Self {
             fixed: TriangleBvh::new(fixed),
-            moving,
+            moving: moving
+                .into_iter()
+                .filter_map(|(id, tris)| Some((id, TriangleBvh::new(tris)?)))
+                .collect(),
         }
     }
 
@@ -210,6 +188,39 @@ impl PlacedShadows<'_> {
             .sum();
         fixed + moving
     }
+}
+
+/// The triangles of the objects of `proxy` whose pack id `keep` accepts: those that never move
+/// together in world space, and each animated object's own in object space (with its pack
+/// id). Shared by the CPU's BVHs and the GPU's flat layout ([`crate::flat_rays`]).
+pub(crate) fn split_triangles(
+    proxy: &ProxyGeometry,
+    keep: impl Fn(u32) -> bool,
+) -> (Vec<Triangle>, Vec<(u32, Vec<Triangle>)>) {
+    let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
+        m.triangles
+            .iter()
+            .map(|t| {
+                let [v0, v1, v2] = t.map(|i| xf.transform_point3a(m.positions[i as usize].into()));
+                Triangle { v0, v1, v2 }
+            })
+            .collect()
+    };
+    let mut fixed = Vec::new();
+    let mut moving = Vec::new();
+    for (i, &id) in proxy.object_ids().iter().enumerate() {
+        if !keep(id) {
+            continue;
+        }
+        let mesh = &proxy.meshes()[i];
+        match &proxy.motions()[i] {
+            Some(m) if m.is_animated() => {
+                moving.push((id, triangles(mesh, Affine3A::IDENTITY)));
+            }
+            _ => fixed.extend(triangles(mesh, proxy.transform(id, 0.0))),
+        }
+    }
+    (fixed, moving)
 }
 
 /// The world bounds of object-space bounds `b` moved by `xf` (its eight corners').

@@ -152,7 +152,7 @@ pub fn see_through_transmittance(
 }
 
 /// How far (m) a reflected ray starts off its surface when it is cast against the proxies.
-const RAY_OFFSET: f32 = 1e-3;
+pub const RAY_OFFSET: f32 = 1e-3;
 
 /// Rays per pixel on a glossy surface ([`Reflections::lobe`]).
 pub const GLOSSY_RAYS: usize = 8;

@@ -9,6 +9,7 @@ use bevy::asset::{AssetLoader, LoadContext, RenderAssetUsages};
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
 use plenoptic_pack::{PackError, PackReader};
+use plenoptic_recon::flat_rays::FlatRays;
 
 use super::{ProxyObject, RadiancePack};
 
@@ -80,6 +81,9 @@ impl AssetLoader for RadiancePackLoader {
         })?;
 
         let (read, mut failed) = plenoptic_recon::proxy::read_proxies(&pack);
+        // What reflected rays are cast against (the CPU's escape test, on the GPU).
+        let rays = plenoptic_recon::ProxyGeometry::from_proxies(&read)
+            .map_or_else(FlatRays::none, |g| FlatRays::new(&g));
         // The environment (its image chunk, if any, is read now: every frame needs it).
         let (environment, env_error) =
             plenoptic_recon::background::PackEnvironment::from_pack(&pack);
@@ -137,6 +141,7 @@ impl AssetLoader for RadiancePackLoader {
             file,
             usable_views,
             environment,
+            rays: Arc::new(rays),
         })
     }
 

@@ -44,6 +44,9 @@ pub struct RadiancePack {
     /// The pack's material textures by index (pack 1.2+), mipmapped as stored; `None` for
     /// one that could not be read (then in [`RadiancePack::failed`]).
     pub textures: Vec<Option<Handle<Image>>>,
+    /// The proxies as reflected rays are cast against them on the GPU (the words of a
+    /// storage buffer, `reconstruct::rays`).
+    pub rays: Arc<plenoptic_recon::flat_rays::FlatRays>,
 }
 
 /// Per base view of `pack`: whether the directory has a radiance cube of it at some time key

@@ -58,6 +58,7 @@ use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
 use crate::reconstruct::frame::{CameraFrame, ObjectShading, frame_lookups, warped};
+use crate::reconstruct::rays::{CameraRays, PackRays};
 use crate::reconstruct::{
     KeyTextures, MaterialFactors, ReconParams, ResolvedBackend, background, image,
     material_factors, object_coverage, volume,
@@ -120,6 +121,13 @@ pub struct PlenopticLighting {
     /// The pack's environment image.
     #[texture(111, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
+    /// The pack's proxies as reflected rays are cast against them
+    /// ([`crate::reconstruct::rays`]).
+    #[storage(112, read_only)]
+    pub rays: Handle<ShaderBuffer>,
+    /// The camera's moving proxies placed at its time.
+    #[storage(113, read_only)]
+    pub ray_placements: Handle<ShaderBuffer>,
     /// The object's material in the pack (its transmission, IOR and emission; the per-pixel
     /// base colour, metalness and roughness are the standard material's).
     pub factors: Option<MaterialFactors>,
@@ -330,18 +338,19 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    cameras: Query<(&PlenopticCamera, &image::ImageFrame)>,
+    cameras: Query<(&PlenopticCamera, &image::ImageFrame, &CameraRays)>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
     mut lit: ResMut<Assets<LitMaterial>>,
     mut env_images: ResMut<background::EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
+    (mut pack_rays, mut buffers): (ResMut<PackRays>, ResMut<Assets<ShaderBuffer>>),
 ) {
     if backend.0 != Backend::Gpu {
         return;
     }
     for (root, scene) in &roots {
-        let Ok((cam, image_frame)) = cameras.get(scene.camera) else {
+        let Ok((cam, image_frame, camera_rays)) = cameras.get(scene.camera) else {
             continue;
         };
         let id = cam.pack.id();
@@ -385,6 +394,8 @@ fn attach_lit_materials(
                     shading_cubes: tex.shading.clone(),
                     environment: background::EnvironmentUniform::default(),
                     environment_image: env_images.get(id, pack, &mut images),
+                    rays: pack_rays.get(id, pack, &mut buffers),
+                    ray_placements: camera_rays.buffer.clone(),
                     factors,
                     coverage,
                 },

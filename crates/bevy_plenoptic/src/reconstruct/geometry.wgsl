@@ -21,9 +21,12 @@
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
 #import plenoptic::environment::{Environment, environment}
 #import plenoptic::reflect::{march, fetch, orthonormal_pair}
+#import plenoptic::rays::{has_rays, occluded}
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
+// How far off its surface a reflected ray is cast (plenoptic_recon::specular's RAY_OFFSET).
+const RAY_OFFSET: f32 = 0.001;
 // Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
 const BIN_FACE: u32 = 16u;
 
@@ -702,6 +705,11 @@ fn see_through() -> bool {
 // Radiance arriving at `origin` along unit `dir`, over a cone of half-angle `cone`, from the
 // lookups' keys: (radiance, 1), or (0, 0) where no lookup can tell.
 fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
+    // A ray that meets no proxy has left the scene (plenoptic_recon::specular's escape
+    // test, cast off the surface it starts on).
+    if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, params.specular.z) {
+        return vec4<f32>(environment(env, env_image, dir), 1.0);
+    }
     let count = min(u32(params.header.x), MAX_LOOKUPS);
     let n = u32(params.header.z);
     var sum = vec3<f32>(0.0);

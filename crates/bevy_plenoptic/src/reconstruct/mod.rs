@@ -53,6 +53,7 @@ pub mod background;
 pub mod cpu;
 pub mod frame;
 pub mod image;
+pub mod rays;
 pub mod reflect;
 pub mod sun;
 pub mod upload;
@@ -93,6 +94,7 @@ impl Plugin for PlenopticReconstructPlugin {
         // (`plenoptic::reflect`).
         bevy::shader::load_shader_library!(app, "environment.wgsl");
         bevy::shader::load_shader_library!(app, "reflect.wgsl");
+        bevy::shader::load_shader_library!(app, "rays.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
         background::build(app);
@@ -101,6 +103,7 @@ impl Plugin for PlenopticReconstructPlugin {
             .init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
             .init_resource::<volume::VolumeBuffers>()
+            .init_resource::<rays::PackRays>()
             .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
@@ -108,6 +111,8 @@ impl Plugin for PlenopticReconstructPlugin {
                     upload::upload_keys,
                     volume::upload_volumes,
                     image::add_frames,
+                    rays::add_camera_rays,
+                    rays::place_rays,
                     attach_materials,
                     background::spawn_backgrounds,
                     volume_mode::prepare_cubes,
@@ -203,6 +208,12 @@ pub struct PlenopticMaterial {
     /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
     #[texture(11, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
+    /// The pack's proxies as reflected rays are cast against them ([`rays`]).
+    #[storage(12, read_only)]
+    pub rays: Handle<ShaderBuffer>,
+    /// The camera's moving proxies placed at its time ([`rays::CameraRays`]).
+    #[storage(13, read_only)]
+    pub ray_placements: Handle<ShaderBuffer>,
     /// The object's diffuse albedo factors from its material in the pack: base-colour factor
     /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
     /// (the textures multiply per pixel); `None` for an object without a material, which
@@ -332,13 +343,14 @@ fn attach_materials(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
-    cameras: Query<&image::ImageFrame>,
+    cameras: Query<(&image::ImageFrame, &rays::CameraRays)>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
     mut env_images: ResMut<background::EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
+    (mut pack_rays, mut buffers): (ResMut<rays::PackRays>, ResMut<Assets<ShaderBuffer>>),
 ) {
     if backend.0 != Backend::Gpu {
         return;
@@ -347,7 +359,7 @@ fn attach_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Ok(image_frame) = cameras.get(scene.camera) else {
+        let Ok((image_frame, camera_rays)) = cameras.get(scene.camera) else {
             continue;
         };
         let (Some(tex), Some(vol), Some(pack)) = (
@@ -373,6 +385,8 @@ fn attach_materials(
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
             environment: background::EnvironmentUniform::default(),
             environment_image,
+            rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
+            ray_placements: camera_rays.buffer.clone(),
             albedo: factors,
             coverage: object_coverage(pack, of.id),
             transmissive,

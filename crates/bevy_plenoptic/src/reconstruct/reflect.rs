@@ -49,7 +49,8 @@ pub(super) fn fill(
 
 #[cfg(test)]
 mod tests {
-    use plenoptic_recon::specular::{MAX_STEPS, REFINE_STEPS, STEP_TEXELS};
+    use plenoptic_recon::flat_rays::NO_TRIANGLES;
+    use plenoptic_recon::specular::{MAX_STEPS, RAY_OFFSET, REFINE_STEPS, STEP_TEXELS};
 
     /// The march's constants in `reflect.wgsl` are the runtime core's (the GPU frame equals
     /// the CPU's only if both step alike).
@@ -63,5 +64,11 @@ mod tests {
         ] {
             assert!(wgsl.contains(&line), "reflect.wgsl lacks `{line}`");
         }
+        let geometry = include_str!("geometry.wgsl");
+        let line = format!("const RAY_OFFSET: f32 = {RAY_OFFSET:?};");
+        assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+        let rays = include_str!("rays.wgsl");
+        let line = format!("const NO_TRIANGLES: u32 = {NO_TRIANGLES:#x}u;");
+        assert!(rays.contains(&line), "rays.wgsl lacks `{line}`");
     }
 }

@@ -1,0 +1,121 @@
+// Reflected rays cast against the proxies (rays.rs): plenoptic_recon::flat_rays's layout,
+// walked as FlatRays::occluded walks it, step for step. A stackless walk over depth-first
+// nodes with miss links (Smits 1998); every link points forward, so it ends.
+#define_import_path plenoptic::rays
+
+#ifdef PLENOPTIC_STANDARD
+@group(#{MATERIAL_BIND_GROUP}) @binding(112) var<storage, read> rays: array<vec4<f32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(113) var<storage, read> ray_placements: array<vec4<f32>>;
+#else
+// The pack's words: header, moving table, nodes, triangles (flat_rays.rs's module doc).
+@group(#{MATERIAL_BIND_GROUP}) @binding(12) var<storage, read> rays: array<vec4<f32>>;
+// The camera's moving objects placed at its time: three rows of world → object per object.
+@group(#{MATERIAL_BIND_GROUP}) @binding(13) var<storage, read> ray_placements: array<vec4<f32>>;
+#endif
+
+const NO_TRIANGLES: u32 = 0xffffffffu;
+
+// Whether the pack has proxy geometry to cast against.
+fn has_rays() -> bool {
+    return bitcast<u32>(rays[0].w) != 0u;
+}
+
+fn safe_recip(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1e-12);
+    let s = select(d, select(-tiny, tiny, d >= vec3<f32>(0.0)), abs(d) < tiny);
+    return 1.0 / s;
+}
+
+fn meets_box(origin: vec3<f32>, inv: vec3<f32>, tmax: f32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let a = (lo - origin) * inv;
+    let b = (hi - origin) * inv;
+    let lo_t = min(a, b);
+    let hi_t = max(a, b);
+    let near = max(max(max(lo_t.x, lo_t.y), lo_t.z), 0.0);
+    let far = min(min(min(hi_t.x, hi_t.y), hi_t.z), tmax);
+    return near <= far;
+}
+
+// Möller–Trumbore, both faces, a hit at 0 ≤ t ≤ tmax.
+fn hits_triangle(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> bool {
+    let e1 = v0 - v1;
+    let e2 = v2 - v0;
+    let n = cross(e1, e2);
+    let c = v0 - origin;
+    let r = cross(dir, c);
+    let det = dot(n, dir);
+    if det == 0.0 {
+        return false;
+    }
+    let inv_det = 1.0 / det;
+    let u = dot(r, e2) * inv_det;
+    let v = dot(r, e1) * inv_det;
+    let w = 1.0 - u - v;
+    if u < 0.0 || v < 0.0 || w < 0.0 {
+        return false;
+    }
+    let t = dot(n, c) * inv_det;
+    return t >= 0.0 && t <= tmax;
+}
+
+// The walk of the node words first..end.
+fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    let inv = safe_recip(dir);
+    var i = first;
+    while i < end {
+        let a = rays[i];
+        let b = rays[i + 1u];
+        if !meets_box(origin, inv, tmax, a.xyz, b.xyz) {
+            i = bitcast<u32>(a.w);
+            continue;
+        }
+        let leaf = bitcast<u32>(b.w);
+        if leaf == NO_TRIANGLES {
+            i += 2u;
+            continue;
+        }
+        var j = leaf;
+        loop {
+            let v0 = rays[j];
+            if hits_triangle(origin, dir, tmax, v0.xyz, rays[j + 1u].xyz, rays[j + 2u].xyz) {
+                return true;
+            }
+            if v0.w != 0.0 {
+                break;
+            }
+            j += 3u;
+        }
+        i = bitcast<u32>(a.w);
+    }
+    return false;
+}
+
+// Whether any proxy lies along the ray from `origin` along `dir` closer than `tmax`.
+fn occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    let header = rays[0];
+    if bitcast<u32>(header.w) == 0u {
+        return false;
+    }
+    if traverse(bitcast<u32>(header.x), bitcast<u32>(header.y), origin, dir, tmax) {
+        return true;
+    }
+    let moving = bitcast<u32>(header.z);
+    let placed = arrayLength(&ray_placements) / 3u;
+    for (var k = 0u; k < moving; k++) {
+        if k >= placed {
+            break;
+        }
+        let entry = rays[1u + k];
+        let r0 = ray_placements[3u * k];
+        let r1 = ray_placements[3u * k + 1u];
+        let r2 = ray_placements[3u * k + 2u];
+        let o = vec4<f32>(origin, 1.0);
+        let d = vec4<f32>(dir, 0.0);
+        let o_obj = vec3<f32>(dot(r0, o), dot(r1, o), dot(r2, o));
+        let d_obj = vec3<f32>(dot(r0, d), dot(r1, d), dot(r2, d));
+        if traverse(bitcast<u32>(entry.x), bitcast<u32>(entry.y), o_obj, d_obj, tmax) {
+            return true;
+        }
+    }
+    return false;
+}
