@@ -8,6 +8,12 @@
 //! decoded to linear and metallic multiplied by the metallic-roughness texture's blue channel.
 //! UVs pass through the binding's `KHR_texture_transform` and wrap modes first.
 //!
+//! Normal maps bend the shading normal as the path tracer bends it (tangent frame from the
+//! proxy's interpolated tangent, Gram–Schmidt against the interpolated normal, the
+//! bitangent's sign from the triangle's first vertex; `normal_scale` on x and y): the runtime
+//! sun and reflections use the bent normal at screen resolution, while the stored lighting
+//! holds its average over a cube texel (the bake's paths start on the bent normal).
+//!
 //! Textures are decoded from the pack on first use and kept (their size is bounded by the
 //! pack's `MAX_TEXTURE_SIDE`); one that cannot be read is reported once and treated as white.
 
@@ -20,10 +26,12 @@ use plenoptic_pack::{
     ColourSpace, MaterialEntry, PackReader, TextureBinding, TextureImage, UvTransform, WrapMode,
 };
 
-/// One object's material and the UVs of its proxy vertices (empty: none).
+/// One object's material and the UVs and tangents of its proxy vertices (empty: none).
 pub(crate) struct ObjectMaterial {
     pub material: MaterialEntry,
     pub uvs: Vec<Vec2>,
+    /// Unit xyz, the bitangent's sign in w (glTF's TANGENT).
+    pub tangents: Vec<Vec4>,
 }
 
 /// The materials of a pack's objects, with their textures decoded on first use.
@@ -43,7 +51,7 @@ fn srgb_table() -> &'static [f32; 256] {
 }
 
 impl Materials {
-    /// Reads the material table, each object's material and its proxy's UVs (whose vertex
+    /// Reads the material table, each object's material and its proxy's UVs and tangents (whose vertex
     /// count the pack reader checked against the proxy mesh).
     pub fn load(pack: &PackReader) -> Self {
         let mut objects = HashMap::new();
@@ -52,11 +60,11 @@ impl Materials {
             let Some(material) = pack.object_material(o.id) else {
                 continue;
             };
-            let uvs = match pack.proxy_attributes(o.id) {
-                Ok(a) => a.map(|a| a.uvs).unwrap_or_default(),
+            let (uvs, tangents) = match pack.proxy_attributes(o.id) {
+                Ok(a) => a.map(|a| (a.uvs, a.tangents)).unwrap_or_default(),
                 Err(e) => {
                     missing.push(format!("UVs of object {}: {e}", o.id));
-                    Vec::new()
+                    Default::default()
                 }
             };
             objects.insert(
@@ -64,6 +72,7 @@ impl Materials {
                 ObjectMaterial {
                     material: material.clone(),
                     uvs,
+                    tangents,
                 },
             );
         }
@@ -151,6 +160,34 @@ impl Materials {
         }
         e
     }
+
+    /// The tangent-space normal of material `m`'s normal map at `uv` (x and y scaled by its
+    /// `normal_scale`, not normalised), with the mip chosen from `footprint` as in
+    /// [`Materials::surface`]; `None` when it has no normal map or it cannot be read.
+    pub fn normal(
+        &self,
+        pack: &PackReader,
+        m: &MaterialEntry,
+        uv: Vec2,
+        footprint: f32,
+    ) -> Option<Vec3> {
+        let b = m.normal_texture?;
+        let t = self.texture(pack, b.texture)?;
+        let c = sample(t, b, uv, footprint).truncate() * 2.0 - Vec3::ONE;
+        Some(Vec3::new(c.x * m.normal_scale, c.y * m.normal_scale, c.z))
+    }
+}
+
+/// Shading normal `ns` bent by tangent-space normal `local` in the frame of `tangent` (world,
+/// not necessarily unit or orthogonal to `ns`) with bitangent sign `sign`, as the path tracer
+/// bends it; `ns` itself where the frame degenerates.
+pub(crate) fn bend_normal(ns: Vec3, tangent: Vec3, sign: f32, local: Vec3) -> Vec3 {
+    let t = (tangent - ns * ns.dot(tangent)).normalize_or_zero();
+    if t == Vec3::ZERO {
+        return ns;
+    }
+    let b = ns.cross(t) * if sign < 0.0 { -1.0 } else { 1.0 };
+    (t * local.x + b * local.y + ns * local.z).normalize_or(ns)
 }
 
 /// `KHR_texture_transform` applied to `uv`.
@@ -286,6 +323,27 @@ mod tests {
             ..binding()
         };
         assert!(sample(&t, scaled, Vec2::new(0.3125, 0.0625), 0.0).x.abs() < 1e-6);
+    }
+
+    #[test]
+    fn normal_maps_bend_along_the_tangent_frame() {
+        let up = Vec3::Y;
+        // The flat normal map's (0.5, 0.5, 1) leaves the normal alone.
+        assert!((bend_normal(up, Vec3::X, 1.0, Vec3::Z) - up).length() < 1e-6);
+        // Tilted towards +tangent; a tangent not orthogonal to the normal is made so.
+        let tilted = Vec3::new(0.6, 0.0, 0.8);
+        let n = bend_normal(up, Vec3::new(2.0, 0.5, 0.0), 1.0, tilted);
+        assert!((n - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-5, "{n}");
+        // The bitangent is n × t, flipped by a negative sign.
+        let along_b = Vec3::new(0.0, 0.6, 0.8);
+        assert!(
+            (bend_normal(up, Vec3::X, 1.0, along_b) - Vec3::new(0.0, 0.8, -0.6)).length() < 1e-5
+        );
+        assert!(
+            (bend_normal(up, Vec3::X, -1.0, along_b) - Vec3::new(0.0, 0.8, 0.6)).length() < 1e-5
+        );
+        // A tangent along the normal has no frame.
+        assert_eq!(bend_normal(up, Vec3::Y, 1.0, tilted), up);
     }
 
     #[test]

@@ -28,9 +28,12 @@
 //! non-diffuse radiance is replaced by their emission at the pixel's UV plus the reflected
 //! ray's radiance, marched through the base views' distance cubes.
 //!
-//! Not yet built: normal maps (the stored lighting is for the texel's normal only), emissive
-//! textures on surfaces that are not marched (emission is in the non-diffuse cube at cube
-//! resolution).
+//! Normal maps bend each pixel's shading normal ([`crate::material::bend_normal`]), which the
+//! runtime sun and the reflections use; the stored lighting stays at cube resolution (its
+//! texels average the bent normals they cover).
+//!
+//! Not yet built: emissive textures on surfaces that are not marched (emission is in the
+//! non-diffuse cube at cube resolution).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -320,6 +323,13 @@ fn surface_image(
                 let to_world = xf.matrix3.inverse().transpose();
                 tri.map(|i| to_world * mesh.normals[i as usize])
             });
+            // Tangents only where a normal map needs them (placed as the tracer places them).
+            let tangents = (m.material.normal_texture.is_some()
+                && m.tangents.len() == mesh.positions.len())
+            .then(|| {
+                let t = tri.map(|i| m.tangents[i as usize]);
+                (t.map(|t| xf.matrix3 * t.truncate()), t[0].w)
+            });
             let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
             if xf.matrix3.determinant() < 0.0 {
                 // The tracer's geometric normal is the object-space one carried by the normal
@@ -327,6 +337,7 @@ fn surface_image(
                 t.normal = -t.normal;
             }
             t.normals = normals;
+            t.tangents = tangents;
             Some(t)
         })
         .collect();
@@ -371,6 +382,13 @@ fn surface_image(
             let mut ns = t.normals.map_or(ng, |[a, c, d]| {
                 (a * b.x + c * b.y + d * b.z).normalize_or(ng)
             });
+            if let Some(([ta, tb, tc], sign)) = t.tangents
+                && let Some(local) =
+                    materials.normal(rec.pack(), &t.material.material, uv, uv_footprint)
+            {
+                let tangent = ta * b.x + tb * b.y + tc * b.z;
+                ns = crate::material::bend_normal(ns, tangent, sign, local);
+            }
             if ns.dot(ng) < 0.0 {
                 ns = -ns;
             }
@@ -447,6 +465,9 @@ struct SurfaceTriangle<'m> {
     normal: Vec3,
     /// Vertex normals placed in the world, when the proxy has them.
     normals: Option<[Vec3; 3]>,
+    /// Vertex tangents placed in the world and the bitangent's sign, when the material has a
+    /// normal map and the proxy tangents.
+    tangents: Option<([Vec3; 3], f32)>,
     uv: Option<[Vec2; 3]>,
     /// √(UV area / world area).
     scale: f32,
@@ -478,6 +499,7 @@ impl<'m> SurfaceTriangle<'m> {
             inv: [d11 / den, -d01 / den, d00 / den],
             normal: world.normalize_or_zero(),
             normals: None,
+            tangents: None,
             uv,
             scale,
         })
@@ -502,6 +524,7 @@ mod tests {
         let m = crate::material::ObjectMaterial {
             material: Default::default(),
             uvs: Vec::new(),
+            tangents: Vec::new(),
         };
         let v = [Vec3::ZERO, Vec3::X * 2.0, Vec3::new(0.0, 3.0, 1.0)];
         let t = SurfaceTriangle::new(1, &m, v, None).unwrap();
