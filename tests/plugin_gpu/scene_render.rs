@@ -261,6 +261,50 @@ fn gpu_reflections_match_cpu() {
     );
 }
 
+/// Normal maps on the GPU: the room with a skylight under the runtime sun, every object
+/// with a normal map of leaning stripes. The fragment bends its normal in the proxy's
+/// tangent frame as the CPU bends each pixel's, so the sun's light shows the stripes alike.
+#[test]
+fn gpu_frame_with_normal_maps_matches_cpu() {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let mode = ReconMode::GeometryAssisted;
+    let extras = |materials| PackExtras {
+        materials,
+        direct_sun: true,
+        open: true,
+    };
+    let f = plugin_and_cpu_frames_with(
+        Backend::Gpu,
+        3000,
+        None,
+        view,
+        mode,
+        extras(Materials::Bumpy),
+    );
+    let flat = plugin_and_cpu_frames_with(
+        Backend::Cpu,
+        3000,
+        None,
+        view,
+        mode,
+        extras(Materials::Factors),
+    );
+    let (apart, same, _) = compare(&f.cpu, &flat.cpu);
+    eprintln!("with normal maps against without (CPU): mean {apart:.3}, within 5 % {same:.3}");
+    assert!(
+        apart > 0.02 && same < 0.9,
+        "the normal maps show: {apart}, {same}"
+    );
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    eprintln!(
+        "GPU against CPU with normal maps: mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
+    assert!(
+        mean < 0.006 && f5 > 0.98 && f20 > 0.99,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
 /// Pack 3's runtime sun on the GPU (the room with a skylight): the fragment adds the sun's
 /// direct light through the material's BSDF, shadowed by Bevy's shadow map of the plugin's
 /// sun light, where the CPU casts shadow rays against the proxies. Away from shadow edges the two agree; at them the

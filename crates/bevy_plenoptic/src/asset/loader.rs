@@ -90,15 +90,15 @@ impl AssetLoader for RadiancePackLoader {
         failed.extend(env_error.map(|e| ("environment".to_string(), e)));
         let mut proxies = Vec::new();
         for proxy in read {
-            // The proxy's UVs (pack 1.2+), for the material textures.
-            let uvs = match pack.proxy_attributes(proxy.id) {
-                Ok(a) => a.map(|a| a.uvs).unwrap_or_default(),
+            // The proxy's UVs and tangents (pack 1.2+), for the material textures.
+            let (uvs, tangents) = match pack.proxy_attributes(proxy.id) {
+                Ok(a) => a.map(|a| (a.uvs, a.tangents)).unwrap_or_default(),
                 Err(e) => {
                     failed.push((format!("UVs of object {}", proxy.id), e.to_string()));
-                    Vec::new()
+                    Default::default()
                 }
             };
-            let mesh = proxy_to_mesh(&proxy.mesh, &uvs);
+            let mesh = proxy_to_mesh(&proxy.mesh, &uvs, &tangents);
             let handle = load_context.add_labeled_asset(format!("proxy{}", proxy.id), mesh);
             proxies.push(ProxyObject {
                 id: proxy.id,
@@ -181,9 +181,11 @@ fn texture_sampler(pack: &PackReader, index: u32) -> bevy::image::ImageSampler {
 }
 
 /// A proxy mesh as a flat-shaded Bevy triangle mesh (vertices duplicated per face), with
-/// TEXCOORD_0 when `uvs` has one per proxy vertex. Triangles with an index outside the
-/// positions are dropped whole, as `plenoptic_recon` drops them.
-pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh, uvs: &[Vec2]) -> Mesh {
+/// TEXCOORD_0 when `uvs` has one per proxy vertex and TANGENT when `tangents` has (each
+/// corner's w the bitangent sign of its triangle's first vertex, as `plenoptic_recon` and the
+/// path tracer take it). Triangles with an index outside the positions are dropped whole, as
+/// `plenoptic_recon` drops them.
+pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh, uvs: &[Vec2], tangents: &[Vec4]) -> Mesh {
     let n = proxy.positions.len();
     let corners: Vec<usize> = proxy
         .indices
@@ -204,6 +206,17 @@ pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh, uvs: &[Vec2]) -> Mesh {
     if uvs.len() == n && n > 0 {
         let uv: Vec<[f32; 2]> = corners.iter().map(|&i| uvs[i].to_array()).collect();
         mesh.insert_attribute(Mesh::ATTRIBUTE_UV_0, uv);
+    }
+    if tangents.len() == n && n > 0 {
+        let t: Vec<[f32; 4]> = corners
+            .chunks_exact(3)
+            .flat_map(|tri| {
+                let sign = if tangents[tri[0]].w < 0.0 { -1.0 } else { 1.0 };
+                tri.iter()
+                    .map(move |&i| tangents[i].truncate().extend(sign).to_array())
+            })
+            .collect();
+        mesh.insert_attribute(Mesh::ATTRIBUTE_TANGENT, t);
     }
     mesh.compute_flat_normals();
     mesh

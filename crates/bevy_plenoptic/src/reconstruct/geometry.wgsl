@@ -1,8 +1,9 @@
 // Geometry-assisted reconstruction (thesis §8.2.3), per fragment of a proxy mesh.
 // Same lookups and weights as plenoptic_recon::geometry (nearest or seamless bilinear texel, id + distance test,
 // w_view · w_time · ((1 + cos θ)/2)^p), with its volume fallback and hole fill. An object with a
-// material in a 2.0 pack is shaded as plenoptic_recon's shading module does it without textures:
-// albedo (the material's factors) · lighting + non-diffuse, both looked up bilinearly; on
+// material in a 2.0 pack is shaded as plenoptic_recon's shading module does it:
+// albedo (the material's factors × textures) · lighting + non-diffuse, both looked up
+// bilinearly, the runtime sun through the normal-mapped shading normal; on
 // mirrors and glossy metals the non-diffuse part is replaced by reflections marched for the
 // camera through the lookups' distance cubes (reflect.rs, reflect.wgsl).
 
@@ -45,15 +46,16 @@ struct ReconParams {
     flags: vec4<f32>,
     // The object's base-colour factor (xyz) and metallic factor (w) when flags.y is 1.
     albedo: vec4<f32>,
-    // x: transmission factor; y, z: largest side of the base-colour and metallic-roughness
-    // textures (0: none).
+    // x: transmission factor; y, z, w: largest side of the base-colour and metallic-roughness
+    // textures and of the normal map (0: none).
     material: vec4<f32>,
-    // KHR_texture_transform of the two textures: offset (xy), scale (zw); rotations in
-    // uv_rotation.xy.
+    // KHR_texture_transform of the three textures: offset (xy), scale (zw); rotations in
+    // uv_rotation.xyz.
     base_uv: vec4<f32>,
     mr_uv: vec4<f32>,
+    normal_uv: vec4<f32>,
     uv_rotation: vec4<f32>,
-    // x: roughness factor, y: IOR (the runtime sun's BSDF).
+    // x: roughness factor, y: IOR (the runtime sun's BSDF), z: the normal map's scale.
     surface: vec4<f32>,
     // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
     sun: vec4<f32>,
@@ -105,6 +107,8 @@ struct ReconParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(7) var base_colour_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(8) var metallic_roughness_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(9) var metallic_roughness_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(14) var normal_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(15) var normal_sampler: sampler;
 // The pack's environment at the camera's time, for reflected rays that leave the scene.
 @group(#{MATERIAL_BIND_GROUP}) @binding(10) var<uniform> env: Environment;
 @group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
@@ -168,6 +172,27 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     pixel_metallic = clamp(metallic, 0.0, 1.0);
     pixel_roughness = clamp(roughness, 0.0, 1.0);
     return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.material.x));
+}
+
+// The shading normal `ns` bent by the normal map at UV `uv` (footprint as above) in the
+// frame of `tangent` (xyz, the bitangent's sign in w), as plenoptic_recon's
+// material::bend_normal bends it; `ns` without a normal map or where the frame degenerates.
+fn bent_normal(ns: vec3<f32>, tangent: vec4<f32>, uv: vec2<f32>, footprint: f32) -> vec3<f32> {
+    if params.material.w <= 0.0 {
+        return ns;
+    }
+    let st = uv_transform(uv, params.normal_uv, params.uv_rotation.z);
+    let lod = level(footprint, params.normal_uv, params.material.w);
+    let c = textureSampleLevel(normal_texture, normal_sampler, st, lod).rgb * 2.0 - 1.0;
+    let local = vec3<f32>(c.xy * params.surface.z, c.z);
+    let t = tangent.xyz - ns * dot(ns, tangent.xyz);
+    if dot(t, t) <= 1e-20 {
+        return ns;
+    }
+    let tn = normalize(t);
+    let b = cross(ns, tn) * select(1.0, -1.0, tangent.w < 0.0);
+    let n = tn * local.x + b * local.y + ns * local.z;
+    return select(ns, normalize(n), dot(n, n) > 1e-20);
 }
 
 // plenoptic_pack::cube::oct_decode.
@@ -415,13 +440,17 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));
     // The material's albedo at the pixel (derivatives are taken before any non-uniform
     // branch). Without UVs the smallest level: the texture's mean, as on the CPU.
+    var v = in;
 #ifdef VERTEX_UVS_A
     let duv = abs(determinant(mat2x2<f32>(dpdx(in.uv), dpdy(in.uv))));
     pixel_albedo = material_albedo(in.uv, sqrt(duv));
+#ifdef VERTEX_TANGENTS
+    v.world_normal = bent_normal(normalize(in.world_normal), in.world_tangent, in.uv, sqrt(duv));
+#endif
 #else
     pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
 #endif
-    return shade(in, ng);
+    return shade(v, ng);
 }
 #endif
 

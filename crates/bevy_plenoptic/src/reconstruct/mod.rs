@@ -201,6 +201,10 @@ pub struct PlenopticMaterial {
     #[texture(8)]
     #[sampler(9)]
     pub metallic_roughness_texture: Option<Handle<Image>>,
+    /// Its normal map (linear; a flat one when it has none).
+    #[texture(14)]
+    #[sampler(15)]
+    pub normal_texture: Option<Handle<Image>>,
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see ([`reflect`]).
     #[uniform(10)]
@@ -282,15 +286,18 @@ pub struct ReconParams {
     /// The object's base-colour factor (xyz) and metallic factor (w) when `flags.y` is 1.
     pub albedo: Vec4,
     /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
-    /// z: the metallic-roughness texture's (0: none); w: unused.
+    /// z: the metallic-roughness texture's (0: none); w: the normal map's (0: none).
     pub material: Vec4,
     /// The base-colour texture's `KHR_texture_transform`: offset (xy), scale (zw).
     pub base_uv: Vec4,
     /// The metallic-roughness texture's: offset (xy), scale (zw).
     pub mr_uv: Vec4,
-    /// The rotations of the two transforms (x, y), radians.
+    /// The normal map's: offset (xy), scale (zw).
+    pub normal_uv: Vec4,
+    /// The rotations of the three transforms (x, y, z), radians.
     pub uv_rotation: Vec4,
-    /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]).
+    /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]), z: the normal
+    /// map's scale.
     pub surface: Vec4,
     /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
     pub sun: Vec4,
@@ -383,6 +390,7 @@ fn attach_materials(
             shading_cubes: tex.shading.clone(),
             base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
+            normal_texture: factors.as_ref().and_then(|f| f.normal.clone()),
             environment: background::EnvironmentUniform::default(),
             environment_image,
             rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
@@ -421,8 +429,10 @@ pub struct MaterialFactors {
     pub base_colour: Option<Handle<Image>>,
     /// Its metallic-roughness texture, likewise.
     pub metallic_roughness: Option<Handle<Image>>,
-    /// Largest sides of level 0 of the two (0: none).
-    pub sizes: (u32, u32),
+    /// Its normal map, likewise.
+    pub normal: Option<Handle<Image>>,
+    /// Largest sides of level 0 of the three (0: none).
+    pub sizes: (u32, u32, u32),
 }
 
 impl MaterialFactors {
@@ -435,12 +445,12 @@ impl MaterialFactors {
             m.transmission.clamp(0.0, 1.0),
             self.sizes.0 as f32,
             self.sizes.1 as f32,
-            0.0,
+            self.sizes.2 as f32,
         );
         params.surface = Vec4::new(
             m.roughness.clamp(0.0, 1.0),
             if m.ior > 0.0 { m.ior } else { 1.5 },
-            0.0,
+            m.normal_scale,
             0.0,
         );
         let uv = |b: Option<plenoptic_pack::TextureBinding>| {
@@ -454,9 +464,11 @@ impl MaterialFactors {
         };
         let (base, rb) = uv(m.base_colour_texture);
         let (mr, rm) = uv(m.metallic_roughness_texture);
+        let (normal, rn) = uv(m.normal_texture);
         params.base_uv = base;
         params.mr_uv = mr;
-        params.uv_rotation = Vec4::new(rb, rm, 0.0, 0.0);
+        params.normal_uv = normal;
+        params.uv_rotation = Vec4::new(rb, rm, rn, 0.0);
     }
 }
 
@@ -471,14 +483,17 @@ pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialF
     };
     let base = texture(m.base_colour_texture);
     let mr = texture(m.metallic_roughness_texture);
+    let normal = texture(m.normal_texture);
     Some(MaterialFactors {
         material: m.clone(),
         sizes: (
             base.as_ref().map_or(0, |t| t.1),
             mr.as_ref().map_or(0, |t| t.1),
+            normal.as_ref().map_or(0, |t| t.1),
         ),
         base_colour: base.map(|t| t.0),
         metallic_roughness: mr.map(|t| t.0),
+        normal: normal.map(|t| t.0),
     })
 }
 

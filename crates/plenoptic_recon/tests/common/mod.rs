@@ -377,6 +377,10 @@ pub enum Materials {
     /// [`Materials::Factors`], with the object named `pane` clear glass (transmission 1, IOR
     /// 1.5, white, roughness 0): see-through in the geometry-assisted mode.
     Glass,
+    /// [`Materials::Factors`] with a 64 × 64 normal map of stripes leaning ±30° on every
+    /// object, on the planar UVs and one tangent off every axis: what the runtime sun's light
+    /// shows of it tests that the backends bend the normal alike.
+    Bumpy,
 }
 
 impl PackSpec {
@@ -595,10 +599,15 @@ pub fn write_pack_with(
                 .iter()
                 .map(|p: &Vec3| Vec2::new(p.x + 0.5 * p.z, p.y - 0.5 * p.z))
                 .collect();
+            let bumpy = spec.materials == Materials::Bumpy;
             w.add_proxy_attributes(&plenoptic_pack::ProxyAttributes {
                 object_id: id,
                 uvs,
-                tangents: Vec::new(),
+                tangents: if bumpy {
+                    vec![Vec3::new(1.0, 0.3, 0.2).normalize().extend(1.0); positions.len()]
+                } else {
+                    Vec::new()
+                },
             })
             .unwrap();
             let (base, metallic, roughness) = match (spec.materials, obj.name.as_str()) {
@@ -620,6 +629,15 @@ pub fn write_pack_with(
                 ),
                 metallic,
                 roughness,
+                normal_texture: (spec.materials == Materials::Bumpy).then_some(
+                    plenoptic_pack::TextureBinding {
+                        texture: 0,
+                        wrap_s: Default::default(),
+                        wrap_t: Default::default(),
+                        transform: None,
+                    },
+                ),
+                normal_scale: 1.0,
                 transmission: if glass { 1.0 } else { 0.0 },
                 ior: 1.5,
                 ..Default::default()
@@ -645,31 +663,42 @@ pub fn write_pack_with(
         });
     }
     w.add_tracks(&tracks).unwrap();
-    if spec.materials == Materials::Textured {
-        let n = 256u32;
-        let texels: Vec<u8> = (0..n * n)
-            .flat_map(|i| {
-                let v = if ((i % n) / 8 + (i / n) / 8).is_multiple_of(2) {
-                    230
-                } else {
-                    90
-                };
-                [v, v, v, 255]
-            })
-            .collect();
-        let texture = plenoptic_pack::TextureImage::with_mips(
-            plenoptic_pack::ColourSpace::Srgb,
-            n,
-            n,
-            texels,
-        )
-        .unwrap();
+    if matches!(spec.materials, Materials::Textured | Materials::Bumpy) {
+        let (n, space, texels) = if spec.materials == Materials::Textured {
+            let n = 256u32;
+            let texels: Vec<u8> = (0..n * n)
+                .flat_map(|i| {
+                    let v = if ((i % n) / 8 + (i / n) / 8).is_multiple_of(2) {
+                        230
+                    } else {
+                        90
+                    };
+                    [v, v, v, 255]
+                })
+                .collect();
+            (n, plenoptic_pack::ColourSpace::Srgb, texels)
+        } else {
+            let n = 64u32;
+            // (±sin 30°, 0, cos 30°) as 8-bit linear values.
+            let texels = (0..n * n)
+                .flat_map(|i| {
+                    let x = if ((i % n) / 8).is_multiple_of(2) {
+                        191
+                    } else {
+                        64
+                    };
+                    [x, 128, 238, 255]
+                })
+                .collect();
+            (n, plenoptic_pack::ColourSpace::Linear, texels)
+        };
+        let texture = plenoptic_pack::TextureImage::with_mips(space, n, n, texels).unwrap();
         w.add_texture(0, &texture).unwrap();
         manifest.textures.push(plenoptic_pack::TextureEntry {
             width: n,
             height: n,
             levels: texture.levels.len() as u32,
-            colour_space: plenoptic_pack::ColourSpace::Srgb,
+            colour_space: space,
         });
     }
     let (a, b) = segment_ends();
