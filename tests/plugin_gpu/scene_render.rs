@@ -261,34 +261,32 @@ fn gpu_reflections_match_cpu() {
     );
 }
 
+/// The room with a skylight (its objects' `materials`, the sun left to the runtime when
+/// `direct_sun`) seen from the usual point on `backend`, with the CPU's frame beside it.
+fn skylit(backend: Backend, materials: Materials, direct_sun: bool) -> Frames {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let extras = PackExtras {
+        materials,
+        direct_sun,
+        open: true,
+    };
+    plugin_and_cpu_frames_with(
+        backend,
+        3000,
+        None,
+        view,
+        ReconMode::GeometryAssisted,
+        extras,
+    )
+}
+
 /// Normal maps on the GPU: the room with a skylight under the runtime sun, every object
 /// with a normal map of leaning stripes. The fragment bends its normal in the proxy's
 /// tangent frame as the CPU bends each pixel's, so the sun's light shows the stripes alike.
 #[test]
 fn gpu_frame_with_normal_maps_matches_cpu() {
-    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
-    let mode = ReconMode::GeometryAssisted;
-    let extras = |materials| PackExtras {
-        materials,
-        direct_sun: true,
-        open: true,
-    };
-    let f = plugin_and_cpu_frames_with(
-        Backend::Gpu,
-        3000,
-        None,
-        view,
-        mode,
-        extras(Materials::Bumpy),
-    );
-    let flat = plugin_and_cpu_frames_with(
-        Backend::Cpu,
-        3000,
-        None,
-        view,
-        mode,
-        extras(Materials::Factors),
-    );
+    let f = skylit(Backend::Gpu, Materials::Bumpy, true);
+    let flat = skylit(Backend::Cpu, Materials::Factors, true);
     let (apart, same, _) = compare(&f.cpu, &flat.cpu);
     eprintln!("with normal maps against without (CPU): mean {apart:.3}, within 5 % {same:.3}");
     assert!(
@@ -311,15 +309,8 @@ fn gpu_frame_with_normal_maps_matches_cpu() {
 /// shadow map's texels and filter decide.
 #[test]
 fn gpu_frame_with_runtime_sun_matches_cpu() {
-    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
-    let mode = ReconMode::GeometryAssisted;
-    let extras = |direct_sun| PackExtras {
-        materials: Materials::Factors,
-        direct_sun,
-        open: true,
-    };
-    let f = plugin_and_cpu_frames_with(Backend::Gpu, 3000, None, view, mode, extras(true));
-    let plain = plugin_and_cpu_frames_with(Backend::Cpu, 3000, None, view, mode, extras(false));
+    let f = skylit(Backend::Gpu, Materials::Factors, true);
+    let plain = skylit(Backend::Cpu, Materials::Factors, false);
     let (apart, same, _) = compare(&f.cpu, &plain.cpu);
     eprintln!("with the runtime sun against without: mean {apart:.3}, within 5 % {same:.3}");
     assert!(

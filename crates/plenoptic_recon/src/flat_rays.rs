@@ -291,8 +291,11 @@ fn meets_box(origin: Vec3, inv: Vec3, tmax: f32, lo: Vec3, hi: Vec3) -> bool {
     near <= far
 }
 
-/// Möller–Trumbore, both faces, a hit at `0 ≤ t ≤ tmax` (obvhs's test, as the CPU's BVHs use
-/// it).
+/// Möller–Trumbore, both faces, a hit at `0 ≤ t ≤ tmax`: obvhs's `Triangle::intersect`, but
+/// with `u, v, w ≥ 0` compared as numbers, as WGSL compares them. obvhs tests their sign
+/// bits, which rejects −0.0: a ray through the diagonal of a quad then misses both of its
+/// triangles (the hand-picked ray into the moving cube in the tests does). This twin of
+/// `rays.wgsl` keeps the shader's rule.
 fn hits_triangle(origin: Vec3, dir: Vec3, tmax: f32, v0: Vec3, v1: Vec3, v2: Vec3) -> bool {
     let e1 = v0 - v1;
     let e2 = v2 - v0;
