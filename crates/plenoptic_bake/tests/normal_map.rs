@@ -2,8 +2,9 @@
 //! sunlit floor whose normal map tilts alternate stripes towards and away from the sun. The
 //! sun's direct light is left to the runtime (pack 3), which bends each pixel's shading normal
 //! as the path tracer does, so the stripes show at screen resolution with the tracer's
-//! contrast; without the normal map the floor would be one flat grey (contrast 1). Frames go
-//! to `target/tmp/normal_map/`.
+//! contrast; without the normal map the floor would be one flat grey (contrast 1). A mirrored
+//! copy (negative scale) must lean its stripes the mirrored way, as the tracer leans them.
+//! Frames go to `target/tmp/normal_map/`.
 
 mod common;
 
@@ -14,10 +15,23 @@ use plenoptic_scene::builder::{LightDesc, MaterialDesc, NodeDesc, SceneBuilder};
 use plenoptic_trace::Image;
 use plenoptic_trace::image::luminance;
 
-/// Where the sunlight travels.
-fn sun_direction() -> Vec3 {
-    Vec3::new(0.5, -1.0, 0.3).normalize()
+/// One floor: how its stripes lean, how its node is placed and where the sunlight travels.
+#[derive(Clone, Copy)]
+struct Case {
+    /// The stripes lean along the tangent (u, x) or, when false, along the bitangent (v).
+    along_tangent: bool,
+    /// The node's scale: (1, 1, −1) mirrors the floor, as exporters write mirrored copies.
+    scale: Vec3,
+    /// Where the sunlight travels.
+    sun: Vec3,
 }
+
+/// The stripes lean towards and away from a sun from −x.
+const FACING_THE_SUN: Case = Case {
+    along_tangent: true,
+    scale: Vec3::ONE,
+    sun: Vec3::new(0.5, -1.0, 0.3),
+};
 
 /// Texels of the normal map along u; stripes are two texels wide, so that between the
 /// centres of a stripe's two texels the bilinear normal is the stripe's own.
@@ -26,35 +40,41 @@ const TEXELS: u32 = 32;
 const SIDE: f32 = 6.0;
 
 /// The tangent-space normal of stripe `s`: even stripes lean 35° towards +tangent (+x, away
-/// from the sun, which shines from −x), odd ones 35° towards −x.
-fn stripe_normal(s: u32) -> Vec3 {
+/// from the sun of [`FACING_THE_SUN`], which shines from −x), odd ones 35° towards −x; along
+/// the bitangent instead unless `along_tangent`.
+fn stripe_normal(s: u32, along_tangent: bool) -> Vec3 {
     let (sin, cos) = 35f32.to_radians().sin_cos();
-    Vec3::new(if s.is_multiple_of(2) { sin } else { -sin }, 0.0, cos)
+    let lean = if s.is_multiple_of(2) { sin } else { -sin };
+    if along_tangent {
+        Vec3::new(lean, 0.0, cos)
+    } else {
+        Vec3::new(0.0, lean, cos)
+    }
 }
 
 /// A `TEXELS × 4` linear normal map of the stripes.
-fn normal_map() -> Vec<u8> {
+fn normal_map(along_tangent: bool) -> Vec<u8> {
     let byte = |v: f32| ((v * 0.5 + 0.5) * 255.0).round() as u8;
     (0..4)
         .flat_map(|_| {
-            (0..TEXELS).flat_map(|i| {
-                let n = stripe_normal(i / 2);
+            (0..TEXELS).flat_map(move |i| {
+                let n = stripe_normal(i / 2, along_tangent);
                 [byte(n.x), byte(n.y), byte(n.z), 255]
             })
         })
         .collect()
 }
 
-fn scene() -> SceneBuilder {
+fn scene(case: Case) -> SceneBuilder {
     let mut b = SceneBuilder::new();
-    let map = b.add_texture_rgba8(TEXELS, 4, normal_map());
+    let map = b.add_texture_rgba8(TEXELS, 4, normal_map(case.along_tangent));
     let floor = b.add_material(MaterialDesc::diffuse(Vec3::splat(0.6)).normal_texture(map));
     let plane = b.add_plane("floor", Vec2::splat(SIDE), 1, floor);
-    b.add_node(NodeDesc::new("floor").mesh(plane));
+    b.add_node(NodeDesc::new("floor").mesh(plane).scale(case.scale));
     b.add_node(
         NodeDesc::new("sun")
             .light(LightDesc::directional(Vec3::ONE, 3.0))
-            .rotation(Quat::from_rotation_arc(Vec3::NEG_Z, sun_direction())),
+            .rotation(Quat::from_rotation_arc(Vec3::NEG_Z, case.sun.normalize())),
     );
     b
 }
@@ -87,12 +107,15 @@ fn stripe_means(camera: &Camera, object: &[u32], floor: u32, pixels: &[Vec3]) ->
     sums.map(|(s, n)| s / n as f64)
 }
 
-#[test]
-fn normal_maps_bend_the_runtime_suns_light_as_the_tracer_does() {
+/// Bakes `case`, renders it at the runtime and against the path tracer, writes the frames
+/// to `target/tmp/normal_map/{name}_*.png` and returns (the reference's contrast, the
+/// runtime's contrast, corrected relative LRMS, mean-luminance ratio), each contrast the odd
+/// stripes' mean over the even ones'.
+fn run(case: Case, name: &str) -> (f64, f64, f64, f64) {
     let dir = tempfile::tempdir().unwrap();
     let quality = "range_image_size = 16\nsamples_per_pixel = 2\nambient_samples = 16";
     let view = "kind = \"segment\"\na = [-0.5, 1.2, -1.5]\nb = [0.5, 1.2, -1.5]";
-    let recipe = common::write_recipe(dir.path(), &scene(), view, quality);
+    let recipe = common::write_recipe(dir.path(), &scene(case), view, quality);
     plenoptic_bake::bake_recipe(&recipe, &plenoptic_bake::BakeOptions::default()).unwrap();
     let scene = plenoptic_scene::load(&dir.path().join("scene.glb")).unwrap();
     let camera = Camera::look_at(
@@ -130,27 +153,55 @@ fn normal_maps_bend_the_runtime_suns_light_as_the_tracer_does() {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("normal_map");
     std::fs::create_dir_all(&out).unwrap();
     let exposure = 0.5 / a.mean_luminance() as f32;
-    a.save_png(out.join("reference.png"), exposure).unwrap();
-    recon.save_png(out.join("recon.png"), exposure).unwrap();
+    a.save_png(out.join(format!("{name}_reference.png")), exposure)
+        .unwrap();
+    recon
+        .save_png(out.join(format!("{name}_recon.png")), exposure)
+        .unwrap();
     println!(
-        "stripes facing the sun / facing away: reference {re:.4} / {ro:.4} = {:.3}, runtime \
-         {ce:.4} / {co:.4} = {:.3}; corrected relative LRMS {:.4}, mean luminance ratio \
-         {ratio:.4}",
+        "{name}: odd stripes / even: reference {ro:.4} / {re:.4} = {:.3}, runtime {co:.4} / \
+         {ce:.4} = {:.3}; corrected relative LRMS {:.4}, mean luminance ratio {ratio:.4}",
         ro / re,
         co / ce,
         lrms.corrected
     );
+    (ro / re, co / ce, lrms.corrected, ratio)
+}
+
+#[test]
+fn normal_maps_bend_the_runtime_suns_light_as_the_tracer_does() {
+    let (reference, runtime, _, ratio) = run(FACING_THE_SUN, "plain");
     // The odd stripes lean towards the sun: cos 0.93 against 0.45 for the even ones.
     assert!(
-        ro / re > 1.6,
-        "the reference shows the stripes: {}",
-        ro / re
+        reference > 1.6,
+        "the reference shows the stripes: {reference}"
     );
     assert!(
-        ((co / ce) / (ro / re) - 1.0).abs() < 0.1,
-        "runtime contrast {} against the reference's {}",
-        co / ce,
-        ro / re
+        (runtime / reference - 1.0).abs() < 0.1,
+        "runtime contrast {runtime} against the reference's {reference}"
+    );
+    assert!((ratio - 1.0).abs() < 0.05, "mean luminance ratio {ratio}");
+}
+
+/// A mirrored floor (scale z = −1) whose stripes lean along the bitangent, under a sun from
+/// −z: which stripes face the sun depends on the bitangent's handedness, which the mirror
+/// flips. The runtime must flip it as the tracer does (or the contrast comes out inverted).
+#[test]
+fn a_mirrored_normal_map_leans_the_same_way_at_the_runtime() {
+    let case = Case {
+        along_tangent: false,
+        scale: Vec3::new(1.0, 1.0, -1.0),
+        sun: Vec3::new(0.3, -1.0, 0.5),
+    };
+    let (reference, runtime, _, ratio) = run(case, "mirrored");
+    // One parity faces the sun, the other leans away from it.
+    assert!(
+        reference.max(1.0 / reference) > 1.4,
+        "the reference shows the stripes: {reference}"
+    );
+    assert!(
+        (runtime / reference - 1.0).abs() < 0.1,
+        "runtime contrast {runtime} against the reference's {reference}"
     );
     assert!((ratio - 1.0).abs() < 0.05, "mean luminance ratio {ratio}");
 }

@@ -328,7 +328,9 @@ fn surface_image(
                 && m.tangents.len() == mesh.positions.len())
             .then(|| {
                 let t = tri.map(|i| m.tangents[i as usize]);
-                (t.map(|t| xf.matrix3 * t.truncate()), t[0].w)
+                // A mirroring placement flips the bitangent's handedness, as in the tracer.
+                let sign = t[0].w * xf.matrix3.determinant().signum();
+                (t.map(|t| xf.matrix3 * t.truncate()), sign)
             });
             let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
             if xf.matrix3.determinant() < 0.0 {

@@ -372,7 +372,13 @@ impl<'a> PlacedScene<'a> {
             let t = inst.to_world.transform_vector3(t4.truncate());
             let t = (t - ns * ns.dot(t)).normalize_or_zero();
             if t != Vec3::ZERO {
-                let sign = if mesh.tangents[i0].w < 0.0 { -1.0 } else { 1.0 };
+                // The bitangent's handedness, flipped by a mirroring placement: the cross
+                // product of mirrored vectors is the mirror of theirs, negated (glTF's
+                // MikkTSpace tangents; Bevy's `mesh_tangent_local_to_world` does the same).
+                let mut sign = if mesh.tangents[i0].w < 0.0 { -1.0 } else { 1.0 };
+                if inst.to_world.matrix3.determinant() < 0.0 {
+                    sign = -sign;
+                }
                 let b = ns.cross(t) * sign;
                 let m = sample_ref(scene, &tex, uv);
                 let s = material.normal_scale;
