@@ -386,8 +386,10 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
 /// interpolates linearly between them).
 pub const SUN_TRACK_SAMPLES: usize = 256;
 
-/// The scene's environment and sun track over `[start, end]` as the pack stores them: `None`
-/// when the scene has neither.
+/// The scene's environment and sun track over `[start, end]` as the pack stores them; a scene
+/// with neither declares its environment none, so that the runtime shows black where no
+/// proxy is, as the tracer does (an undeclared environment makes the runtime show what a
+/// base view saw in the pixel's direction, which may be a wall).
 fn environment_entry(
     start: f32,
     end: f32,
@@ -405,7 +407,7 @@ fn environment_entry(
         .map(|l| DirectSun {
             angular_radius: l.angular_radius.clamp(0.0, DirectSun::MAX_ANGULAR_RADIUS),
         });
-    (!scene.environment.is_none() || sun.is_some()).then(|| EnvironmentEntry {
+    Some(EnvironmentEntry {
         direct_sun,
         ..EnvironmentEntry::new(&scene.environment, sun)
     })
@@ -558,7 +560,9 @@ mod environment_tests {
 
     #[test]
     fn the_manifest_carries_the_scenes_environment_and_sun_track() {
-        assert_eq!(environment_entry(0.0, 1.0, &Scene::default(), true), None);
+        // A scene without either declares none: black where no proxy is.
+        let none = environment_entry(0.0, 1.0, &Scene::default(), true).unwrap();
+        assert_eq!(none, EnvironmentEntry::new(&Environment::None, None));
         let track = SunTrack::new(vec![
             SunTrackSample {
                 time: 0.0,
