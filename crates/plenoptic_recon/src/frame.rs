@@ -106,8 +106,8 @@ pub struct FallbackReport {
     /// From temporal-volume samples (geometry-assisted fallback; all covered pixels in volume
     /// mode).
     pub volume: f32,
-    /// Filled from neighbours: same-object fill (geometry-assisted) or background fill (image,
-    /// volume).
+    /// Filled from neighbours: same-object fill in screen space, then the object's own texels
+    /// around the lookups (geometry-assisted), or background fill (image, volume).
     pub hole_fill: f32,
     /// Nothing matched: the nearest base view's cube along the pixel's direction, or black.
     pub background: f32,

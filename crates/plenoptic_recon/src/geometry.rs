@@ -13,8 +13,11 @@
 //!    `((1 + cos θ)/2)^p` of the view's direction to the point and the camera's.
 //! 4. No accepted lookup: the temporal-volume samples of the same object near that direction
 //!    and within t ± tε (tent filter in time); then the nearest accepted pixel of the same
-//!    object in screen space (same-object hole fill); then the nearest view's cube in the
-//!    point's direction regardless of id ("background").
+//!    object in screen space (same-object hole fill); then, in each key, the nearest texel
+//!    of the object itself, else of any surface at the point's distance, within
+//!    [`NEIGHBOUR_TEXELS`] of the lookup's texel (a thin object, a window's mullion seen from
+//!    afar, that no texel centre met: without this it showed the sky behind it); then the
+//!    nearest view's cube in the point's direction regardless of id ("background").
 //!
 //! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key. The pixel
 //! loop is parallel over bands of rows: each band of the mask is rasterized and then looked up
@@ -375,12 +378,14 @@ pub(crate) fn render(
     }
     report.stage_ms.push(("volume".into(), ms(start)));
     let start = Instant::now();
+    let slot = |o: u32| slot_of.get(o);
     let (hole, background) = hole_fill(
         &mut frame,
         &mut class,
         rec.settings.hole_fill_radius as i64,
         &keys,
         &point,
+        &slot,
     );
     frame.depth = depth;
     report.stage_ms.push(("hole_fill".into(), ms(start)));
@@ -401,14 +406,80 @@ enum MaskSource<'a> {
     Mask(&'a GeometryMask),
 }
 
-/// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search);
-/// what remains takes the heaviest view's cube in the point's direction. Returns the counts.
+/// Texels on either side of a lookup's texel (along each axis of its face) searched for the
+/// object itself when nothing else answered ([`neighbour_texel`]; the GPU searches alike).
+pub const NEIGHBOUR_TEXELS: i64 = 4;
+/// How far (relative) a neighbouring texel's distance may be from the point's: a thin
+/// object's neighbouring texel sees another part of it.
+pub const NEIGHBOUR_TOLERANCE: f32 = 0.25;
+
+/// Ranks another object's texel behind every texel of the object itself.
+const OTHER_OBJECT: i64 = 100;
+
+/// The colour of the nearest texel at about the distance of point `p` (at the frame's time;
+/// `slot` its motion's slot) within [`NEIGHBOUR_TEXELS`] of each key's lookup texel on the
+/// same face, the keys blended with their weights; `None` where no key has one. Texels of
+/// `object` itself come first; failing them, any surface's (a mullion that no texel centre
+/// met takes the lighting of the wall around its window, not the sky behind it). The
+/// nearest is the smallest offset, the first found in row order on ties.
+fn neighbour_texel(keys: &[ViewKey], slot: Option<usize>, object: u32, p: Vec3) -> Option<Vec3> {
+    let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
+    for k in keys.iter().filter(|k| k.weight > 1e-4) {
+        let q = slot
+            .and_then(|s| k.motion.get(s))
+            .map_or(p, |m| m.transform_point3(p));
+        let d = q - k.base;
+        let dist = d.length();
+        if dist <= 1e-6 {
+            continue;
+        }
+        let (ids, distance) = (&k.cubes.ids, &k.cubes.distance);
+        let n = ids.face_size.max(1) as i64;
+        let t = plenoptic_pack::cube::direction_to_texel(ids.face_size, d) as i64;
+        let (face, i, j) = (t / (n * n), t % n, (t / n) % n);
+        let mut best: Option<(i64, usize)> = None;
+        for dj in -NEIGHBOUR_TEXELS..=NEIGHBOUR_TEXELS {
+            for di in -NEIGHBOUR_TEXELS..=NEIGHBOUR_TEXELS {
+                let (x, y) = (i + di, j + dj);
+                if x < 0 || y < 0 || x >= n || y >= n {
+                    continue;
+                }
+                let idx = (face * n * n + y * n + x) as usize;
+                let Some(&id) = ids.texels.get(idx) else {
+                    continue;
+                };
+                // The object's own texels first, then any surface at the point's distance.
+                let score = di * di + dj * dj + if id == object { 0 } else { OTHER_OBJECT };
+                if id != 0
+                    && distance
+                        .texels
+                        .get(idx)
+                        .is_some_and(|&l| (l - dist).abs() <= NEIGHBOUR_TOLERANCE * dist)
+                    && best.is_none_or(|(b, _)| score < b)
+                {
+                    best = Some((score, idx));
+                }
+            }
+        }
+        if let Some(c) = best.and_then(|(_, idx)| k.cubes.radiance.texels.get(idx)) {
+            sum += *c * k.weight;
+            ws += k.weight;
+        }
+    }
+    (ws > 0.0).then(|| sum / ws)
+}
+
+/// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search),
+/// then from the nearest texels of the object around the lookups ([`neighbour_texel`]); what
+/// remains takes the heaviest view's cube in the point's direction. Returns the counts
+/// (filled, background).
 fn hole_fill(
     frame: &mut Frame,
     class: &mut [u8],
     radius: i64,
     keys: &[ViewKey],
     point: &(dyn Fn(usize) -> Vec3 + Sync),
+    slot: &(dyn Fn(u32) -> Option<usize> + Sync),
 ) -> (usize, usize) {
     let (w, h) = (frame.width as i64, frame.height as i64);
     let holes: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
@@ -442,7 +513,7 @@ fn hole_fill(
                     return (j, Some(sum / n as f32));
                 }
             }
-            (j, None)
+            (j, neighbour_texel(keys, slot(o), o, point(j)))
         })
         .collect();
     let env: Option<(Vec3, Arc<CubeImage<Vec3>>)> = keys

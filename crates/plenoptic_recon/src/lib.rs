@@ -105,6 +105,7 @@ pub mod warp;
 
 pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
+pub use geometry::{NEIGHBOUR_TEXELS, NEIGHBOUR_TOLERANCE};
 pub use motion::ObjectMotion;
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
