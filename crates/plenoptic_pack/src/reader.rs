@@ -304,6 +304,13 @@ impl PackReader {
         })
     }
 
+    /// Whether the non-diffuse radiance (cubes of kind 13, volume samples) leaves out the
+    /// surfaces' emission, which the runtime then takes from each object's material at the
+    /// pixel's UV (pack 4.0; `docs/pack-format.md`). Before 4.0 the emission is in it.
+    pub fn runtime_emission(&self) -> bool {
+        self.header().version_major >= crate::header::RUNTIME_EMISSION_MAJOR
+    }
+
     /// The header.
     pub fn header(&self) -> &Header {
         &self.header

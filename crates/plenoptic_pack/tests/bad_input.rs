@@ -69,12 +69,12 @@ fn wrong_magic() {
 #[test]
 fn unknown_major_version() {
     let mut b = small_pack();
-    rewrite_header(&mut b, |h| h.version_major = 4);
+    rewrite_header(&mut b, |h| h.version_major = 5);
     assert!(matches!(
         open(b).unwrap_err(),
         PackError::UnsupportedVersion {
-            major: 4,
-            supported: 3,
+            major: 5,
+            supported: 4,
             ..
         }
     ));
@@ -88,6 +88,15 @@ fn version_two_packs_still_open() {
     let r = open(b).unwrap();
     assert_eq!(r.header().version_major, 2);
     assert!(r.direct_sun().is_none());
+    assert!(!r.runtime_emission());
+}
+
+#[test]
+fn version_three_packs_keep_the_emission_in_the_non_diffuse_radiance() {
+    let mut b = small_pack();
+    rewrite_header(&mut b, |h| h.version_major = 3);
+    assert!(!open(b).unwrap().runtime_emission());
+    assert!(open(small_pack()).unwrap().runtime_emission());
 }
 
 #[test]
@@ -380,7 +389,7 @@ fn glazing_coverage_outside_zero_to_one_is_refused_and_named() {
 #[test]
 fn older_majors_are_outdated() {
     let dir = tempfile::tempdir().unwrap();
-    for (major, outdated) in [(1, true), (2, true), (3, false)] {
+    for (major, outdated) in [(1, true), (2, true), (3, true), (4, false)] {
         let mut b = small_pack();
         rewrite_header(&mut b, |h| h.version_major = major);
         let path = dir.path().join(format!("v{major}.pack"));

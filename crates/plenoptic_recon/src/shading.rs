@@ -2,15 +2,15 @@
 //! separating illumination quality from image quality): a pixel on an object with a material
 //! is
 //!
-//! `albedo(uv) · lighting + non-diffuse`
+//! `albedo(uv) · lighting + emission(uv) + non-diffuse`
 //!
-//! where the *lighting* and the *non-diffuse radiance* (emission plus the specular part as
-//! the base views saw it) are looked up in the range images exactly as the radiance was
+//! where the *lighting* and the *non-diffuse radiance* (the specular part as the base views
+//! saw it) are looked up in the range images exactly as the radiance was
 //! (motion-compensated, view- and time-blended, with the volume and hole-fill fallbacks of
 //! [`crate::geometry`]), and the *albedo* comes from the object's material at the pixel's own
-//! UV, with the texture's mip chosen by the pixel's footprint ([`crate::material`]). Texture
-//! detail is therefore at screen resolution whatever the cube size; only the lighting is at
-//! cube resolution.
+//! UV, with the texture's mip chosen by the pixel's footprint ([`crate::material`]), as does
+//! the *emission*. Texture detail is therefore at screen resolution whatever the cube size;
+//! only the lighting is at cube resolution.
 //!
 //! The lighting and non-diffuse lookups are always seam-aware bilinear
 //! ([`CubeFilter::Bilinear`]): at cube resolution, nearest texels show as blocks.
@@ -32,8 +32,9 @@
 //! runtime sun and the reflections use; the stored lighting stays at cube resolution (its
 //! texels average the bent normals they cover).
 //!
-//! Not yet built: emissive textures on surfaces that are not marched (emission is in the
-//! non-diffuse cube at cube resolution).
+//! Emission is the material's at the pixel's UV (factor × emissive texture, mip by footprint)
+//! where the pack leaves it to the runtime (pack 4.0); in older packs it is in the
+//! non-diffuse cube, at cube resolution, except on marched surfaces.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -155,6 +156,7 @@ pub(crate) fn render(
         .zip(rec.proxy_rays())
         .map(|(s, rays)| s.at(rays, proxy, t, rec.settings.sun_shadow_rays));
     let glossy = specular::glossy_allowed(rec);
+    let runtime_emission = rec.pack().runtime_emission();
     let (surface, raster_ms) =
         surface_image(rec, materials, camera, t, layer, sun.is_some(), glossy);
     timed("albedo", start);
@@ -214,6 +216,9 @@ pub(crate) fn render(
             // baked radiance holds what it lets through, which is composited apart).
             let baked = if px.see_through {
                 Vec3::ZERO
+            } else if runtime_emission {
+                // Pack 4: the emission at the pixel's UV, the specular part from the cubes.
+                non_diffuse.radiance[j] + px.emission
             } else {
                 non_diffuse.radiance[j]
             };
@@ -261,14 +266,16 @@ struct SurfacePixel {
     marched: bool,
     /// Transmissive glass drawn in the see-through layer: only its reflection is shown.
     see_through: bool,
-    /// Emitted radiance at the pixel's UV, where the specular part is marched (which
-    /// replaces the baked non-diffuse radiance that holds the emission); else zero.
+    /// Emitted radiance at the pixel's UV where the pack leaves the emission to the runtime
+    /// (pack 4) or the specular part is marched (which replaces the baked non-diffuse
+    /// radiance, holding the emission before pack 4); else zero.
     emission: Vec3,
 }
 
 /// Per pixel, the surface of an object with a material seen there (`None` where there is
 /// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it), its
-/// emission where its specular part is marched (`glossy`: [`specular::glossy_allowed`]); and
+/// emission where the pack leaves it to the runtime or its specular part is marched
+/// (`glossy`: [`specular::glossy_allowed`]); and
 /// the milliseconds its raster pass took.
 fn surface_image(
     rec: &Reconstructor,
@@ -433,7 +440,9 @@ fn surface_image(
                 },
                 glossy || see_through,
             );
-            let emission = if marched {
+            // A single-sided emitter emits from its front only, as the tracer has it.
+            let emits = t.material.material.double_sided || view.dot(ng) < 0.0;
+            let emission = if emits && (marched || rec.pack().runtime_emission()) {
                 materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
             } else {
                 Vec3::ZERO

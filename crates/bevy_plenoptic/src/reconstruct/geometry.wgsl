@@ -67,6 +67,11 @@ struct ReconParams {
     specular: vec4<f32>,
     // The material's emissive factor (xyz).
     emissive: vec4<f32>,
+    // The emissive texture's transform: offset (xy), scale (zw).
+    emissive_uv: vec4<f32>,
+    // x: the emissive texture's largest side (0: none), y: 1 when the pack leaves the
+    // emission to the runtime, z: 1 when double-sided, w: the texture's UV rotation.
+    emission: vec4<f32>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -109,6 +114,8 @@ struct ReconParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(9) var metallic_roughness_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(14) var normal_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(15) var normal_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(16) var emissive_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(17) var emissive_sampler: sampler;
 // The pack's environment at the camera's time, for reflected rays that leave the scene.
 @group(#{MATERIAL_BIND_GROUP}) @binding(10) var<uniform> env: Environment;
 @group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
@@ -122,6 +129,8 @@ var<private> pixel_metallic: f32;
 var<private> pixel_roughness: f32;
 // 0 where a marched reflection replaces the baked non-diffuse radiance.
 var<private> non_diffuse_weight: f32 = 1.0;
+// Its emission at its UV (pack 4 and marched surfaces; zero for app meshes).
+var<private> pixel_emission: vec3<f32>;
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
@@ -172,6 +181,22 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     pixel_metallic = clamp(metallic, 0.0, 1.0);
     pixel_roughness = clamp(roughness, 0.0, 1.0);
     return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.material.x));
+}
+
+// The emission at UV `uv` (footprint as above), as plenoptic_recon's Materials::emission:
+// the emissive factor × the sRGB texture; from the front only unless double-sided.
+fn material_emission(in: VertexOutput, uv: vec2<f32>, footprint: f32) -> vec3<f32> {
+    var e = params.emissive.xyz;
+    let front = dot(view.world_position - in.world_position.xyz, in.world_normal) > 0.0;
+    if params.emission.z != 1.0 && !front {
+        return vec3<f32>(0.0);
+    }
+    if params.emission.x > 0.0 && any(e != vec3<f32>(0.0)) {
+        let st = uv_transform(uv, params.emissive_uv, params.emission.w);
+        let lod = level(footprint, params.emissive_uv, params.emission.x);
+        e *= textureSampleLevel(emissive_texture, emissive_sampler, st, lod).rgb;
+    }
+    return e;
 }
 
 // The shading normal `ns` bent by the normal map at UV `uv` (footprint as above) in the
@@ -293,6 +318,57 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         }
         sum += radiance * w;
         ws += w;
+    }
+    return vec4<f32>(sum, ws);
+}
+
+// plenoptic_recon's NEIGHBOUR_TEXELS and NEIGHBOUR_TOLERANCE.
+const NEIGHBOUR_TEXELS: i32 = 4;
+const NEIGHBOUR_TOLERANCE: f32 = 0.25;
+
+// The fallback after the hole fill (plenoptic_recon's neighbour_texel): in each lookup's key,
+// the nearest texel at about the distance of `p` within NEIGHBOUR_TEXELS of the lookup's
+// texel on its face, `object`'s own first, then any surface's (the first in row order on
+// ties). Returns (Σ w·colour, Σ w).
+fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
+    let count = u32(params.header.x);
+    let n = u32(params.header.z);
+    var sum = vec3<f32>(0.0);
+    var ws = 0.0;
+    for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
+        let q = (params.motion[k] * vec4<f32>(p, 1.0)).xyz;
+        let d = q - params.base[k].xyz;
+        let dist = length(d);
+        if dist <= 1e-6 {
+            continue;
+        }
+        let t = cube_texel(d, n);
+        let layer0 = u32(params.base[k].w);
+        var best = 1000;
+        var best_c = t;
+        for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
+            for (var di = -NEIGHBOUR_TEXELS; di <= NEIGHBOUR_TEXELS; di++) {
+                let x = i32(t.x) + di;
+                let y = i32(t.y) + dj;
+                if x < 0 || y < 0 || x >= i32(n) || y >= i32(n) {
+                    continue;
+                }
+                let c = vec3<u32>(u32(x), u32(y), t.z);
+                let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
+                // The object's own texels first, then any surface at the point's distance.
+                let score = di * di + dj * dj + select(100, 0, texel.z == object);
+                if texel.z != 0u && abs(bitcast<f32>(texel.y) - dist) <= NEIGHBOUR_TOLERANCE * dist
+                    && score < best {
+                    best = score;
+                    best_c = c;
+                }
+            }
+        }
+        if best < 1000 {
+            let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
+            sum += colour(best_c, layer0, texel) * params.weight[k].x;
+            ws += params.weight[k].x;
+        }
     }
     return vec4<f32>(sum, ws);
 }
@@ -444,11 +520,13 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #ifdef VERTEX_UVS_A
     let duv = abs(determinant(mat2x2<f32>(dpdx(in.uv), dpdy(in.uv))));
     pixel_albedo = material_albedo(in.uv, sqrt(duv));
+    pixel_emission = material_emission(in, in.uv, sqrt(duv));
 #ifdef VERTEX_TANGENTS
     v.world_normal = bent_normal(normalize(in.world_normal), in.world_tangent, in.uv, sqrt(duv));
 #endif
 #else
     pixel_albedo = material_albedo(vec2<f32>(0.0), 1e9);
+    pixel_emission = material_emission(in, vec2<f32>(0.0), 1e9);
 #endif
     return shade(v, ng);
 }
@@ -462,8 +540,13 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         let r = reflection(in, ng);
         if r.w > 0.0 {
             non_diffuse_weight = 0.0;
-            reflected = params.emissive.xyz + r.rgb;
+            reflected = pixel_emission + r.rgb;
         }
+    }
+    // Pack 4 leaves the emission to the runtime: where no marched reflection carries it.
+    if lit() && params.fill.z != 1.0 && params.emission.y == 1.0 && non_diffuse_weight != 0.0
+        && !see_through() {
+        reflected += pixel_emission;
     }
     var c: vec4<f32>;
     if see_through() {
@@ -549,6 +632,11 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         if count > 0.0 {
             return vec4<f32>(sum / count, 1.0);
         }
+    }
+    // A thin object no texel centre met where the lookups fell: its own nearest texels.
+    let near = neighbour_texels(p, object);
+    if near.w > 0.0 {
+        return vec4<f32>(near.rgb / near.w, 1.0);
     }
     // Nothing: the heaviest key's texel in the point's direction ("background").
     let h = u32(params.fill.y);

@@ -205,6 +205,10 @@ pub struct PlenopticMaterial {
     #[texture(14)]
     #[sampler(15)]
     pub normal_texture: Option<Handle<Image>>,
+    /// Its emissive texture (sRGB; white when it has none).
+    #[texture(16)]
+    #[sampler(17)]
+    pub emissive_texture: Option<Handle<Image>>,
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see ([`reflect`]).
     #[uniform(10)]
@@ -309,6 +313,12 @@ pub struct ReconParams {
     pub specular: Vec4,
     /// The material's emissive factor (xyz), which marched surfaces add.
     pub emissive: Vec4,
+    /// The emissive texture's `KHR_texture_transform`: offset (xy), scale (zw).
+    pub emissive_uv: Vec4,
+    /// x: the emissive texture's largest side (0: none); y: 1 when the pack leaves the
+    /// emission to the runtime (pack 4: every lit fragment adds it); z: 1 when the material
+    /// is double-sided (else it emits from its front only); w: the texture's UV rotation.
+    pub emission: Vec4,
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
@@ -391,6 +401,7 @@ fn attach_materials(
             base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
             normal_texture: factors.as_ref().and_then(|f| f.normal.clone()),
+            emissive_texture: factors.as_ref().and_then(|f| f.emissive.clone()),
             environment: background::EnvironmentUniform::default(),
             environment_image,
             rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
@@ -431,8 +442,16 @@ pub struct MaterialFactors {
     pub metallic_roughness: Option<Handle<Image>>,
     /// Its normal map, likewise.
     pub normal: Option<Handle<Image>>,
-    /// Largest sides of level 0 of the three (0: none).
+    /// Its emissive texture, likewise.
+    pub emissive: Option<Handle<Image>>,
+    /// Largest sides of level 0 of the base-colour, metallic-roughness and normal textures
+    /// (0: none).
     pub sizes: (u32, u32, u32),
+    /// The emissive texture's (0: none).
+    pub emissive_size: u32,
+    /// Whether the pack leaves the emission to the runtime
+    /// ([`plenoptic_pack::PackReader::runtime_emission`]).
+    pub runtime_emission: bool,
 }
 
 impl MaterialFactors {
@@ -465,10 +484,19 @@ impl MaterialFactors {
         let (base, rb) = uv(m.base_colour_texture);
         let (mr, rm) = uv(m.metallic_roughness_texture);
         let (normal, rn) = uv(m.normal_texture);
+        let (emissive, re) = uv(m.emissive_texture);
         params.base_uv = base;
         params.mr_uv = mr;
         params.normal_uv = normal;
         params.uv_rotation = Vec4::new(rb, rm, rn, 0.0);
+        params.emissive = m.emissive.extend(0.0);
+        params.emissive_uv = emissive;
+        params.emission = Vec4::new(
+            self.emissive_size as f32,
+            if self.runtime_emission { 1.0 } else { 0.0 },
+            if m.double_sided { 1.0 } else { 0.0 },
+            re,
+        );
     }
 }
 
@@ -484,6 +512,7 @@ pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialF
     let base = texture(m.base_colour_texture);
     let mr = texture(m.metallic_roughness_texture);
     let normal = texture(m.normal_texture);
+    let emissive = texture(m.emissive_texture);
     Some(MaterialFactors {
         material: m.clone(),
         sizes: (
@@ -494,6 +523,9 @@ pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialF
         base_colour: base.map(|t| t.0),
         metallic_roughness: mr.map(|t| t.0),
         normal: normal.map(|t| t.0),
+        emissive_size: emissive.as_ref().map_or(0, |t| t.1),
+        emissive: emissive.map(|t| t.0),
+        runtime_emission: pack.reader.runtime_emission(),
     })
 }
 

@@ -5,14 +5,14 @@
 //! reads the hit's radiance around it from that key, blends the keys with their lookup
 //! weights × the angular closeness, and shows
 //!
-//! `albedo · lighting + emission + W(n·ω_o) · L_in`
+//! `albedo · lighting + emission(uv) + W(n·ω_o) · L_in`
 //!
 //! instead of the baked non-diffuse radiance (`geometry.wgsl`). Glossy lobes march 8 rays
 //! reflected about GGX half-vectors from the same Hammersley set, turned per pixel by the
 //! same golden-ratio sequence; rays that leave the scene see the pack's environment at the
 //! camera's time. Where no lookup answers, the baked non-diffuse radiance stays.
 //!
-//! Not on the GPU: emissive textures on marched surfaces (the emissive factor only).
+//! The emission is the material's at the fragment's UV (`pixel_emission`), as on the CPU.
 
 use bevy::prelude::*;
 use plenoptic_pack::MaterialEntry;
@@ -67,6 +67,18 @@ mod tests {
         let geometry = include_str!("geometry.wgsl");
         let line = format!("const RAY_OFFSET: f32 = {RAY_OFFSET:?};");
         assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+        for line in [
+            format!(
+                "const NEIGHBOUR_TEXELS: i32 = {};",
+                plenoptic_recon::NEIGHBOUR_TEXELS
+            ),
+            format!(
+                "const NEIGHBOUR_TOLERANCE: f32 = {:?};",
+                plenoptic_recon::NEIGHBOUR_TOLERANCE
+            ),
+        ] {
+            assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+        }
         let rays = include_str!("rays.wgsl");
         let line = format!("const NO_TRIANGLES: u32 = {NO_TRIANGLES:#x}u;");
         assert!(rays.contains(&line), "rays.wgsl lacks `{line}`");

@@ -10,13 +10,13 @@
 //! ([`plenoptic_trace::RadianceSample::diffuse`], [`plenoptic_trace::RadianceSample::albedo`])
 //! into a [`LightingCube`]:
 //!
-//! `radiance = albedo ⊙ lighting + residual`
+//! `radiance = albedo ⊙ lighting + residual + sun + emission`
 //!
 //! - `lighting`: the first hit's diffuse lighting, diffuse radiance / diffuse albedo per
 //!   channel (demodulated: textures are divided out, so filtering it does not blur them). This
 //!   is the only part filtered.
 //! - `albedo`: `(1 − metallic)(1 − transmission) · base colour`, mean over the texel's samples.
-//! - `residual`: emission, the specular/view-dependent part (glossy and mirror reflections,
+//! - `residual`: the specular/view-dependent part (glossy and mirror reflections,
 //!   refraction, the environment seen directly) and the diffuse radiance of channels whose
 //!   albedo is below [`MIN_ALBEDO`]. Not filtered: a reflection's detail is geometry seen in
 //!   another direction, not noise, and guides of the first hit cannot tell its edges.
@@ -25,6 +25,9 @@
 //!   to the runtime (shadow rays against the proxies at screen resolution). It is taken out of
 //!   the lighting and the residual before anything else, so the filter never sees sun-shadow
 //!   edges, and added back only into the radiance (image and volume modes warp that).
+//! - `emission`: what the first hit emits towards the ray, which pack 4 leaves to the runtime
+//!   (the material's emissive factor × texture at each pixel's UV, at screen resolution
+//!   instead of the cube's). Taken out with the sun, added back only into the radiance.
 //!
 //! This record is pack v2's "lighting apart from reflectance": the pack can store `lighting`
 //! (and `residual` as the view-dependent part) and the runtime multiply by `albedo(uv)`.
@@ -127,10 +130,13 @@ pub struct LightingCube {
     pub lighting: Vec<Vec3>,
     /// Diffuse albedo.
     pub albedo: Vec<Vec3>,
-    /// Emission, the specular/view-dependent part and undemodulated diffuse radiance.
+    /// The specular/view-dependent part and undemodulated diffuse radiance.
     pub residual: Vec<Vec3>,
     /// The first hit's direct sunlight, left to the runtime (see the module doc).
     pub sun: Vec<Vec3>,
+    /// The first hit's emission, left to the runtime (pack 4: the material's emission at
+    /// the pixel's own UV).
+    pub emission: Vec<Vec3>,
     /// Distance along the texel's centre ray; infinite for a miss.
     pub distance: Vec<f32>,
     /// Pack object id (0: none).
@@ -158,17 +164,25 @@ impl LightingCube {
             albedo: Vec::new(),
             residual: Vec::new(),
             sun: Vec::new(),
+            emission: Vec::new(),
             distance: Vec::new(),
             object: Vec::new(),
             normal: Vec::new(),
             variance: Vec::new(),
         };
         for s in samples {
-            let (lighting, albedo, residual, sun) = split(s);
+            let Split {
+                lighting,
+                albedo,
+                residual,
+                sun,
+                emission,
+            } = split(s);
             c.lighting.push(lighting);
             c.albedo.push(albedo);
             c.residual.push(residual);
             c.sun.push(sun);
+            c.emission.push(emission);
             c.distance.push(s.distance);
             c.object.push(pack_object_id(s.object));
             c.normal.push(s.normal);
@@ -192,9 +206,11 @@ impl LightingCube {
         self.object[i] != 0 && self.albedo[i].max_element() > MIN_ALBEDO
     }
 
-    /// Radiance of texel `i`: `albedo ⊙ lighting + residual + sun`, never negative.
+    /// Radiance of texel `i`: `albedo ⊙ lighting + residual + sun + emission`, never
+    /// negative.
     pub fn radiance(&self, i: usize) -> Vec3 {
-        (self.albedo[i] * self.lighting[i] + self.residual[i] + self.sun[i]).max(Vec3::ZERO)
+        (self.albedo[i] * self.lighting[i] + self.residual[i] + self.sun[i] + self.emission[i])
+            .max(Vec3::ZERO)
     }
 
     /// The range image of the records (pack v2): radiance re-modulated, the lighting with
@@ -307,22 +323,32 @@ impl LightingCube {
     }
 }
 
-/// `(lighting, non-diffuse)` of one rendered sample (a temporal-volume sample: pack v2 stores
-/// them beside its radiance), as a range-image texel splits them: both without the sun's
-/// direct light.
+/// `(lighting, non-diffuse)` of a volume sample, as a range image's texel stores them: the
+/// sun's direct light and the emission left out (both for the runtime).
 pub fn split_sample(s: &RadianceSample) -> (Vec3, Vec3) {
-    let (lighting, _, residual, _) = split(s);
-    (lighting, residual.max(Vec3::ZERO))
+    let split = split(s);
+    (split.lighting, split.residual.max(Vec3::ZERO))
 }
 
-/// `(lighting, albedo, residual, sun)` of a rendered sample: the sun's direct light is taken
-/// out first (clamped so that nothing goes negative), then the rest of the Lambertian part is
+/// A rendered sample taken apart: `radiance = albedo ⊙ lighting + residual + sun + emission`.
+struct Split {
+    lighting: Vec3,
+    albedo: Vec3,
+    residual: Vec3,
+    sun: Vec3,
+    emission: Vec3,
+}
+
+/// [`Split`] of a rendered sample: the sun's direct light and the emission are taken out
+/// first (clamped so that nothing goes negative), then the rest of the Lambertian part is
 /// demodulated by the albedo.
-fn split(s: &RadianceSample) -> (Vec3, Vec3, Vec3, Vec3) {
+fn split(s: &RadianceSample) -> Split {
     let radiance = s.radiance.max(Vec3::ZERO);
     let sun = s.sun.max(Vec3::ZERO).min(radiance);
     let sun_diffuse = s.sun_diffuse.max(Vec3::ZERO).min(sun);
     let radiance = radiance - sun;
+    let emission = s.emission.max(Vec3::ZERO).min(radiance);
+    let radiance = radiance - emission;
     let albedo = s.albedo;
     let diffuse = (s.diffuse - sun_diffuse).max(Vec3::ZERO).min(radiance);
     let mut lighting = Vec3::ZERO;
@@ -335,5 +361,11 @@ fn split(s: &RadianceSample) -> (Vec3, Vec3, Vec3, Vec3) {
     }
     // What is not demodulated stays in the residual, so radiance is exactly recovered.
     let albedo = Vec3::select(albedo.cmpgt(Vec3::splat(MIN_ALBEDO)), albedo, Vec3::ZERO);
-    (lighting, albedo, radiance - kept, sun)
+    Split {
+        lighting,
+        albedo,
+        residual: radiance - kept,
+        sun,
+        emission,
+    }
 }

@@ -130,6 +130,9 @@ impl<'f> MultiStageRenderer<'f> {
                 Some(p) => power_heuristic(p, placed.lights().emissive_pdf(ray.origin, &hit)),
             };
             l += le * w;
+            if let Some(out) = first.as_deref_mut() {
+                out.emission = le * w;
+            }
         }
         let wo = -ray.direction;
         let bsdf = Bsdf::new(&props, &hit, wo);
