@@ -3,7 +3,7 @@
 //! and the comparison of the two frames.
 
 use crate::common::*;
-use crate::pack::{Materials, PackSpec, open_room, room, write_pack};
+use crate::pack::{Materials, PackSpec, open_room, open_room_with_ball, room, write_pack};
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
@@ -15,6 +15,8 @@ pub(crate) struct Frames {
     pub(crate) gpu: Vec<Vec3>,
     /// plenoptic_recon's CPU frame.
     pub(crate) cpu: Vec<Vec3>,
+    /// The pack object id at each pixel of the CPU frame (0: none).
+    pub(crate) cpu_object: Vec<u32>,
     /// plenoptic_recon's CPU frame in geometry-assisted mode (whatever the compared mode).
     pub(crate) cpu_geometry: Vec<Vec3>,
     /// plenoptic_recon's CPU frame in image mode (whatever the compared mode).
@@ -80,6 +82,8 @@ pub(crate) struct PackExtras {
     pub(crate) direct_sun: bool,
     /// The room with a skylight instead of the closed one.
     pub(crate) open: bool,
+    /// With `open`, the room with a smooth-shaded ball on its floor.
+    pub(crate) ball: bool,
 }
 
 impl From<Materials> for PackExtras {
@@ -88,6 +92,7 @@ impl From<Materials> for PackExtras {
             materials,
             direct_sun: false,
             open: false,
+            ball: false,
         }
     }
 }
@@ -105,6 +110,7 @@ pub(crate) fn plugin_and_cpu_frames_with(
         materials,
         direct_sun,
         open,
+        ball,
     } = extras.into();
     use bevy::camera::Hdr;
     use bevy::render::render_resource::{TextureFormat, TextureUsages};
@@ -112,7 +118,11 @@ pub(crate) fn plugin_and_cpu_frames_with(
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("room.pack");
-    let scene = if open { open_room() } else { room(true) };
+    let scene = match (open, ball) {
+        (true, true) => open_room_with_ball(),
+        (true, false) => open_room(),
+        (false, _) => room(true),
+    };
     write_pack(
         &scene,
         &PackSpec {
@@ -213,6 +223,7 @@ pub(crate) fn plugin_and_cpu_frames_with(
     let data = settled_frame(&mut app, &image);
     Frames {
         gpu: decode(&data),
+        cpu_object: cpu.object,
         cpu: cpu.radiance,
         cpu_geometry: cpu_geometry.radiance,
         cpu_image: cpu_image.radiance,
@@ -249,13 +260,25 @@ pub(crate) fn compare(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
             .collect();
         eprintln!("{row}");
     }
-    let mean = (0..n).map(err).sum::<f32>() / n as f32;
-    let frac = |limit: f32| (0..n).filter(|&j| err(j) < limit).count() as f32 / n as f32;
-    let (f5, f20) = (frac(0.05), frac(0.2));
+    let (mean, f5, f20) = compare_on(gpu, cpu);
     eprintln!(
         "GPU vs CPU: mean relative error {mean:.5}, {:.2}% within 5%, {:.2}% within 20%",
         100.0 * f5,
         100.0 * f20
     );
     (mean, f5, f20)
+}
+
+/// [`compare`]'s figures for any set of pixels (no map): `gpu[i]` against `cpu[i]`.
+pub(crate) fn compare_on(gpu: &[Vec3], cpu: &[Vec3]) -> (f32, f32, f32) {
+    assert_eq!(gpu.len(), cpu.len());
+    let n = cpu.len().max(1);
+    let err: Vec<f32> = gpu
+        .iter()
+        .zip(cpu)
+        .map(|(g, c)| ((*g - *c).abs() / (c.abs() + Vec3::splat(0.02))).max_element())
+        .collect();
+    let mean = err.iter().sum::<f32>() / n as f32;
+    let frac = |limit: f32| err.iter().filter(|&&e| e < limit).count() as f32 / n as f32;
+    (mean, frac(0.05), frac(0.2))
 }

@@ -242,6 +242,29 @@ fn gpu_frame_from_textured_materials_matches_cpu() {
     );
 }
 
+/// Pack 4's emission on the GPU: the back wall emits through a checker texture, which the
+/// fragment samples at its UV with the CPU's level and adds as the CPU adds it (the pack's
+/// non-diffuse radiance no longer holds it).
+#[test]
+fn gpu_frame_with_emissive_texture_matches_cpu() {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let mode = ReconMode::GeometryAssisted;
+    let f = plugin_and_cpu_frames_with(Backend::Gpu, 3000, None, view, mode, Materials::Glowing);
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    let factors =
+        plugin_and_cpu_frames_with(Backend::Cpu, 3000, None, view, mode, Materials::Factors);
+    let (apart, _, _) = compare(&f.cpu, &factors.cpu);
+    eprintln!(
+        "emissive against factors only (CPU): mean {apart:.3}; GPU against CPU: mean \
+         {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
+    assert!(apart > 0.1, "the emission shows: {apart}");
+    assert!(
+        mean < 0.003 && f5 > 0.995 && f20 > 0.999,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
 /// Reflections for the camera on the GPU (`reflect.wgsl`): the room's left wall is a mirror
 /// and its right wall glossy metal; the fragment marches their reflected rays through the
 /// lookups' distance cubes as `plenoptic_recon::specular` does, and the frame equals the
@@ -264,11 +287,17 @@ fn gpu_reflections_match_cpu() {
 /// The room with a skylight (its objects' `materials`, the sun left to the runtime when
 /// `direct_sun`) seen from the usual point on `backend`, with the CPU's frame beside it.
 fn skylit(backend: Backend, materials: Materials, direct_sun: bool) -> Frames {
+    skylit_room(backend, materials, direct_sun, false)
+}
+
+/// [`skylit`], with a smooth-shaded ball on the floor when `ball`.
+fn skylit_room(backend: Backend, materials: Materials, direct_sun: bool, ball: bool) -> Frames {
     let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
     let extras = PackExtras {
         materials,
         direct_sun,
         open: true,
+        ball,
     };
     plugin_and_cpu_frames_with(
         backend,
@@ -278,6 +307,41 @@ fn skylit(backend: Backend, materials: Materials, direct_sun: bool) -> Frames {
         ReconMode::GeometryAssisted,
         extras,
     )
+}
+
+/// Smooth shading on the GPU: a coarse ball (12 × 6 facets) hanging in the room with a skylight
+/// under the runtime sun. The proxy meshes carry the pack's vertex normals, so the sun's light
+/// on the ball follows its interpolated normals as on the CPU instead of its facets.
+#[test]
+fn gpu_frame_shades_smooth_normals_as_cpu() {
+    let f = skylit_room(Backend::Gpu, Materials::Factors, true, true);
+    let ball = *f.cpu_object.iter().max().unwrap();
+    let on_ball: Vec<usize> = (0..f.cpu.len())
+        .filter(|&j| f.cpu_object[j] == ball)
+        .collect();
+    assert!(on_ball.len() > 100, "ball pixels: {}", on_ball.len());
+    let pick = |v: &[Vec3]| on_ball.iter().map(|&j| v[j]).collect::<Vec<_>>();
+    // The sun reaches the ball: its brightest pixels are well above its darkest.
+    let lum: Vec<f32> = pick(&f.cpu).iter().map(|c| c.dot(Vec3::ONE)).collect();
+    let (lo, hi) = lum
+        .iter()
+        .fold((f32::MAX, 0f32), |(lo, hi), &l| (lo.min(l), hi.max(l)));
+    assert!(hi > 3.0 * lo, "the ball is sunlit: {lo} to {hi}");
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    let (ball_mean, ball_f5, _) = crate::harness::compare_on(&pick(&f.gpu), &pick(&f.cpu));
+    eprintln!(
+        "GPU against CPU with a smooth ball: frame mean {mean:.4}, within 5 % {f5:.4}, within \
+         20 % {f20:.4}; on the ball ({} pixels) mean {ball_mean:.4}, within 5 % {ball_f5:.4}",
+        on_ball.len()
+    );
+    assert!(
+        mean < 0.006 && f5 > 0.98 && f20 > 0.99,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+    assert!(
+        ball_mean < 0.01 && ball_f5 > 0.95,
+        "on the ball: mean {ball_mean}, within 5 %: {ball_f5}"
+    );
 }
 
 /// Normal maps on the GPU: the room with a skylight under the runtime sun, every object

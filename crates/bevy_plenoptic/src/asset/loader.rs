@@ -180,8 +180,8 @@ fn texture_sampler(pack: &PackReader, index: u32) -> bevy::image::ImageSampler {
     })
 }
 
-/// A proxy mesh as a flat-shaded Bevy triangle mesh (vertices duplicated per face), with
-/// TEXCOORD_0 when `uvs` has one per proxy vertex and TANGENT when `tangents` has (each
+/// A proxy mesh as a Bevy triangle mesh (vertices duplicated per face), with the pack's vertex
+/// normals where it has one per vertex (flat normals otherwise), TEXCOORD_0 when `uvs` has one per proxy vertex and TANGENT when `tangents` has (each
 /// corner's w the bitangent sign of its triangle's first vertex, as `plenoptic_recon` and the
 /// path tracer take it). Triangles with an index outside the positions are dropped whole, as
 /// `plenoptic_recon` drops them.
@@ -218,6 +218,14 @@ pub fn proxy_to_mesh(proxy: &plenoptic_pack::ProxyMesh, uvs: &[Vec2], tangents: 
             .collect();
         mesh.insert_attribute(Mesh::ATTRIBUTE_TANGENT, t);
     }
-    mesh.compute_flat_normals();
+    // The pack's vertex normals where it has them (curved surfaces shade smoothly, as on the
+    // CPU, which interpolates them); the triangles' own normals elsewhere.
+    match proxy.normals.as_deref() {
+        Some(normals) if normals.len() == n && n > 0 => {
+            let normals: Vec<[f32; 3]> = corners.iter().map(|&i| normals[i].to_array()).collect();
+            mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
+        }
+        _ => mesh.compute_flat_normals(),
+    }
     mesh
 }

@@ -28,6 +28,22 @@ pub fn open_room() -> Scene {
     room_with(false, false)
 }
 
+/// The room of [`open_room`] with a ball hanging above its middle (high enough for the test
+/// packs' low sun to reach it over the walls): a coarse UV sphere (12 × 6) whose vertex
+/// normals are smooth, so that its shading normals differ from its facets' (which a renderer
+/// shades with shows in the sun's light on it). The ball is the last object.
+pub fn open_room_with_ball() -> Scene {
+    let mut b = room_builder(false, false, true);
+    let m = b.material(shapes::diffuse(Vec3::new(0.8, 0.7, 0.5)));
+    b.object(
+        "ball",
+        shapes::uv_sphere(0.4, 12, 6),
+        m,
+        Vec3::new(-0.3, 1.6, -1.0),
+    );
+    b.build()
+}
+
 /// The window of [`windowed_room`] in the front wall (z = 2.5): x from −0.8 to 0.8, y from
 /// 0.8 to 2.0.
 pub const WINDOW: (Vec2, Vec2) = (Vec2::new(-0.8, 0.8), Vec2::new(0.8, 2.0));
@@ -381,6 +397,10 @@ pub enum Materials {
     /// object, on the planar UVs and one tangent off every axis: what the runtime sun's light
     /// shows of it tests that the backends bend the normal alike.
     Bumpy,
+    /// [`Materials::Factors`], with the back wall emitting (factor (1, 0.7, 0.4)) through
+    /// [`Materials::Textured`]'s checker as its emissive texture: the runtime adds the
+    /// emission at each pixel's UV (pack 4).
+    Glowing,
 }
 
 impl PackSpec {
@@ -568,11 +588,25 @@ pub fn write_pack_with(
                 .map(|&p| to_world.transform_point3(p))
                 .collect()
         };
+        // Vertex normals placed as the positions are (the normal matrix for static objects).
+        let normal_matrix = to_world.matrix3.inverse().transpose();
+        let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
+            mesh.normals
+                .iter()
+                .map(|&n| {
+                    if animated {
+                        n
+                    } else {
+                        (normal_matrix * n).normalize_or(n)
+                    }
+                })
+                .collect()
+        });
         w.add_proxy_mesh(&ProxyMesh {
             object_id: id,
             positions: positions.clone(),
             indices: mesh.triangles.iter().flatten().copied().collect(),
-            normals: None,
+            normals,
         })
         .unwrap();
         if animated {
@@ -617,8 +651,20 @@ pub fn write_pack_with(
                 _ => (object_colour(i as u32), 0.0, 0.5),
             };
             let glass = spec.materials == Materials::Glass && obj.name == "pane";
+            let glowing = spec.materials == Materials::Glowing && obj.name == "back";
             manifest.materials.push(plenoptic_pack::MaterialEntry {
                 base_colour: base.extend(1.0),
+                emissive: if glowing {
+                    Vec3::new(1.0, 0.7, 0.4)
+                } else {
+                    Vec3::ZERO
+                },
+                emissive_texture: glowing.then_some(plenoptic_pack::TextureBinding {
+                    texture: 0,
+                    wrap_s: Default::default(),
+                    wrap_t: Default::default(),
+                    transform: None,
+                }),
                 base_colour_texture: (spec.materials == Materials::Textured).then_some(
                     plenoptic_pack::TextureBinding {
                         texture: 0,
@@ -663,8 +709,11 @@ pub fn write_pack_with(
         });
     }
     w.add_tracks(&tracks).unwrap();
-    if matches!(spec.materials, Materials::Textured | Materials::Bumpy) {
-        let (n, space, texels) = if spec.materials == Materials::Textured {
+    if matches!(
+        spec.materials,
+        Materials::Textured | Materials::Bumpy | Materials::Glowing
+    ) {
+        let (n, space, texels) = if spec.materials != Materials::Bumpy {
             let n = 256u32;
             let texels: Vec<u8> = (0..n * n)
                 .flat_map(|i| {
