@@ -144,17 +144,7 @@ fn emissive_textures_show_at_screen_resolution() {
     let recon = on_panel(&frame.radiance);
     let lrms = corrected_relative_lrms(&recon, &on_panel(&a.pixels), &on_panel(&b.pixels));
     let ratio = recon.mean_luminance() / on_panel(&mean).mean_luminance();
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("emission");
-    std::fs::create_dir_all(&out).unwrap();
-    let exposure = 0.5 / a.mean_luminance() as f32;
-    a.save_png(out.join("reference.png"), exposure).unwrap();
-    Image {
-        width: frame.width,
-        height: frame.height,
-        pixels: frame.radiance.clone(),
-    }
-    .save_png(out.join("recon.png"), exposure)
-    .unwrap();
+    common::save_frames("emission", "", &a, &frame);
     println!(
         "bright / dark squares: reference {rb:.4} / {rd:.4} = {:.2}, runtime {cb:.4} / {cd:.4} \
          = {:.2}; on the panel corrected relative LRMS {:.4}, mean luminance ratio {ratio:.4}",

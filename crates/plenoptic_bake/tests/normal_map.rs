@@ -150,14 +150,7 @@ fn run(case: Case, name: &str) -> (f64, f64, f64, f64) {
     };
     let lrms = corrected_relative_lrms(&recon, &a, &b);
     let ratio = recon.mean_luminance() / (0.5 * (a.mean_luminance() + b.mean_luminance()));
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("normal_map");
-    std::fs::create_dir_all(&out).unwrap();
-    let exposure = 0.5 / a.mean_luminance() as f32;
-    a.save_png(out.join(format!("{name}_reference.png")), exposure)
-        .unwrap();
-    recon
-        .save_png(out.join(format!("{name}_recon.png")), exposure)
-        .unwrap();
+    common::save_frames("normal_map", &format!("{name}_"), &a, &frame);
     println!(
         "{name}: odd stripes / even: reference {ro:.4} / {re:.4} = {:.3}, runtime {co:.4} / \
          {ce:.4} = {:.3}; corrected relative LRMS {:.4}, mean luminance ratio {ratio:.4}",

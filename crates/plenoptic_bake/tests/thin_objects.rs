@@ -12,7 +12,6 @@ mod common;
 use glam::{Vec2, Vec3};
 use plenoptic_recon::{Camera, Mode, Reconstructor};
 use plenoptic_scene::builder::{MaterialDesc, NodeDesc, SceneBuilder};
-use plenoptic_trace::Image;
 use plenoptic_trace::image::luminance;
 
 /// The window in the wall at z = −2: x from −0.6 to 0.6, y from 0.8 to 2.0.
@@ -103,17 +102,7 @@ fn a_mullion_no_texel_centre_meets_is_not_shown_as_the_sky() {
     let reference = 0.5 * (mean(&a.pixels) + mean(&b.pixels));
     let runtime = mean(&frame.radiance);
     let sky = 3.0;
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("thin_objects");
-    std::fs::create_dir_all(&out).unwrap();
-    let exposure = 0.5 / a.mean_luminance() as f32;
-    a.save_png(out.join("reference.png"), exposure).unwrap();
-    Image {
-        width: frame.width,
-        height: frame.height,
-        pixels: frame.radiance.clone(),
-    }
-    .save_png(out.join("recon.png"), exposure)
-    .unwrap();
+    common::save_frames("thin_objects", "", &a, &frame);
     println!(
         "mullion ({} pixels): runtime {runtime:.4}, reference {reference:.4} (ratio {:.3}; the \
          sky behind it {sky}); fallbacks {:?}",

@@ -160,3 +160,27 @@ pub fn reference_halves(
     };
     (half(seed), half(seed + 1))
 }
+
+/// Writes the reference and the reconstruction as `{prefix}reference.png` and
+/// `{prefix}recon.png` into `target/tmp/{dir}/`, both at the exposure that puts the
+/// reference's mean luminance at 0.5.
+pub fn save_frames(
+    dir: &str,
+    prefix: &str,
+    reference: &plenoptic_trace::Image<Vec3>,
+    recon: &plenoptic_recon::Frame,
+) {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(dir);
+    std::fs::create_dir_all(&out).unwrap();
+    let exposure = 0.5 / reference.mean_luminance() as f32;
+    reference
+        .save_png(out.join(format!("{prefix}reference.png")), exposure)
+        .unwrap();
+    plenoptic_trace::Image {
+        width: recon.width,
+        height: recon.height,
+        pixels: recon.radiance.clone(),
+    }
+    .save_png(out.join(format!("{prefix}recon.png")), exposure)
+    .unwrap();
+}
