@@ -633,7 +633,8 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
             return vec4<f32>(sum / count, 1.0);
         }
     }
-    // A thin object no texel centre met where the lookups fell: its own nearest texels.
+    // A thin object no texel centre met where the lookups fell: its own nearest texels, else
+    // those of the surface around it at its distance.
     let near = neighbour_texels(p, object);
     if near.w > 0.0 {
         return vec4<f32>(near.rgb / near.w, 1.0);
