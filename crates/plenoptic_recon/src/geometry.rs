@@ -408,7 +408,7 @@ enum MaskSource<'a> {
 
 /// Texels on either side of a lookup's texel (along each axis of its face) searched for the
 /// object itself, else any surface at the point's distance, when nothing else answered
-/// ([`neighbour_texel`]; the GPU searches alike). On the tour, 2 left Room A's mullions at
+/// (`neighbour_texel`; the GPU searches alike). On the tour, 2 left Room A's mullions at
 /// 3.8× the path tracer's luminance and 3 at 2.7×; 4 brings them to 1.03×.
 pub const NEIGHBOUR_TEXELS: i64 = 4;
 /// How far (relative) a neighbouring texel's distance may be from the point's: a thin

@@ -154,7 +154,7 @@ pub fn see_through_transmittance(
 /// How far (m) a reflected ray starts off its surface when it is cast against the proxies.
 pub const RAY_OFFSET: f32 = 1e-3;
 
-/// Rays per pixel on a glossy surface ([`Reflections::lobe`]).
+/// Rays per pixel on a glossy surface (`Reflections::lobe`).
 pub const GLOSSY_RAYS: usize = 8;
 /// Most march steps per view.
 pub const MAX_STEPS: usize = 160;
