@@ -66,7 +66,8 @@ pub struct ReconSettings {
     pub supersampling: u32,
 }
 
-/// What the geometry-assisted mode shows on objects with a material (`plenoptic_recon::shading`, docs/architecture.md "Pack v2").
+/// What the geometry-assisted mode shows on objects with a material (the `shading` module;
+/// docs/architecture.md, "Pack v2").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Shading {
     /// The material's albedo at each pixel's UV × the baked lighting + the baked non-diffuse

@@ -214,7 +214,8 @@ impl LightingCube {
     }
 
     /// The range image of the records (pack v2): radiance re-modulated, the lighting with
-    /// [`Self::filled_lighting`] applied, the residual as the non-diffuse part, the guides as they are.
+    /// [`Self::filled_lighting`] applied, the residual as the non-diffuse part, the guides as
+    /// they are.
     pub fn to_range_image(&self) -> RangeImage {
         let n = self.face_size;
         let lighting = self.filled_lighting();
