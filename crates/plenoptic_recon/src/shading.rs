@@ -291,6 +291,7 @@ fn surface_image(
         return ((0..n).map(|_| None).collect(), 0.0);
     };
     let start = std::time::Instant::now();
+    let runtime_emission = rec.pack().runtime_emission();
     // Glazing (coverage) is composited as such even where its material transmits
     // (crate::glazing); only other transmissive glass shows its reflection alone.
     let glazing: Vec<u32> = match layer {
@@ -442,7 +443,7 @@ fn surface_image(
             );
             // A single-sided emitter emits from its front only, as the tracer has it.
             let emits = t.material.material.double_sided || view.dot(ng) < 0.0;
-            let emission = if emits && (marched || rec.pack().runtime_emission()) {
+            let emission = if emits && (marched || runtime_emission) {
                 materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
             } else {
                 Vec3::ZERO

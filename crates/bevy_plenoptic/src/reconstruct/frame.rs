@@ -194,7 +194,7 @@ impl CameraFrame<'_> {
         {
             factors.fill(&mut params);
             sun::fill(&mut params, pack, cam.time);
-            reflect::fill(&mut params, pack, &cam.settings, &factors.material);
+            reflect::fill(&mut params, pack, &cam.settings);
             if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
                 &cam.settings,
                 &factors.material,

@@ -311,7 +311,7 @@ pub struct ReconParams {
     /// glossy surface marched (−1: ideal mirrors only), z: how far rays are marched, w: rays
     /// per glossy pixel.
     pub specular: Vec4,
-    /// The material's emissive factor (xyz), which marched surfaces add.
+    /// The material's emissive factor (xyz; [`MaterialFactors::fill`]).
     pub emissive: Vec4,
     /// The emissive texture's `KHR_texture_transform`: offset (xy), scale (zw).
     pub emissive_uv: Vec4,

@@ -15,7 +15,6 @@
 //! The emission is the material's at the fragment's UV (`pixel_emission`), as on the CPU.
 
 use bevy::prelude::*;
-use plenoptic_pack::MaterialEntry;
 use plenoptic_recon::Specular;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
@@ -23,14 +22,8 @@ use super::ReconParams;
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 
-/// The uniform's reflection fields for an object of material `material` in `pack`, as the
-/// camera's `settings` ask.
-pub(super) fn fill(
-    params: &mut ReconParams,
-    pack: &RadiancePack,
-    settings: &ReconSettings,
-    material: &MaterialEntry,
-) {
+/// The uniform's reflection fields for an object in `pack`, as the camera's `settings` ask.
+pub(super) fn fill(params: &mut ReconParams, pack: &RadiancePack, settings: &ReconSettings) {
     let manifest = pack.reader.manifest();
     params.specular = match settings.specular {
         Specular::Baked => Vec4::ZERO,
@@ -44,7 +37,6 @@ pub(super) fn fill(
             )
         }
     };
-    params.emissive = material.emissive.extend(0.0);
 }
 
 #[cfg(test)]
