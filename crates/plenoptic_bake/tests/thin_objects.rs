@@ -4,7 +4,8 @@
 //! direction, which shows the sky behind the mullion: the tour's mullions glowed (frame 6 of
 //! 8 at 320 × 180: 6.3× the reference's luminance on them, corrected relative LRMS 1.13).
 //! The runtime now takes the nearest texels of the object itself around the lookup, else of
-//! any surface at the point's distance (the wall around the window). Frames go to
+//! any surface at the point's distance (the wall around the window; `neighbour.rs` in
+//! `plenoptic_recon`, whose unit tests cover an opening wider than this one). Frames go to
 //! `target/tmp/thin_objects/`.
 
 mod common;

@@ -15,9 +15,9 @@
 //!    and within t ± tε (tent filter in time); then the nearest accepted pixel of the same
 //!    object in screen space (same-object hole fill); then, in each key, the nearest texel
 //!    of the object itself, else of any surface at the point's distance, within
-//!    [`NEIGHBOUR_TEXELS`] of the lookup's texel (a thin object, a window's mullion seen from
-//!    afar, that no texel centre met: without this it showed the sky behind it); then the
-//!    nearest view's cube in the point's direction regardless of id ("background").
+//!    [`crate::NEIGHBOUR_TEXELS`] of the lookup's texel (`neighbour.rs`: a thin object, a
+//!    window's mullion seen from afar, that no texel centre met; without this it showed the
+//!    sky behind it); then the nearest view's cube in the point's direction regardless of id ("background").
 //!
 //! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key. The pixel
 //! loop is parallel over bands of rows: each band of the mask is rasterized and then looked up
@@ -406,20 +406,8 @@ enum MaskSource<'a> {
     Mask(&'a GeometryMask),
 }
 
-/// Texels on either side of a lookup's texel (along each axis of its face) searched for the
-/// object itself, else any surface at the point's distance, when nothing else answered
-/// (`neighbour_texel`; the GPU searches alike). On the tour, 2 left Room A's mullions at
-/// 3.8× the path tracer's luminance and 3 at 2.7×; 4 brings them to 1.03×.
-pub const NEIGHBOUR_TEXELS: i64 = 4;
-/// How far (relative) a neighbouring texel's distance may be from the point's: a thin
-/// object's neighbouring texel sees another part of it.
-pub const NEIGHBOUR_TOLERANCE: f32 = 0.25;
-
-/// Ranks another object's texel behind every texel of the object itself.
-const OTHER_OBJECT: i64 = 100;
-
 /// The colour of the nearest texel at about the distance of point `p` (at the frame's time;
-/// `slot` its motion's slot) within [`NEIGHBOUR_TEXELS`] of each key's lookup texel on the
+/// `slot` its motion's slot) within [`crate::NEIGHBOUR_TEXELS`] of each key's lookup texel on the
 /// same face, the keys blended with their weights; `None` where no key has one. Texels of
 /// `object` itself come first; failing them, any surface's (a mullion that no texel centre
 /// met takes the lighting of the wall around its window, not the sky behind it). The
@@ -430,40 +418,9 @@ fn neighbour_texel(keys: &[ViewKey], slot: Option<usize>, object: u32, p: Vec3) 
         let q = slot
             .and_then(|s| k.motion.get(s))
             .map_or(p, |m| m.transform_point3(p));
-        let d = q - k.base;
-        let dist = d.length();
-        if dist <= 1e-6 {
-            continue;
-        }
-        let (ids, distance) = (&k.cubes.ids, &k.cubes.distance);
-        let n = ids.face_size.max(1) as i64;
-        let t = plenoptic_pack::cube::direction_to_texel(ids.face_size, d) as i64;
-        let (face, i, j) = (t / (n * n), t % n, (t / n) % n);
-        let mut best: Option<(i64, usize)> = None;
-        for dj in -NEIGHBOUR_TEXELS..=NEIGHBOUR_TEXELS {
-            for di in -NEIGHBOUR_TEXELS..=NEIGHBOUR_TEXELS {
-                let (x, y) = (i + di, j + dj);
-                if x < 0 || y < 0 || x >= n || y >= n {
-                    continue;
-                }
-                let idx = (face * n * n + y * n + x) as usize;
-                let Some(&id) = ids.texels.get(idx) else {
-                    continue;
-                };
-                // The object's own texels first, then any surface at the point's distance.
-                let score = di * di + dj * dj + if id == object { 0 } else { OTHER_OBJECT };
-                if id != 0
-                    && distance
-                        .texels
-                        .get(idx)
-                        .is_some_and(|&l| (l - dist).abs() <= NEIGHBOUR_TOLERANCE * dist)
-                    && best.is_none_or(|(b, _)| score < b)
-                {
-                    best = Some((score, idx));
-                }
-            }
-        }
-        if let Some(c) = best.and_then(|(_, idx)| k.cubes.radiance.texels.get(idx)) {
+        let best =
+            crate::neighbour::nearest_texel(&k.cubes.ids, &k.cubes.distance, q - k.base, object);
+        if let Some(c) = best.and_then(|idx| k.cubes.radiance.texels.get(idx)) {
             sum += *c * k.weight;
             ws += k.weight;
         }

@@ -87,6 +87,7 @@ mod glazing;
 mod lookup;
 mod material;
 pub mod motion;
+mod neighbour;
 pub mod path;
 pub mod proxy;
 mod raster;
@@ -105,8 +106,8 @@ pub mod warp;
 
 pub use camera::Camera;
 pub use frame::{FallbackReport, Frame, Mode, Report};
-pub use geometry::{NEIGHBOUR_TEXELS, NEIGHBOUR_TOLERANCE};
 pub use motion::ObjectMotion;
+pub use neighbour::{NEIGHBOUR_TEXELS, NEIGHBOUR_TOLERANCE};
 pub use path::{CameraPath, Keyframe, PathSample};
 pub use proxy::{GeometryMask, ProxyGeometry, TriangleMesh};
 pub use reconstructor::Reconstructor;

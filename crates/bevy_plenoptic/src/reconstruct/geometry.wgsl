@@ -323,8 +323,12 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
 }
 
 // plenoptic_recon's NEIGHBOUR_TEXELS and NEIGHBOUR_TOLERANCE.
-const NEIGHBOUR_TEXELS: i32 = 4;
+const NEIGHBOUR_TEXELS: i32 = 8;
 const NEIGHBOUR_TOLERANCE: f32 = 0.25;
+// Ranks another object's texel behind every texel of the object itself.
+const OTHER_OBJECT: i32 = 2 * NEIGHBOUR_TEXELS * NEIGHBOUR_TEXELS + 1;
+// Above every score.
+const NO_TEXEL: i32 = 1073741824;
 
 // The fallback after the hole fill (plenoptic_recon's neighbour_texel): in each lookup's key,
 // the nearest texel at about the distance of `p` within NEIGHBOUR_TEXELS of the lookup's
@@ -344,7 +348,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
         }
         let t = cube_texel(d, n);
         let layer0 = u32(params.base[k].w);
-        var best = 1000;
+        var best = NO_TEXEL;
         var best_c = t;
         for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
             for (var di = -NEIGHBOUR_TEXELS; di <= NEIGHBOUR_TEXELS; di++) {
@@ -356,7 +360,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
                 let c = vec3<u32>(u32(x), u32(y), t.z);
                 let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
                 // The object's own texels first, then any surface at the point's distance.
-                let score = di * di + dj * dj + select(100, 0, texel.z == object);
+                let score = di * di + dj * dj + select(OTHER_OBJECT, 0, texel.z == object);
                 if texel.z != 0u && abs(bitcast<f32>(texel.y) - dist) <= NEIGHBOUR_TOLERANCE * dist
                     && score < best {
                     best = score;
@@ -364,7 +368,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
                 }
             }
         }
-        if best < 1000 {
+        if best < NO_TEXEL {
             let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
             sum += colour(best_c, layer0, texel) * params.weight[k].x;
             ws += params.weight[k].x;
