@@ -73,11 +73,13 @@ fn sphere_scene(
     let t = 0.7;
     let mut app = headless_app_in(dir.path());
     app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
-    // Only the pack lights the sphere.
-    app.insert_resource(GlobalAmbientLight {
-        brightness: 0.0,
-        ..default()
-    });
+    // Bevy's own ambient light at its default (80 cd/m², hundreds of times this room's light
+    // at the camera's exposure): the plugin turns it off for a camera it lights with the pack,
+    // so that only the pack lights the sphere.
+    assert_eq!(
+        app.world().resource::<GlobalAmbientLight>().brightness,
+        GlobalAmbientLight::default().brightness
+    );
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
     let image = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();

@@ -23,6 +23,13 @@
 //! A camera that already has an `EnvironmentMapLight` or a `GeneratedEnvironmentMapLight`
 //! of its own keeps it; [`crate::PlenopticSettings::environment_light`] turns this off.
 //!
+//! The pack's light is the scene's whole indirect light, so a camera given it also gets an
+//! [`AmbientLight`] of zero brightness, unless it has an `AmbientLight` of its own. Bevy's
+//! `GlobalAmbientLight` (80 cd/m² by default) otherwise lights every `StandardMaterial` mesh
+//! evenly on top of the probes: at the exposure a pack is shown with (about 1 for the tour,
+//! [`crate::camera::EV100_UNIT`]) that is hundreds of times the baked interior's light, and
+//! the `own_scene` example's white sphere showed as a white disc.
+//!
 //! Meshes near a base view are lit by that view's own cube instead, through a light probe
 //! at the base view ([`probes`]; where the device has binding arrays); the camera's light
 //! serves the meshes outside every probe. Their diffuse light comes from an irradiance
@@ -36,7 +43,7 @@ pub mod volume;
 use std::collections::HashMap;
 
 use bevy::asset::RenderAssetUsages;
-use bevy::light::{EnvironmentMapLight, GeneratedEnvironmentMapLight};
+use bevy::light::{AmbientLight, EnvironmentMapLight, GeneratedEnvironmentMapLight};
 use bevy::prelude::*;
 use bevy::render::render_resource::{
     Extent3d, TextureDimension, TextureFormat, TextureUsages, TextureViewDescriptor,
@@ -251,10 +258,12 @@ type LitCamera<'a> = (
     Option<&'a mut PackEnvironmentLight>,
     Has<EnvironmentMapLight>,
     Has<GeneratedEnvironmentMapLight>,
+    Has<AmbientLight>,
 );
 
 /// Writes each camera's source cubemap when its heaviest view, keys or time weight change,
-/// and gives a camera without an environment light of its own the generated one.
+/// and gives a camera without an environment light of its own the generated one (and no
+/// ambient light, unless it has one of its own).
 fn update_environment_lights(
     mut commands: Commands,
     settings: Res<PlenopticSettings>,
@@ -267,7 +276,7 @@ fn update_environment_lights(
     if !settings.environment_light {
         return;
     }
-    for (entity, cam, transform, ours, has_map, has_generated) in &mut cameras {
+    for (entity, cam, transform, ours, has_map, has_generated, has_ambient) in &mut cameras {
         if ours.is_none() && (has_map || has_generated) {
             // The app's own environment light.
             continue;
@@ -313,6 +322,13 @@ fn update_environment_lights(
                         ..default()
                     },
                 ));
+                if !has_ambient {
+                    // The pack's light replaces Bevy's uniform stand-in for indirect light.
+                    commands.entity(entity).insert(AmbientLight {
+                        brightness: 0.0,
+                        ..default()
+                    });
+                }
             }
         }
     }
