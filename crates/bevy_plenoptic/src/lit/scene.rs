@@ -487,19 +487,23 @@ fn update_lit_materials(
         } else {
             Mat4::IDENTITY
         };
-        let Some(mut mat) = materials.get_mut(&handle.0) else {
+        let Some(mat) = materials.get(&handle.0) else {
             continue;
         };
-        let ext = &mut mat.extension;
-        ext.params = ctx.params(&ObjectShading {
+        let ext = &mat.extension;
+        let params = ctx.params(&ObjectShading {
             id: object.id,
             drawn_inverse,
             coverage: ext.coverage,
             factors: ext.factors.as_ref(),
         });
         let environment = background::EnvironmentUniform::new(&pack.environment.at(cam.time));
-        if ext.environment != environment {
-            ext.environment = environment;
+        // Written only when it changed (a written asset's bind group is prepared again).
+        if (ext.params != params || ext.environment != environment)
+            && let Some(mut mat) = materials.get_mut(&handle.0)
+        {
+            mat.extension.params = params;
+            mat.extension.environment = environment;
         }
     }
 }

@@ -272,7 +272,7 @@ impl Material for PlenopticMaterial {
 }
 
 /// The per-frame uniform of a [`PlenopticMaterial`].
-#[derive(ShaderType, Debug, Clone, Default)]
+#[derive(ShaderType, Debug, Clone, Default, PartialEq)]
 pub struct ReconParams {
     /// x: lookup count, y: object id, z: face size, w: volume block count.
     pub header: Vec4,
@@ -586,23 +586,32 @@ pub(crate) fn update_materials(
         let drawn_inverse = pack.proxy(of.id).map_or(Mat4::IDENTITY, |p| {
             p.transform_at(cam.time).to_matrix().inverse()
         });
-        if let Some(mut mat) = materials.get_mut(&handle.0) {
-            // Coverage and material were looked up in the manifest once, when the material
-            // was attached.
-            let params = ctx.params(&frame::ObjectShading {
-                id: of.id,
-                drawn_inverse,
-                coverage: mat.coverage,
-                factors: mat.albedo.as_ref(),
-            });
-            if mat.albedo.is_some() && cam.settings.shading == plenoptic_recon::Shading::Materials {
-                let environment =
-                    background::EnvironmentUniform::new(&pack.environment.at(cam.time));
-                if mat.environment != environment {
-                    mat.environment = environment;
-                }
+        let Some(mat) = materials.get(&handle.0) else {
+            continue;
+        };
+        // Coverage and material were looked up in the manifest once, when the material was
+        // attached.
+        let params = ctx.params(&frame::ObjectShading {
+            id: of.id,
+            drawn_inverse,
+            coverage: mat.coverage,
+            factors: mat.albedo.as_ref(),
+        });
+        let environment = (mat.albedo.is_some()
+            && cam.settings.shading == plenoptic_recon::Shading::Materials)
+            .then(|| background::EnvironmentUniform::new(&pack.environment.at(cam.time)))
+            .filter(|e| *e != mat.environment);
+        // Written only when it changed: a written asset's bind group is prepared again, so a
+        // still camera (or one whose lookups did not change) costs no uploads.
+        if (mat.params != params || environment.is_some())
+            && let Some(mut mat) = materials.get_mut(&handle.0)
+        {
+            if let Some(environment) = environment {
+                mat.environment = environment;
             }
-            mat.params = params;
+            if mat.params != params {
+                mat.params = params;
+            }
         }
     }
     for (bg, handle) in &backgrounds {
