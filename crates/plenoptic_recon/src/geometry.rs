@@ -17,7 +17,8 @@
 //!    of the object itself, else of any surface at the point's distance, within
 //!    [`crate::NEIGHBOUR_TEXELS`] of the lookup's texel (`neighbour.rs`: a thin object, a
 //!    window's mullion seen from afar, that no texel centre met; without this it showed the
-//!    sky behind it); then the nearest view's cube in the point's direction regardless of id ("background").
+//!    sky behind it); then the nearest view's cube in the point's direction regardless of id
+//!    ("background").
 //!
 //! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key. The pixel
 //! loop is parallel over bands of rows: each band of the mask is rasterized and then looked up
@@ -407,11 +408,9 @@ enum MaskSource<'a> {
 }
 
 /// The colour of the nearest texel at about the distance of point `p` (at the frame's time;
-/// `slot` its motion's slot) within [`crate::NEIGHBOUR_TEXELS`] of each key's lookup texel on the
-/// same face, the keys blended with their weights; `None` where no key has one. Texels of
-/// `object` itself come first; failing them, any surface's (a mullion that no texel centre
-/// met takes the lighting of the wall around its window, not the sky behind it). The
-/// nearest is the smallest offset, the first found in row order on ties.
+/// `slot` its motion's slot) within [`crate::NEIGHBOUR_TEXELS`] of each key's lookup texel on
+/// the same face ([`crate::neighbour::nearest_texel`]), the keys blended with their weights;
+/// `None` where no key has one.
 fn neighbour_texel(keys: &[ViewKey], slot: Option<usize>, object: u32, p: Vec3) -> Option<Vec3> {
     let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
     for k in keys.iter().filter(|k| k.weight > 1e-4) {

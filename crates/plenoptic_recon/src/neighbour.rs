@@ -124,8 +124,11 @@ mod tests {
     #[test]
     fn the_objects_own_texels_come_before_a_nearer_wall() {
         let (mut ids, distance) = window(4);
-        // A texel of the mullion at the opening's corner, farther than the wall's edge.
-        let far = (4 * N * N + (16 - 4) * N + 16 - 4) as usize;
+        // A texel of the mullion at the search's far corner (squared offset 2 · 8² = 128),
+        // farther than the wall's edge (5² = 25): an own texel anywhere in the window ranks
+        // first (with a fixed rank of 100 for other objects, the wall would win here).
+        let k = NEIGHBOUR_TEXELS as u32;
+        let far = (4 * N * N + (16 + k) * N + 16 + k) as usize;
         ids.texels[far] = MULLION;
         let mut distance = distance;
         distance.texels[far] = 3.05;

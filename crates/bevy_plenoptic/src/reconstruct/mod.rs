@@ -601,15 +601,16 @@ pub(crate) fn update_materials(
             && cam.settings.shading == plenoptic_recon::Shading::Materials)
             .then(|| background::EnvironmentUniform::new(&pack.environment.at(cam.time)))
             .filter(|e| *e != mat.environment);
+        let params = (mat.params != params).then_some(params);
         // Written only when it changed: a written asset's bind group is prepared again, so a
         // still camera (or one whose lookups did not change) costs no uploads.
-        if (mat.params != params || environment.is_some())
+        if (params.is_some() || environment.is_some())
             && let Some(mut mat) = materials.get_mut(&handle.0)
         {
             if let Some(environment) = environment {
                 mat.environment = environment;
             }
-            if mat.params != params {
+            if let Some(params) = params {
                 mat.params = params;
             }
         }
