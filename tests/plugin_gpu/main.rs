@@ -11,6 +11,8 @@
 //! - [`own_scene`]: the tour's glb loaded by Bevy's glTF loader, lit by the pack.
 //! - [`many_cameras`]: several plenoptic cameras in one app (two modes and times, a stereo
 //!   pair, a runtime sun per camera), each equal to its CPU frame.
+//! - [`per_view`]: a camera's lookups live in its view buffer; its materials are not
+//!   rewritten from frame to frame.
 
 #[path = "../../crates/bevy_plenoptic/tests/gpu/common/mod.rs"]
 mod common;
@@ -24,5 +26,6 @@ mod lit;
 mod many_cameras;
 mod own_scene;
 mod pack_asset;
+mod per_view;
 mod scene_render;
 mod sky;

@@ -19,21 +19,21 @@ use plenoptic_recon::Reconstructor;
 
 /// One camera of a test: where it is, what it looks at, its time and mode.
 #[derive(Clone, Copy)]
-struct Eye {
-    at: Vec3,
-    target: Vec3,
-    t: f32,
-    mode: ReconMode,
+pub(crate) struct Eye {
+    pub(crate) at: Vec3,
+    pub(crate) target: Vec3,
+    pub(crate) t: f32,
+    pub(crate) mode: ReconMode,
 }
 
 impl Eye {
-    fn transform(&self) -> Transform {
+    pub(crate) fn transform(&self) -> Transform {
         Transform::from_translation(self.at).looking_at(self.target, Vec3::Y)
     }
 }
 
 /// `plenoptic_recon`'s frame of the pack at `path` for `eye`.
-fn cpu_frame(path: &std::path::Path, eye: Eye) -> Vec<Vec3> {
+pub(crate) fn cpu_frame(path: &std::path::Path, eye: Eye) -> Vec<Vec3> {
     let rec = Reconstructor::open(path).unwrap();
     let cam = plenoptic_recon::Camera::new(
         eye.at,
@@ -50,6 +50,17 @@ fn cpu_frame(path: &std::path::Path, eye: Eye) -> Vec<Vec3> {
 /// The frames the plugin shows for `eyes`, all cameras of one app on the pack `room.pack` in
 /// `dir` (linear radiance read back from `Rgba16Float` targets, no MSAA).
 fn plugin_frames(dir: &std::path::Path, eyes: &[Eye]) -> Vec<Vec<Vec3>> {
+    let (mut app, _, targets) = plugin_cameras(dir, eyes);
+    settled_frames(&mut app, &targets)
+}
+
+/// An app with one plenoptic camera per eye on the pack `room.pack` in `dir`, each rendering
+/// into its own `Rgba16Float` target, run until every camera's keys are resident: the app,
+/// the cameras and their targets.
+pub(crate) fn plugin_cameras(
+    dir: &std::path::Path,
+    eyes: &[Eye],
+) -> (App, Vec<Entity>, Vec<Handle<Image>>) {
     let mut app = headless_app_in(dir);
     app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
@@ -101,7 +112,7 @@ fn plugin_frames(dir: &std::path::Path, eyes: &[Eye]) -> Vec<Vec<Vec3>> {
         complete_frames, 3,
         "the cameras' keys never became resident"
     );
-    settled_frames(&mut app, &targets)
+    (app, cameras, targets)
 }
 
 /// The frames `targets` settle on together: each shown (drawn, not the red clear colour,
@@ -155,7 +166,12 @@ pub(crate) fn settled_frames(app: &mut App, targets: &[Handle<Image>]) -> Vec<Ve
 
 /// Asserts each GPU frame equals its CPU frame within the bounds of the one-camera tests
 /// (`mean`, `within5`: mean relative error and share within 5 %).
-fn assert_each_matches(gpu: &[Vec<Vec3>], cpu: &[Vec<Vec3>], mean_bound: f32, within5: f32) {
+pub(crate) fn assert_each_matches(
+    gpu: &[Vec<Vec3>],
+    cpu: &[Vec<Vec3>],
+    mean_bound: f32,
+    within5: f32,
+) {
     for (n, (g, c)) in gpu.iter().zip(cpu).enumerate() {
         let (mean, f5, f20) = compare(g, c);
         eprintln!("camera {n}: GPU against CPU mean {mean:.5}, within 5 % {f5:.4}");

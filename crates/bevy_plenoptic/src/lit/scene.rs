@@ -18,11 +18,12 @@
 //!   (later edits to the original do not reach it), whose fragment shader is the proxies'
 //!   (`reconstruct/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups, weights and
 //!   fallbacks, the same marched reflections and runtime sun, with the mesh's own base
-//!   colour, metalness, roughness and normal map per pixel. The uniform is filled by the
-//!   same code as a proxy's ([`crate::reconstruct::frame`]): only the transform that carries
-//!   a fragment's point into the pack's object frame differs (the mesh's own global transform
-//!   for an animated object, so the lighting follows the object wherever the app's animation
-//!   puts it; the identity for a static one, whose proxy is in world space).
+//!   colour, metalness, roughness and normal map per pixel. Its object uniform is filled by
+//!   the same code as a proxy's ([`crate::reconstruct::frame`]) and it binds the camera's
+//!   view buffer ([`crate::reconstruct::view`]), as the camera's proxies do; the shader
+//!   carries a fragment's point into the pack's object frame with the mesh's own inverse
+//!   transform for an animated object (so the lighting follows the object wherever the app's
+//!   animation puts it), not at all for a static one (its proxy is in world space).
 //! - **Proxies.** The camera's proxy of a matched object is moved from the camera's render
 //!   layer to its shadow-only layer ([`crate::camera::layers::ViewLayer::shadow_only`]): the
 //!   camera no longer draws it (the app's mesh is there instead, no depth fight), but the
@@ -42,7 +43,7 @@
 //! shows the camera's CPU frame in screen space, as the proxies do there (the pack's own
 //! materials: the app's are not used).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use bevy::asset::AssetPath;
 use bevy::camera::visibility::RenderLayers;
@@ -57,13 +58,13 @@ use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
-use crate::reconstruct::frame::{CameraFrame, ObjectShading, frame_lookups, warped};
+use crate::reconstruct::frame::ObjectShading;
 use crate::reconstruct::rays::{CameraRays, PackRays};
+use crate::reconstruct::view::ViewBuffer;
 use crate::reconstruct::{
-    KeyTextures, MaterialFactors, ReconParams, ResolvedBackend, background, image,
+    KeyTextures, MaterialFactors, ObjectParams, ResolvedBackend, background, image,
     material_factors, object_coverage, volume,
 };
-use crate::streaming::StreamCache;
 use crate::{Backend, PlenopticSystems};
 
 /// Lights the meshes under this entity (a `WorldAssetRoot`, or any ancestor of them) with the
@@ -100,9 +101,9 @@ pub struct PlenopticLighting {
     /// Resident keys ([`crate::reconstruct`]).
     #[texture(100, dimension = "2d_array", sample_type = "u_int")]
     pub cubes: Handle<Image>,
-    /// This frame's lookups for the mesh's object.
+    /// The mesh's object: its id, motion slot, coverage and material.
     #[uniform(101)]
-    pub params: ReconParams,
+    pub params: ObjectParams,
     /// Resident temporal-volume samples of the pack.
     #[storage(102, read_only)]
     pub volume_samples: Handle<ShaderBuffer>,
@@ -115,9 +116,10 @@ pub struct PlenopticLighting {
     /// The resident keys' lighting and non-diffuse radiance.
     #[texture(105, dimension = "2d_array", sample_type = "u_int")]
     pub shading_cubes: Handle<Image>,
-    /// The pack's environment at the camera's time (reflected rays that leave the scene).
-    #[uniform(110)]
-    pub environment: background::EnvironmentUniform,
+    /// The camera's view buffer ([`crate::reconstruct::view::ViewBuffer`]): its lookups,
+    /// tunables, sun, environment and the animated objects' motion this frame.
+    #[storage(110, read_only)]
+    pub view: Handle<ShaderBuffer>,
     /// The pack's environment image.
     #[texture(111, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
@@ -133,6 +135,8 @@ pub struct PlenopticLighting {
     pub factors: Option<MaterialFactors>,
     /// The object's glazing coverage (1: opaque).
     pub coverage: f32,
+    /// The camera's [`ViewBuffer::bindings`] when the bind group was last prepared.
+    pub bindings: u64,
 }
 
 impl MaterialExtension for PlenopticLighting {
@@ -338,7 +342,12 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    cameras: Query<(&PlenopticCamera, &image::ImageFrame, &CameraRays)>,
+    cameras: Query<(
+        &PlenopticCamera,
+        &image::ImageFrame,
+        &CameraRays,
+        &ViewBuffer,
+    )>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
     mut lit: ResMut<Assets<LitMaterial>>,
@@ -350,7 +359,7 @@ fn attach_lit_materials(
         return;
     }
     for (root, scene) in &roots {
-        let Ok((cam, image_frame, camera_rays)) = cameras.get(scene.camera) else {
+        let Ok((cam, image_frame, camera_rays, view)) = cameras.get(scene.camera) else {
             continue;
         };
         let id = cam.pack.id();
@@ -387,17 +396,18 @@ fn attach_lit_materials(
                 base,
                 extension: PlenopticLighting {
                     cubes: tex.image.clone(),
-                    params: ReconParams::default(),
+                    params: ObjectParams::default(),
                     volume_samples: vol.samples.clone(),
                     volume_bins: vol.bins.clone(),
                     image_frame: image_frame.0.clone(),
                     shading_cubes: tex.shading.clone(),
-                    environment: background::EnvironmentUniform::default(),
+                    view: view.buffer.clone(),
                     environment_image: env_images.get(id, pack, &mut images),
                     rays: pack_rays.get(id, pack, &mut buffers),
                     ray_placements: camera_rays.buffer.clone(),
                     factors,
                     coverage,
+                    bindings: view.bindings,
                 },
             });
             commands
@@ -443,67 +453,34 @@ fn release_lit_materials(
     }
 }
 
-/// Fills every lit mesh's lookups for its camera, as the proxies' are filled.
+/// Keeps every lit mesh's uniform and bindings up to date with its camera, as the proxies'
+/// are ([`crate::reconstruct::update_materials`]): written only when they changed.
 fn update_lit_materials(
-    keys: Res<KeyTextures>,
-    volumes: Res<volume::VolumeBuffers>,
-    cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<(&PlenopticCamera, &GlobalTransform, &image::ImageJob)>,
-    objects: Query<(&LitObject, &GlobalTransform, &MeshMaterial3d<LitMaterial>)>,
+    cameras: Query<(&PlenopticCamera, &ViewBuffer)>,
+    objects: Query<(&LitObject, &MeshMaterial3d<LitMaterial>)>,
     mut materials: ResMut<Assets<LitMaterial>>,
 ) {
-    let mut frames = HashMap::new();
-    for (object, transform, handle) in &objects {
-        let Ok((cam, eye, job)) = cameras.get(object.camera) else {
+    for (object, handle) in &objects {
+        let Ok((cam, view)) = cameras.get(object.camera) else {
             continue;
         };
-        let id = cam.pack.id();
-        let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
-            continue;
-        };
-        let lookups = frames.entry(object.camera).or_insert_with(|| {
-            frame_lookups(
-                id,
-                pack,
-                tex,
-                &cache,
-                &cam.settings,
-                eye.translation(),
-                cam.time,
-            )
-        });
-        let ctx = CameraFrame {
-            cam,
-            pack,
-            tex,
-            volumes: volumes.0.get(&id),
-            lookups,
-            image_mode: warped(cam.mode) && job.0.is_some(),
-        };
-        let animated = pack.proxy(object.id).is_some_and(|p| p.track.is_some());
-        let drawn_inverse = if animated {
-            transform.to_matrix().inverse()
-        } else {
-            Mat4::IDENTITY
-        };
-        let Some(mat) = materials.get(&handle.0) else {
+        let (Some(pack), Some(mat)) = (packs.get(cam.pack.id()), materials.get(&handle.0)) else {
             continue;
         };
         let ext = &mat.extension;
-        let params = ctx.params(&ObjectShading {
+        let params = ObjectShading {
             id: object.id,
-            drawn_inverse,
             coverage: ext.coverage,
             factors: ext.factors.as_ref(),
-        });
-        let environment = background::EnvironmentUniform::new(&pack.environment.at(cam.time));
-        // Written only when it changed (a written asset's bind group is prepared again).
-        if (ext.params != params || ext.environment != environment)
+        }
+        .params(cam, pack);
+        if (ext.params != params || ext.bindings != view.bindings || ext.view != view.buffer)
             && let Some(mut mat) = materials.get_mut(&handle.0)
         {
             mat.extension.params = params;
-            mat.extension.environment = environment;
+            mat.extension.bindings = view.bindings;
+            mat.extension.view = view.buffer.clone();
         }
     }
 }

@@ -1,7 +1,8 @@
-//! What one camera looks up this frame on its pack, and the per-object uniform of the
-//! geometry-assisted shader filled from it: shared by the proxy materials ([`super`]) and the
-//! app's own meshes lit by the pack ([`crate::lit::scene`]), so that both are shaded from
-//! the same lookups (thesis §8.2.3; `docs/architecture.md`, "The runtime plugin").
+//! What one camera looks up this frame on its pack (its view buffer, [`super::view`]), and
+//! the per-object uniform of the geometry-assisted shader: shared by the proxy materials
+//! ([`super`]) and the app's own meshes lit by the pack ([`crate::lit::scene`]), so that both
+//! are shaded from the same lookups (thesis §8.2.3; `docs/architecture.md`, "The runtime
+//! plugin").
 //!
 //! The lookups are those of `plenoptic_recon`'s geometry mode: the view-space weights of
 //! the nearest [`ReconSettings::max_views`] base views ([`ReconSettings::view_weights`]),
@@ -11,7 +12,10 @@
 use bevy::prelude::*;
 use plenoptic_recon::temporal::bracketing;
 
-use super::{KeyTexture, MAX_LOOKUPS, MaterialFactors, ReconParams, reflect, sun, volume};
+use super::view::{ViewParams, motion_slot};
+use super::{
+    KeyTexture, MAX_LOOKUPS, MaterialFactors, ObjectParams, background, reflect, sun, view, volume,
+};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 use crate::streaming::StreamCache;
@@ -105,7 +109,7 @@ pub(crate) fn warped(mode: ReconMode) -> bool {
     matches!(mode, ReconMode::Image | ReconMode::Volume)
 }
 
-/// One camera's frame on its pack: what every object's uniform is filled from.
+/// One camera's frame on its pack: what its view buffer is filled from.
 pub(crate) struct CameraFrame<'a> {
     /// The camera.
     pub(crate) cam: &'a PlenopticCamera,
@@ -125,29 +129,48 @@ pub(crate) struct CameraFrame<'a> {
 pub(crate) struct ObjectShading<'a> {
     /// Pack object id.
     pub(crate) id: u32,
-    /// The inverse of the transform that carries the object's local frame to where its
-    /// fragments are drawn: `M_o(t)⁻¹` for a proxy placed at the camera's time, the mesh
-    /// entity's own global transform inverted for an app mesh. A lookup at key τ carries the
-    /// fragment's point by `M_o(τ)` times this.
-    pub(crate) drawn_inverse: Mat4,
     /// The object's glazing coverage (1: opaque).
     pub(crate) coverage: f32,
     /// Its material from the pack, if any.
     pub(crate) factors: Option<&'a MaterialFactors>,
 }
 
-impl CameraFrame<'_> {
-    /// The uniform of one object for this camera.
-    pub(crate) fn params(&self, object: &ObjectShading) -> ReconParams {
-        let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
-        let m = pack.reader.manifest();
-        let mut params = ReconParams {
-            header: Vec4::new(
-                f.lookups.len() as f32,
-                object.id as f32,
-                tex.face as f32,
+impl ObjectShading<'_> {
+    /// The object's uniform as camera `cam` shows it from `pack`: its id, motion slot,
+    /// coverage and material. It changes only with the camera's settings.
+    pub(crate) fn params(&self, cam: &PlenopticCamera, pack: &RadiancePack) -> ObjectParams {
+        let mut params = ObjectParams {
+            object: Vec4::new(
+                self.id as f32,
+                motion_slot(pack, self.id).map_or(-1.0, |s| s as f32),
+                self.coverage,
                 0.0,
             ),
+            ..default()
+        };
+        if let Some(factors) = self.factors
+            && cam.settings.shading == plenoptic_recon::Shading::Materials
+        {
+            factors.fill(&mut params);
+            if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
+                &cam.settings,
+                &factors.material,
+            ) && self.coverage >= 1.0
+            {
+                params.glass = Vec4::new(1.0, (t.x + t.y + t.z) / 3.0, 0.0, 0.0);
+            }
+        }
+        params
+    }
+}
+
+impl CameraFrame<'_> {
+    /// The camera's view buffer contents ([`super::view`]).
+    pub(crate) fn view_params(&self) -> ViewParams {
+        let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
+        let m = pack.reader.manifest();
+        let mut params = ViewParams {
+            header: Vec4::new(f.lookups.len() as f32, tex.face as f32, 0.0, 0.0),
             tuning: Vec4::new(
                 cam.settings.depth_tolerance,
                 cam.settings.angular_power,
@@ -158,7 +181,7 @@ impl CameraFrame<'_> {
                 cam.settings.hole_fill_radius as f32,
                 f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
                 if self.image_mode { 1.0 } else { 0.0 },
-                object.coverage,
+                0.0,
             ),
             flags: Vec4::new(
                 if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
@@ -170,6 +193,7 @@ impl CameraFrame<'_> {
                 0.0,
                 0.0,
             ),
+            environment: background::EnvironmentUniform::new(&pack.environment.at(cam.time)),
             ..default()
         };
         let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
@@ -182,28 +206,15 @@ impl CameraFrame<'_> {
             cam.time,
             cam.settings.time_epsilon_on(m),
         );
-        let proxy = pack.proxy(object.id);
         for (n, l) in f.lookups.iter().enumerate() {
             params.base[n] = l.base.extend((l.slot * 6) as f32);
             params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
-            params.motion[n] = proxy.map_or(Mat4::IDENTITY, |p| p.transform_at(l.tau).to_matrix())
-                * object.drawn_inverse;
         }
-        if let Some(factors) = object.factors
-            && cam.settings.shading == plenoptic_recon::Shading::Materials
-        {
-            factors.fill(&mut params);
+        let taus: Vec<f32> = f.lookups.iter().map(|l| l.tau).collect();
+        view::fill_motion(&mut params, pack, &taus);
+        if cam.settings.shading == plenoptic_recon::Shading::Materials {
             sun::fill(&mut params, pack, cam.time);
             reflect::fill(&mut params, pack, &cam.settings);
-            if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
-                &cam.settings,
-                &factors.material,
-            ) && !self.image_mode
-                && object.coverage >= 1.0
-            {
-                params.flags.z = 1.0;
-                params.flags.w = (t.x + t.y + t.z) / 3.0;
-            }
         }
         params
     }

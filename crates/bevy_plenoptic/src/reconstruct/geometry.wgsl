@@ -14,6 +14,7 @@
 #import bevy_core_pipeline::tonemapping::tone_mapping
 #endif
 #import bevy_pbr::prepass_utils
+#import bevy_pbr::mesh_functions::get_local_from_world
 #ifdef PLENOPTIC_STANDARD
 #import bevy_pbr::pbr_fragment::pbr_input_from_standard_material
 #import bevy_pbr::pbr_functions::alpha_discard
@@ -31,20 +32,49 @@ const RAY_OFFSET: f32 = 0.001;
 // Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
 const BIN_FACE: u32 = 16u;
 
-struct ReconParams {
-    // x: lookup count, y: object id, z: face size (all as floats), w: unused.
+// A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
+struct ViewParams {
+    // x: lookup count, y: face size, z: volume block count (all as floats), w: unused.
     header: vec4<f32>,
-    // x: depth tolerance, y: angular power.
+    // x: depth tolerance, y: angular power, z: time t, w: temporal window tε.
     tuning: vec4<f32>,
     // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
-    // frame, w: coverage of glazing.
+    // frame.
     fill: vec4<f32>,
-    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
-    // y: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials);
-    // z: 1 for see-through transmissive glass (its reflection over what lies behind), w: its
-    // mean transmittance per surface.
+    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter).
     flags: vec4<f32>,
-    // The object's base-colour factor (xyz) and metallic factor (w) when flags.y is 1.
+    // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
+    sun: vec4<f32>,
+    // Its illuminance at the camera's time (xyz).
+    sun_illuminance: vec4<f32>,
+    // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
+    // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
+    // pixel (plenoptic_recon's GLOSSY_RAYS).
+    specular: vec4<f32>,
+    // Per lookup: base view position (xyz) and first layer (w).
+    base: array<vec4<f32>, 16>,
+    // Per lookup: weight (x), whether the key has normals (y).
+    weight: array<vec4<f32>, 16>,
+    // Per volume block: base view position (xyz), view weight (w).
+    volume: array<vec4<f32>, 8>,
+    // Per volume block: first sample (x), first bin offset (y).
+    volume_range: array<vec4<u32>, 8>,
+    // The pack's environment at the camera's time, for reflected rays that leave the scene
+    // (not named `environment`: naga_oil would take the field for the imported function).
+    env: Environment,
+    // M_o(τ) per animated object (its motion slot) and lookup: entry slot · 16 + k.
+    motion: array<mat4x4<f32>>,
+}
+
+// A material's uniform (mod.rs, ObjectParams): its object and material.
+struct ObjectParams {
+    // x: object id, y: motion slot (−1: static, in world space), z: coverage of glazing,
+    // w: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
+    object: vec4<f32>,
+    // x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
+    // mean transmittance per surface.
+    glass: vec4<f32>,
+    // The object's base-colour factor (xyz) and metallic factor (w) when object.w is 1.
     albedo: vec4<f32>,
     // x: transmission factor; y, z, w: largest side of the base-colour and metallic-roughness
     // textures and of the normal map (0: none).
@@ -57,14 +87,6 @@ struct ReconParams {
     uv_rotation: vec4<f32>,
     // x: roughness factor, y: IOR (the runtime sun's BSDF), z: the normal map's scale.
     surface: vec4<f32>,
-    // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
-    sun: vec4<f32>,
-    // Its illuminance at the camera's time (xyz).
-    sun_illuminance: vec4<f32>,
-    // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
-    // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
-    // pixel (plenoptic_recon's GLOSSY_RAYS).
-    specular: vec4<f32>,
     // The material's emissive factor (xyz).
     emissive: vec4<f32>,
     // The emissive texture's transform: offset (xy), scale (zw).
@@ -72,16 +94,6 @@ struct ReconParams {
     // x: the emissive texture's largest side (0: none), y: 1 when the pack leaves the
     // emission to the runtime, z: 1 when double-sided, w: the texture's UV rotation.
     emission: vec4<f32>,
-    // Per lookup: base view position (xyz) and first layer (w).
-    base: array<vec4<f32>, 16>,
-    // Per lookup: weight (x), whether the key has normals (y).
-    weight: array<vec4<f32>, 16>,
-    // Per lookup: M_o(τ) M_o(t)⁻¹ of this material's object.
-    motion: array<mat4x4<f32>, 16>,
-    // Per volume block: base view position (xyz), view weight (w).
-    volume: array<vec4<f32>, 8>,
-    // Per volume block: first sample (x), first bin offset (y).
-    volume_range: array<vec4<u32>, 8>,
 }
 
 #ifdef PLENOPTIC_STANDARD
@@ -89,21 +101,21 @@ struct ReconParams {
 // standard material's bindings come first, this extension's from 100 (the same bindings as
 // the proxy material's below, less its pack textures: the standard material has its own).
 @group(#{MATERIAL_BIND_GROUP}) @binding(100) var cubes: texture_2d_array<u32>;
-@group(#{MATERIAL_BIND_GROUP}) @binding(101) var<uniform> params: ReconParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(101) var<uniform> params: ObjectParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(102) var<storage, read> volume_samples: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(103) var<storage, read> volume_bins: array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(104) var image_frame: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(105) var shading_cubes: texture_2d_array<u32>;
-@group(#{MATERIAL_BIND_GROUP}) @binding(110) var<uniform> env: Environment;
+@group(#{MATERIAL_BIND_GROUP}) @binding(110) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
 #else
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
-@group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ReconParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ObjectParams;
 // Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object,
 // lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
-// The image-mode frame (image.wgsl), shown when params.fill.z is 1.
+// The image-mode frame (image.wgsl), shown when cam.fill.z is 1.
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
 // Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
@@ -116,8 +128,8 @@ struct ReconParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(15) var normal_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(16) var emissive_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(17) var emissive_sampler: sampler;
-// The pack's environment at the camera's time, for reflected rays that leave the scene.
-@group(#{MATERIAL_BIND_GROUP}) @binding(10) var<uniform> env: Environment;
+// The camera's view buffer: its lookups, settings, environment and objects' motion.
+@group(#{MATERIAL_BIND_GROUP}) @binding(10) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
 #endif
 
@@ -131,10 +143,24 @@ var<private> pixel_roughness: f32;
 var<private> non_diffuse_weight: f32 = 1.0;
 // Its emission at its UV (pack 4 and marched surfaces; zero for app meshes).
 var<private> pixel_emission: vec3<f32>;
+// The drawn mesh's local_from_world (Bevy's mesh uniform): M_o(t)⁻¹ for a proxy placed at
+// the camera's time, the app mesh's own inverse transform for a lit mesh.
+var<private> local_from_world: mat4x4<f32>;
+
+// Point `p` of this object carried to lookup k's key time τ: M_o(τ) · local_from_world · p
+// for an animated object, `p` itself for a static one (in world space).
+fn carried(p: vec3<f32>, k: u32) -> vec3<f32> {
+    let slot = params.object.y;
+    if slot < 0.0 {
+        return p;
+    }
+    let m = cam.motion[u32(slot) * MAX_LOOKUPS + k];
+    return (m * (local_from_world * vec4<f32>(p, 1.0))).xyz;
+}
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
-    return params.flags.y == 1.0;
+    return params.object.w == 1.0;
 }
 
 // The shaded colour of a shading texel: the fragment's albedo · lighting + non-diffuse (in the
@@ -268,22 +294,22 @@ fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
 fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
-    let count = u32(params.header.x);
-    let n = u32(params.header.z);
-    let tol = params.tuning.x;
-    let power = params.tuning.y;
+    let count = u32(cam.header.x);
+    let n = u32(cam.header.y);
+    let tol = cam.tuning.x;
+    let power = cam.tuning.y;
     let to_eye = normalize(eye - p);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = (params.motion[k] * vec4<f32>(p, 1.0)).xyz;
-        let d = q - params.base[k].xyz;
+        let q = carried(p, k);
+        let d = q - cam.base[k].xyz;
         let dist = length(d);
         if dist <= 1e-6 {
             continue;
         }
         let t = cube_texel(d, n);
-        let layer = u32(params.base[k].w) + t.z;
+        let layer = u32(cam.base[k].w) + t.z;
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0);
         if texel.z != object {
             continue;
@@ -292,7 +318,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         // Fast path: the texel's centre distance agrees. Otherwise compare with the distance
         // to the texel's surface plane along the lookup direction (grazing surfaces).
         if abs(dc - dist) > tol * dist {
-            if params.weight[k].y == 0.0 {
+            if cam.weight[k].y == 0.0 {
                 continue;
             }
             let nrm = oct_decode(max(unpack2x16snorm(texel.w), vec2<f32>(-1.0)));
@@ -310,11 +336,11 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
             let c = max((1.0 - dot(d, to_eye) / dist) * 0.5, 1e-3);
             wa = pow(c, power);
         }
-        let w = params.weight[k].x * wa;
+        let w = cam.weight[k].x * wa;
         var radiance = rgb9e5_decode(texel.x);
         // Lighting is always filtered (plenoptic_recon's shading module).
-        if params.flags.x == 1.0 || lit() {
-            radiance = filtered(u32(params.base[k].w), n, d, t, object, dist, tol);
+        if cam.flags.x == 1.0 || lit() {
+            radiance = filtered(u32(cam.base[k].w), n, d, t, object, dist, tol);
         }
         sum += radiance * w;
         ws += w;
@@ -335,19 +361,19 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·colour, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
-    let count = u32(params.header.x);
-    let n = u32(params.header.z);
+    let count = u32(cam.header.x);
+    let n = u32(cam.header.y);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = (params.motion[k] * vec4<f32>(p, 1.0)).xyz;
-        let d = q - params.base[k].xyz;
+        let q = carried(p, k);
+        let d = q - cam.base[k].xyz;
         let dist = length(d);
         if dist <= 1e-6 {
             continue;
         }
         let t = cube_texel(d, n);
-        let layer0 = u32(params.base[k].w);
+        let layer0 = u32(cam.base[k].w);
         var best = NO_TEXEL;
         var best_c = t;
         for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
@@ -370,8 +396,8 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
         }
         if best < NO_TEXEL {
             let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
-            sum += colour(best_c, layer0, texel) * params.weight[k].x;
-            ws += params.weight[k].x;
+            sum += colour(best_c, layer0, texel) * cam.weight[k].x;
+            ws += cam.weight[k].x;
         }
     }
     return vec4<f32>(sum, ws);
@@ -383,24 +409,24 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
 // whose time is within t ± tε, weighted by the tent filter and the angular falloff.
 // Returns (Σ w·radiance, Σ w).
 fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
-    let count = min(u32(params.header.w), MAX_VOLUMES);
-    let tol = params.tuning.x * 3.0;
-    let t = params.tuning.z;
-    let eps = params.tuning.w;
+    let count = min(u32(cam.header.z), MAX_VOLUMES);
+    let tol = cam.tuning.x * 3.0;
+    let t = cam.tuning.z;
+    let eps = cam.tuning.w;
     let half_bin = 1.0 / f32(BIN_FACE);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
     for (var i = 0u; i < count; i++) {
-        let d = p - params.volume[i].xyz;
+        let d = p - cam.volume[i].xyz;
         let dist = length(d);
         if dist <= 1e-6 {
             continue;
         }
         let dir = d / dist;
         let bt = cube_texel(dir, BIN_FACE);
-        let bin = params.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
-        let first = params.volume_range[i].x;
-        let view_w = params.volume[i].w;
+        let bin = cam.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
+        let first = cam.volume_range[i].x;
+        let view_w = cam.volume[i].w;
         for (var j = volume_bins[bin]; j < volume_bins[bin + 1u]; j++) {
             let s = 3u * (first + j);
             let c = volume_samples[s + 2u];
@@ -501,6 +527,7 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // object's points, exactly as a proxy fragment of the same object is shaded.
 @fragment
 fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+    local_from_world = get_local_from_world(vertex.instance_index);
     let ng = cross(dpdx(vertex.world_position.xyz), dpdy(vertex.world_position.xyz));
     var pbr = pbr_input_from_standard_material(vertex, is_front);
     pbr.material.base_color = alpha_discard(pbr.material, pbr.material.base_color);
@@ -516,6 +543,7 @@ fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @loc
 #else
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    local_from_world = get_local_from_world(in.instance_index);
     // The triangle's plane, before any non-uniform branch.
     let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));
     // The material's albedo at the pixel (derivatives are taken before any non-uniform
@@ -540,7 +568,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 // and sun light, times the exposure.
 fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
     var reflected = vec3<f32>(0.0);
-    if lit() && params.fill.z != 1.0 && marched() {
+    if lit() && cam.fill.z != 1.0 && marched() {
         let r = reflection(in, ng);
         if r.w > 0.0 {
             non_diffuse_weight = 0.0;
@@ -548,7 +576,7 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         }
     }
     // Pack 4 leaves the emission to the runtime: where no marched reflection carries it.
-    if lit() && params.fill.z != 1.0 && params.emission.y == 1.0 && non_diffuse_weight != 0.0
+    if lit() && cam.fill.z != 1.0 && params.emission.y == 1.0 && non_diffuse_weight != 0.0
         && !see_through() {
         reflected += pixel_emission;
     }
@@ -562,15 +590,15 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         c = radiance(in, ng);
         c = vec4<f32>(c.rgb + reflected, c.a);
     }
-    if lit() && params.sun.w == 1.0 && params.fill.z != 1.0 {
+    if lit() && cam.sun.w == 1.0 && cam.fill.z != 1.0 {
         c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
     }
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
-    let glazing = params.fill.w > 0.0 && params.fill.w < 1.0 && params.fill.z != 1.0;
-    var alpha = select(c.a, params.fill.w, glazing);
+    let glazing = params.object.z > 0.0 && params.object.z < 1.0 && cam.fill.z != 1.0;
+    var alpha = select(c.a, params.object.z, glazing);
     if see_through() {
-        alpha = 1.0 - params.flags.w;
+        alpha = 1.0 - params.glass.y;
     }
     var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), alpha);
 #ifdef TONEMAP_IN_SHADER
@@ -582,8 +610,8 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
 // The reconstructed radiance of the fragment (linear, before exposure).
 // `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
 fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
-    let object = u32(params.header.y);
-    let n = u32(params.header.z);
+    let object = u32(params.object.x);
+    let n = u32(cam.header.y);
     let p = in.world_position.xyz;
     let eye = view.world_position;
     // The surface plane.
@@ -592,7 +620,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         nrm = in.world_normal;
     }
     nrm = normalize(nrm);
-    if params.fill.z == 1.0 {
+    if cam.fill.z == 1.0 {
         return image_frame_texel(in.position.xy);
     }
     let own = reconstruct(p, eye, object);
@@ -602,7 +630,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
     // this one whose points (neighbour_point) have a direct or volume lookup of this object;
     // their mean.
-    let radius = i32(params.fill.x);
+    let radius = i32(cam.fill.x);
     let centre = in.position.xy;
     for (var r = 1; r <= radius; r++) {
         var sum = vec3<f32>(0.0);
@@ -618,7 +646,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
                 // Glazing is not in the depth prepass (Bevy's transparent pass): its ring
                 // pixels are found on its plane, panes being flat.
                 var q: vec4<f32>;
-                if params.fill.w > 0.0 && params.fill.w < 1.0 {
+                if params.object.z > 0.0 && params.object.z < 1.0 {
                     q = pixel_on_plane(c, p, nrm);
                 } else {
                     q = neighbour_point(c, p, nrm);
@@ -644,10 +672,10 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(near.rgb / near.w, 1.0);
     }
     // Nothing: the heaviest key's texel in the point's direction ("background").
-    let h = u32(params.fill.y);
-    if h < min(u32(params.header.x), MAX_LOOKUPS) {
-        let t = cube_texel(p - params.base[h].xyz, n);
-        let layer0 = u32(params.base[h].w);
+    let h = u32(cam.fill.y);
+    if h < min(u32(cam.header.x), MAX_LOOKUPS) {
+        let t = cube_texel(p - cam.base[h].xyz, n);
+        let layer0 = u32(cam.base[h].w);
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
         return vec4<f32>(colour(t, layer0, texel), 1.0);
     }
@@ -786,7 +814,7 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
     if !diffuse && pixel_roughness < 0.02 {
         return vec3<f32>(0.0);
     }
-    let wi = normalize(params.sun.xyz);
+    let wi = normalize(cam.sun.xyz);
     let f = sun_bsdf(wi, wo, n, ng, eta);
     if all(f == vec3<f32>(0.0)) {
         return vec3<f32>(0.0);
@@ -807,7 +835,7 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
             break;
         }
     }
-    return f * params.sun_illuminance.xyz * abs(dot(wi, n)) * shadow;
+    return f * cam.sun_illuminance.xyz * abs(dot(wi, n)) * shadow;
 }
 
 // ---- Reflections for the camera (plenoptic_recon's specular module, the same formulas) ----
@@ -815,13 +843,13 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
 // Whether this fragment's surface is marched: no transmission, an ideal mirror, or glossy
 // up to the roughest surface marched.
 fn marched() -> bool {
-    return params.specular.x == 1.0 && (params.material.x <= 0.0 || see_through())
-        && (pixel_roughness < 0.02 || pixel_roughness <= params.specular.y);
+    return cam.specular.x == 1.0 && (params.material.x <= 0.0 || see_through())
+        && (pixel_roughness < 0.02 || pixel_roughness <= cam.specular.y);
 }
 
 // Whether this fragment is see-through transmissive glass (flags.z).
 fn see_through() -> bool {
-    return params.flags.z == 1.0 && params.fill.z != 1.0;
+    return params.glass.x == 1.0 && cam.fill.z != 1.0;
 }
 
 // Radiance arriving at `origin` along unit `dir`, over a cone of half-angle `cone`, from the
@@ -829,26 +857,26 @@ fn see_through() -> bool {
 fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     // A ray that meets no proxy has left the scene (plenoptic_recon::specular's escape
     // test, cast off the surface it starts on).
-    if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, params.specular.z) {
-        return vec4<f32>(environment(env, env_image, dir), 1.0);
+    if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, cam.specular.z) {
+        return vec4<f32>(environment(cam.env, env_image, dir), 1.0);
     }
-    let count = min(u32(params.header.x), MAX_LOOKUPS);
-    let n = u32(params.header.z);
+    let count = min(u32(cam.header.x), MAX_LOOKUPS);
+    let n = u32(cam.header.y);
     var sum = vec3<f32>(0.0);
     var total = 0.0;
     var escaped = false;
     for (var k = 0u; k < count; k++) {
-        if params.weight[k].x <= 0.0 {
+        if cam.weight[k].x <= 0.0 {
             continue;
         }
-        let centre = params.base[k].xyz;
-        let layer0 = u32(params.base[k].w);
-        let m = march(cubes, layer0, n, centre, origin, dir, params.specular.z, params.tuning.x);
+        let centre = cam.base[k].xyz;
+        let layer0 = u32(cam.base[k].w);
+        let m = march(cubes, layer0, n, centre, origin, dir, cam.specular.z, cam.tuning.x);
         if m.y == 1.0 {
             let to = origin + dir * m.x - centre;
             let d = length(to);
             let cos = dot(to, dir) / max(d, 1e-6);
-            let w = params.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), params.tuning.y);
+            let w = cam.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), cam.tuning.y);
             let angle = min(cone * m.x / max(d, 1e-3), 0.5);
             sum += fetch(cubes, layer0, n, to, angle) * w;
             total += w;
@@ -860,18 +888,18 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
         return vec4<f32>(sum / total, 1.0);
     }
     if escaped {
-        return vec4<f32>(environment(env, env_image, dir), 1.0);
+        return vec4<f32>(environment(cam.env, env_image, dir), 1.0);
     }
     return vec4<f32>(0.0);
 }
 
-// The mean radiance over params.specular.w directions reflected about GGX half-vectors
+// The mean radiance over cam.specular.w directions reflected about GGX half-vectors
 // (roughness `alpha`) around `n` seen from `wo`, a Hammersley set turned by `turn`.
 fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -> vec4<f32> {
     let pair = orthonormal_pair(n);
     var sum = vec3<f32>(0.0);
     var count = 0.0;
-    let rays = u32(params.specular.w);
+    let rays = u32(cam.specular.w);
     for (var k = 0u; k < rays; k++) {
         let u1 = (f32(k) + 0.5) / f32(rays);
         let u2 = fract(f32(reverseBits(k)) / 4294967296.0 + turn);

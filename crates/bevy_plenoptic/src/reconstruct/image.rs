@@ -184,7 +184,6 @@ pub(super) fn prepare_jobs(
         &MeshMaterial3d<PlenopticBackgroundMaterial>,
     )>,
     mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
-    mut proxy_materials: ResMut<Assets<super::PlenopticMaterial>>,
 ) {
     for (camera, mut job) in &mut cameras {
         let work = job_for(&backend, &keys, &cache, &packs, camera);
@@ -193,24 +192,14 @@ pub(super) fn prepare_jobs(
             let size = UVec2::new(w.params.size.x, w.params.size.y);
             if images.get(&frame.0).is_some_and(|i| i.size() != size) {
                 images.insert(&frame.0, frame_image(size.x, size.y)).ok();
-                // Touch the camera's background and proxy materials so that their bind groups
-                // take the new texture (the proxies' uniforms are written only when they
-                // change).
+                // Touch the camera's background so that its bind group takes the new texture
+                // (the proxies and lit meshes see it in their camera's
+                // `view::ViewBuffer::bindings`).
                 for (bg, handle) in &backgrounds {
                     if bg.camera == entity
                         && let Some(m) = background_materials.get_mut(&handle.0)
                     {
                         // Marks it modified (a bare `get_mut` does not).
-                        m.into_inner();
-                    }
-                }
-                let users: Vec<_> = proxy_materials
-                    .iter()
-                    .filter(|(_, m)| m.image_frame == frame.0)
-                    .map(|(id, _)| id)
-                    .collect();
-                for id in users {
-                    if let Some(m) = proxy_materials.get_mut(id) {
                         m.into_inner();
                     }
                 }

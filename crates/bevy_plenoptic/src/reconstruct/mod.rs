@@ -57,6 +57,7 @@ pub mod rays;
 pub mod reflect;
 pub mod sun;
 pub mod upload;
+pub mod view;
 pub mod volume;
 pub mod volume_mode;
 
@@ -73,9 +74,7 @@ use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::{ReconMode, ReconSettings};
 use crate::proxy::{PlenopticScene, ProxyOf};
-use crate::streaming::StreamCache;
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
-use frame::{FrameLookups, frame_lookups, warped};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
@@ -113,11 +112,13 @@ impl Plugin for PlenopticReconstructPlugin {
                     image::add_frames,
                     rays::add_camera_rays,
                     rays::place_rays,
+                    view::add_view_buffers,
                     attach_materials,
                     background::spawn_backgrounds,
                     volume_mode::prepare_cubes,
                     image::prepare_jobs,
                     sun::update_suns,
+                    view::update_view_buffers,
                     update_materials,
                 )
                     .chain()
@@ -170,16 +171,18 @@ fn resolve_backend(
     }
 }
 
-/// The proxy material of the GPU path: one instance per proxy object of each camera (its
-/// uniform carries that camera's lookups).
+/// The proxy material of the GPU path: one instance per proxy object of each camera. Its
+/// uniform holds its object's part ([`ObjectParams`]), and it binds its camera's view buffer
+/// ([`view::ViewBuffer`]) for the camera's lookups, which every material of the camera
+/// shares.
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
 pub struct PlenopticMaterial {
     /// Resident keys (see the module doc).
     #[texture(0, dimension = "2d_array", sample_type = "u_int")]
     pub cubes: Handle<Image>,
-    /// Lookups of this frame for this material's object.
+    /// The object's id, motion slot, coverage and material.
     #[uniform(1)]
-    pub params: ReconParams,
+    pub params: ObjectParams,
     /// Resident temporal-volume samples of the pack ([`volume::PackVolumes::samples`]).
     #[storage(2, read_only)]
     pub volume_samples: Handle<ShaderBuffer>,
@@ -209,10 +212,10 @@ pub struct PlenopticMaterial {
     #[texture(16)]
     #[sampler(17)]
     pub emissive_texture: Option<Handle<Image>>,
-    /// The pack's environment at the camera's time: what reflected rays that leave the scene
-    /// see ([`reflect`]).
-    #[uniform(10)]
-    pub environment: background::EnvironmentUniform,
+    /// The camera's view buffer ([`view::ViewBuffer`]): its lookups, tunables, sun,
+    /// environment and the animated objects' motion this frame.
+    #[storage(10, read_only)]
+    pub view: Handle<ShaderBuffer>,
     /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
     #[texture(11, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
@@ -240,6 +243,8 @@ pub struct PlenopticMaterial {
     /// `plenoptic_recon`'s glazing module composites a pane); elsewhere it is opaque (alpha 1).
     /// Glazing (`coverage` < 1) is blended as glazing even where its material transmits.
     pub transmissive: bool,
+    /// The camera's [`view::ViewBuffer::bindings`] when the bind group was last prepared.
+    pub bindings: u64,
 }
 
 impl Material for PlenopticMaterial {
@@ -271,23 +276,19 @@ impl Material for PlenopticMaterial {
     }
 }
 
-/// The per-frame uniform of a [`PlenopticMaterial`].
+/// The uniform of a [`PlenopticMaterial`]: what belongs to its object (the camera's part is
+/// in its view buffer, [`view::ViewParams`]). It changes only with the camera's settings.
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
-pub struct ReconParams {
-    /// x: lookup count, y: object id, z: face size, w: volume block count.
-    pub header: Vec4,
-    /// x: relative depth tolerance, y: angular power, z: time t, w: temporal window tε.
-    pub tuning: Vec4,
-    /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
-    /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
-    /// image-mode passes' frame instead (image and volume modes), w: the glazing's coverage
-    /// (its output alpha in geometry-assisted mode; 1 or 0 for opaque objects).
-    pub fill: Vec4,
-    /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
-    /// `CubeFilter::Bilinear` (0: the nearest texel); y: 1 to shade as albedo · lighting +
+pub struct ObjectParams {
+    /// x: the object's id, y: its motion slot ([`view::ViewParams::motion`]; −1 for a static
+    /// object, in world space), z: its coverage (its output alpha as glazing in
+    /// geometry-assisted mode; 1 for opaque objects), w: 1 to shade as albedo · lighting +
     /// non-diffuse (`Shading::Materials`; those lookups are always bilinear).
-    pub flags: Vec4,
-    /// The object's base-colour factor (xyz) and metallic factor (w) when `flags.y` is 1.
+    pub object: Vec4,
+    /// x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
+    /// mean transmittance per surface.
+    pub glass: Vec4,
+    /// The object's base-colour factor (xyz) and metallic factor (w) when `object.w` is 1.
     pub albedo: Vec4,
     /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
     /// z: the metallic-roughness texture's (0: none); w: the normal map's (0: none).
@@ -303,14 +304,6 @@ pub struct ReconParams {
     /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]), z: the normal
     /// map's scale.
     pub surface: Vec4,
-    /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
-    pub sun: Vec4,
-    /// The runtime sun's illuminance at the camera's time (xyz).
-    pub sun_illuminance: Vec4,
-    /// Reflections marched for the camera ([`reflect`]): x: 1 when on, y: the roughest
-    /// glossy surface marched (−1: ideal mirrors only), z: how far rays are marched, w: rays
-    /// per glossy pixel.
-    pub specular: Vec4,
     /// The material's emissive factor (xyz; [`MaterialFactors::fill`]).
     pub emissive: Vec4,
     /// The emissive texture's `KHR_texture_transform`: offset (xy), scale (zw).
@@ -319,16 +312,6 @@ pub struct ReconParams {
     /// emission to the runtime (pack 4: every lit fragment adds it); z: 1 when the material
     /// is double-sided (else it emits from its front only); w: the texture's UV rotation.
     pub emission: Vec4,
-    /// Base view position (xyz) and first array layer (w) per lookup.
-    pub base: [Vec4; MAX_LOOKUPS],
-    /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
-    pub weight: [Vec4; MAX_LOOKUPS],
-    /// `M_o(τ) M_o(t)⁻¹` per lookup.
-    pub motion: [Mat4; MAX_LOOKUPS],
-    /// Base view position (xyz) and view weight (w) per volume block.
-    pub volume: [Vec4; volume::MAX_VOLUMES],
-    /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
-    pub volume_range: [UVec4; volume::MAX_VOLUMES],
 }
 
 /// The key texture of each pack and which key each slot holds.
@@ -360,7 +343,7 @@ fn attach_materials(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
-    cameras: Query<(&image::ImageFrame, &rays::CameraRays)>,
+    cameras: Query<(&image::ImageFrame, &rays::CameraRays, &view::ViewBuffer)>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
@@ -376,7 +359,7 @@ fn attach_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Ok((image_frame, camera_rays)) = cameras.get(scene.camera) else {
+        let Ok((image_frame, camera_rays, view_buffer)) = cameras.get(scene.camera) else {
             continue;
         };
         let (Some(tex), Some(vol), Some(pack)) = (
@@ -393,7 +376,7 @@ fn attach_materials(
         let environment_image = env_images.get(scene.pack.id(), pack, &mut images);
         let m = materials.add(PlenopticMaterial {
             cubes: tex.image.clone(),
-            params: ReconParams::default(),
+            params: ObjectParams::default(),
             volume_samples: vol.samples.clone(),
             volume_bins: vol.bins.clone(),
             image_frame: image_frame.0.clone(),
@@ -402,13 +385,14 @@ fn attach_materials(
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
             normal_texture: factors.as_ref().and_then(|f| f.normal.clone()),
             emissive_texture: factors.as_ref().and_then(|f| f.emissive.clone()),
-            environment: background::EnvironmentUniform::default(),
+            view: view_buffer.buffer.clone(),
             environment_image,
             rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
             ray_placements: camera_rays.buffer.clone(),
             albedo: factors,
             coverage: object_coverage(pack, of.id),
             transmissive,
+            bindings: view_buffer.bindings,
         });
         commands
             .entity(entity)
@@ -456,9 +440,9 @@ pub struct MaterialFactors {
 
 impl MaterialFactors {
     /// The uniform's material fields.
-    fn fill(&self, params: &mut ReconParams) {
+    fn fill(&self, params: &mut ObjectParams) {
         let m = &self.material;
-        params.flags.y = 1.0;
+        params.object.w = 1.0;
         params.albedo = m.base_colour.truncate().extend(m.metallic.clamp(0.0, 1.0));
         params.material = Vec4::new(
             m.transmission.clamp(0.0, 1.0),
@@ -529,15 +513,18 @@ pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialF
     })
 }
 
-/// Fills every proxy material's lookups for its camera, and every background's environment
-/// key.
+/// Keeps every proxy material's uniform and bindings up to date with its camera, and every
+/// background's environment and key.
+///
+/// A material is written only when its uniform (which changes with the camera's settings)
+/// or its camera's bindings changed: a written asset's bind group is prepared again, and the
+/// per-frame lookups are in the camera's view buffer, so a camera costs no material uploads
+/// from one frame to the next.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 pub(crate) fn update_materials(
-    keys: Res<KeyTextures>,
-    volumes: Res<volume::VolumeBuffers>,
-    cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<(&PlenopticCamera, &GlobalTransform, &image::ImageJob)>,
+    keys: Res<KeyTextures>,
+    cameras: Query<(&PlenopticCamera, &view::ViewBuffer)>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(&ChildOf, &ProxyOf, &MeshMaterial3d<PlenopticMaterial>)>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
@@ -547,76 +534,34 @@ pub(crate) fn update_materials(
     )>,
     mut background_materials: ResMut<Assets<background::PlenopticBackgroundMaterial>>,
 ) {
-    // Each camera's lookups, computed once per frame.
-    let mut frames: HashMap<Entity, FrameLookups> = HashMap::new();
-    let mut frame = |camera: Entity, cam: &PlenopticCamera, at: Vec3| {
-        let id = cam.pack.id();
-        let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
-        Some(
-            frames
-                .entry(camera)
-                .or_insert_with(|| {
-                    frame_lookups(id, pack, tex, &cache, &cam.settings, at, cam.time)
-                })
-                .clone(),
-        )
-    };
     for (parent, of, handle) in &proxies {
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Ok((cam, transform, job)) = cameras.get(scene.camera) else {
+        let Ok((cam, view)) = cameras.get(scene.camera) else {
             continue;
         };
-        let id = cam.pack.id();
-        let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
-            continue;
-        };
-        let Some(f) = frame(scene.camera, cam, transform.translation()) else {
-            continue;
-        };
-        let ctx = frame::CameraFrame {
-            cam,
-            pack,
-            tex,
-            volumes: volumes.0.get(&id),
-            lookups: &f,
-            image_mode: warped(cam.mode) && job.0.is_some(),
-        };
-        let drawn_inverse = pack.proxy(of.id).map_or(Mat4::IDENTITY, |p| {
-            p.transform_at(cam.time).to_matrix().inverse()
-        });
-        let Some(mat) = materials.get(&handle.0) else {
+        let (Some(pack), Some(mat)) = (packs.get(cam.pack.id()), materials.get(&handle.0)) else {
             continue;
         };
         // Coverage and material were looked up in the manifest once, when the material was
         // attached.
-        let params = ctx.params(&frame::ObjectShading {
+        let params = frame::ObjectShading {
             id: of.id,
-            drawn_inverse,
             coverage: mat.coverage,
             factors: mat.albedo.as_ref(),
-        });
-        let environment = (mat.albedo.is_some()
-            && cam.settings.shading == plenoptic_recon::Shading::Materials)
-            .then(|| background::EnvironmentUniform::new(&pack.environment.at(cam.time)))
-            .filter(|e| *e != mat.environment);
-        let params = (mat.params != params).then_some(params);
-        // Written only when it changed: a written asset's bind group is prepared again, so a
-        // still camera (or one whose lookups did not change) costs no uploads.
-        if (params.is_some() || environment.is_some())
+        }
+        .params(cam, pack);
+        if (mat.params != params || mat.bindings != view.bindings || mat.view != view.buffer)
             && let Some(mut mat) = materials.get_mut(&handle.0)
         {
-            if let Some(environment) = environment {
-                mat.environment = environment;
-            }
-            if let Some(params) = params {
-                mat.params = params;
-            }
+            mat.params = params;
+            mat.bindings = view.bindings;
+            mat.view = view.buffer.clone();
         }
     }
     for (bg, handle) in &backgrounds {
-        let Ok((cam, transform, job)) = cameras.get(bg.camera) else {
+        let Ok((cam, view)) = cameras.get(bg.camera) else {
             continue;
         };
         if bg.cpu {
@@ -624,8 +569,7 @@ pub(crate) fn update_materials(
         }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
-        let layer = frame(bg.camera, cam, transform.translation()).and_then(|f| f.heaviest_layer());
-        let image_mode = warped(cam.mode) && job.0.is_some();
+        let layer = view.lookups.heaviest_layer();
         let env = packs
             .get(id)
             .map(|p| p.environment.at(cam.time))
@@ -636,7 +580,7 @@ pub(crate) fn update_materials(
             &env,
             layer,
             face,
-            image_mode,
+            view.params().fill.z == 1.0,
         );
     }
 }

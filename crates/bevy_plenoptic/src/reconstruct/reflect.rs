@@ -18,12 +18,12 @@ use bevy::prelude::*;
 use plenoptic_recon::Specular;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
-use super::ReconParams;
+use super::view::ViewParams;
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 
-/// The uniform's reflection fields for an object in `pack`, as the camera's `settings` ask.
-pub(super) fn fill(params: &mut ReconParams, pack: &RadiancePack, settings: &ReconSettings) {
+/// The view buffer's reflection fields on `pack`, as the camera's `settings` ask.
+pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &ReconSettings) {
     let manifest = pack.reader.manifest();
     params.specular = match settings.specular {
         Specular::Baked => Vec4::ZERO,

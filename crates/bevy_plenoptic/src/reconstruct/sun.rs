@@ -20,7 +20,7 @@
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
 
-use super::ReconParams;
+use super::view::ViewParams;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
@@ -40,8 +40,8 @@ pub fn sun_at(pack: &RadiancePack, t: f32) -> Option<(Vec3, Vec3)> {
     Some((towards.normalize_or(Vec3::Y), illuminance))
 }
 
-/// The uniform's sun fields for a fragment shown at time `t` from `pack`.
-pub(super) fn fill(params: &mut ReconParams, pack: &RadiancePack, t: f32) {
+/// The view buffer's sun fields for a camera at time `t` on `pack`.
+pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, t: f32) {
     if let Some((towards, illuminance)) = sun_at(pack, t) {
         params.sun = towards.extend(1.0);
         params.sun_illuminance = illuminance.extend(0.0);

@@ -6,7 +6,7 @@
 //! Every resident volume block of a pack ([`crate::streaming::BinnedVolume`]: samples sorted
 //! by direction bin, and the bins' offsets) is packed into two storage buffers per pack,
 //! rebuilt when the set of resident blocks changes; each block's place in them is passed
-//! per frame in the material's uniform ([`ReconParams::volume_range`]).
+//! per frame in the camera's view buffer ([`ViewParams::volume_range`]).
 
 use std::collections::HashMap;
 
@@ -14,7 +14,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
 
-use super::ReconParams;
+use super::view::ViewParams;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::streaming::schedule::BlockRef;
@@ -37,6 +37,9 @@ pub struct PackVolumes {
     pub bins: Handle<ShaderBuffer>,
     /// Per block in the buffers: (first sample, first bin offset).
     pub layout: HashMap<BlockRef, (u32, u32)>,
+    /// Counts the repacks: the buffers are new ones after each, which the materials must
+    /// bind again ([`super::view::ViewBuffer::bindings`]).
+    pub generation: u64,
 }
 
 impl PackVolumes {
@@ -46,6 +49,7 @@ impl PackVolumes {
             samples: buffers.add(storage(&[0; VOLUME_SAMPLE_WORDS])),
             bins: buffers.add(storage(&[0; VOLUME_BIN_OFFSETS])),
             layout: HashMap::new(),
+            generation: 0,
         }
     }
 }
@@ -104,13 +108,14 @@ pub(super) fn upload_volumes(
             *s = storage(&bins);
         }
         pv.layout = layout;
+        pv.generation += 1;
     }
 }
 
 /// Fills the volume entries of `params` for the views `views` (index, normalised weight)
 /// at the buckets `buckets`, from the blocks uploaded in `pv`; `eps` is tε.
 pub(super) fn fill_params(
-    params: &mut ReconParams,
+    params: &mut ViewParams,
     pv: Option<&PackVolumes>,
     views: &[(usize, f32)],
     positions: &[Vec3],
@@ -133,7 +138,7 @@ pub(super) fn fill_params(
             n += 1;
         }
     }
-    params.header.w = n as f32;
+    params.header.z = n as f32;
     params.tuning.z = t;
     params.tuning.w = eps;
 }

@@ -1,0 +1,210 @@
+//! Per-view state of the geometry-assisted path (thesis §8.2.3; `docs/architecture.md`, "The
+//! runtime plugin"): what one camera looks up this frame, in one storage buffer per camera
+//! that every material it draws binds.
+//!
+//! A camera's [`ViewBuffer`] holds its [`ViewParams`]: the lookups (base views, bracketing
+//! keys, weights), the volume blocks, its tunables from [`ReconSettings`], the runtime sun,
+//! the reflection settings and the pack's environment at its time, and per animated object
+//! of the pack the object's transform at each lookup's key time, `M_o(τ)`. It is rewritten
+//! in place once per camera per frame (Bevy reuses a storage buffer of the same size), so a
+//! material's own uniform ([`super::ObjectParams`]) holds only what belongs to its object:
+//! the object's id, its motion slot, its coverage and its material. A fragment carries its
+//! point into key τ's frame as `M_o(τ) · local_from_world · p`, with the drawn mesh's own
+//! inverse transform from Bevy's mesh uniform: for a proxy placed at the camera's time that
+//! is `M_o(t)⁻¹`, for an app mesh its own global transform (so its lighting follows it
+//! wherever the app's animation puts it). Static objects are in world space and not carried.
+//!
+//! [`ViewBuffer::bindings`] changes whenever something the camera's materials bind was
+//! replaced (its view buffer grew, the pack's volume buffers were repacked, the image-mode
+//! frame was resized); a material bound with another value is marked modified, so that Bevy
+//! prepares its bind group again. Bevy does not do this itself for a material's handles.
+
+use std::hash::{Hash, Hasher};
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::render_resource::ShaderType;
+use bevy::render::storage::ShaderBuffer;
+
+use super::frame::{CameraFrame, FrameLookups, frame_lookups, warped};
+use super::{KeyTextures, MAX_LOOKUPS, background, image, volume};
+use crate::asset::RadiancePack;
+use crate::camera::PlenopticCamera;
+#[cfg(doc)]
+use crate::camera::ReconSettings;
+use crate::streaming::StreamCache;
+
+/// One camera's lookups and settings, as `geometry.wgsl` reads them (`ViewParams` there).
+#[derive(ShaderType, Debug, Clone, Default, PartialEq)]
+pub struct ViewParams {
+    /// x: lookup count, y: face size, z: volume block count, w: unused.
+    pub header: Vec4,
+    /// x: relative depth tolerance, y: angular power, z: time t, w: temporal window tε.
+    pub tuning: Vec4,
+    /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
+    /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
+    /// image-mode passes' frame instead (image and volume modes).
+    pub fill: Vec4,
+    /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
+    /// `CubeFilter::Bilinear` (0: the nearest texel).
+    pub flags: Vec4,
+    /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
+    pub sun: Vec4,
+    /// The runtime sun's illuminance at the camera's time (xyz).
+    pub sun_illuminance: Vec4,
+    /// Reflections marched for the camera ([`super::reflect`]): x: 1 when on, y: the
+    /// roughest glossy surface marched (−1: ideal mirrors only), z: how far rays are marched,
+    /// w: rays per glossy pixel.
+    pub specular: Vec4,
+    /// Base view position (xyz) and first array layer (w) per lookup.
+    pub base: [Vec4; MAX_LOOKUPS],
+    /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
+    pub weight: [Vec4; MAX_LOOKUPS],
+    /// Base view position (xyz) and view weight (w) per volume block.
+    pub volume: [Vec4; volume::MAX_VOLUMES],
+    /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
+    pub volume_range: [UVec4; volume::MAX_VOLUMES],
+    /// The pack's environment at the camera's time: what reflected rays that leave the scene
+    /// see.
+    pub environment: background::EnvironmentUniform,
+    /// `M_o(τ)` of each lookup per animated object: entry `slot · MAX_LOOKUPS + k` for the
+    /// object in motion slot `slot` ([`motion_slot`]) and lookup `k`.
+    #[shader(size(runtime))]
+    pub motion: Vec<Mat4>,
+}
+
+/// A camera's [`ViewParams`] buffer and this frame's lookups.
+#[derive(Component, Debug, Clone)]
+pub struct ViewBuffer {
+    /// The storage buffer its materials bind.
+    pub buffer: Handle<ShaderBuffer>,
+    /// What it holds now.
+    params: ViewParams,
+    /// This frame's lookups (the background's key comes from them).
+    pub(crate) lookups: FrameLookups,
+    /// Changes when something the camera's materials bind was replaced (see the module doc).
+    pub bindings: u64,
+}
+
+impl ViewBuffer {
+    /// What the buffer holds now.
+    pub fn params(&self) -> &ViewParams {
+        &self.params
+    }
+}
+
+/// The motion slot of the pack's object `id`: its index among the pack's animated objects,
+/// or `None` for a static one (in world space).
+pub(crate) fn motion_slot(pack: &RadiancePack, id: u32) -> Option<u32> {
+    pack.proxies
+        .iter()
+        .filter(|p| p.track.is_some())
+        .position(|p| p.id == id)
+        .map(|s| s as u32)
+}
+
+fn shader_buffer(params: &ViewParams) -> ShaderBuffer {
+    let mut b = ShaderBuffer::new(&[], RenderAssetUsages::RENDER_WORLD);
+    b.set_data(params.clone());
+    b
+}
+
+/// Gives every plenoptic camera its view buffer.
+pub(super) fn add_view_buffers(
+    mut commands: Commands,
+    cameras: Query<Entity, (With<PlenopticCamera>, Without<ViewBuffer>)>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+) {
+    for camera in &cameras {
+        let params = ViewParams {
+            motion: vec![Mat4::IDENTITY],
+            ..default()
+        };
+        commands.entity(camera).insert(ViewBuffer {
+            buffer: buffers.add(shader_buffer(&params)),
+            params,
+            lookups: FrameLookups::default(),
+            bindings: 0,
+        });
+    }
+}
+
+/// Fills each camera's view buffer for this frame (rewritten only when it changed).
+pub(super) fn update_view_buffers(
+    keys: Res<KeyTextures>,
+    volumes: Res<volume::VolumeBuffers>,
+    cache: Res<StreamCache>,
+    packs: Res<Assets<RadiancePack>>,
+    mut cameras: Query<(
+        &PlenopticCamera,
+        &GlobalTransform,
+        &image::ImageJob,
+        &image::ImageFrame,
+        &mut ViewBuffer,
+    )>,
+    images: Res<Assets<Image>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+) {
+    for (cam, transform, job, frame, mut view) in &mut cameras {
+        let id = cam.pack.id();
+        let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
+            continue;
+        };
+        let lookups = frame_lookups(
+            id,
+            pack,
+            tex,
+            &cache,
+            &cam.settings,
+            transform.translation(),
+            cam.time,
+        );
+        let pack_volumes = volumes.0.get(&id);
+        let ctx = CameraFrame {
+            cam,
+            pack,
+            tex,
+            volumes: pack_volumes,
+            lookups: &lookups,
+            image_mode: warped(cam.mode) && job.0.is_some(),
+        };
+        let params = ctx.view_params();
+        let view = view.as_mut();
+        if params.motion.len() != view.params.motion.len() {
+            // Another size: a new buffer, which the materials must bind again.
+            view.buffer = buffers.add(shader_buffer(&params));
+        } else if params != view.params
+            && let Some(mut b) = buffers.get_mut(&view.buffer)
+        {
+            b.set_data(params.clone());
+        }
+        view.params = params;
+        view.lookups = lookups;
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        view.buffer.id().hash(&mut h);
+        pack_volumes.map(|v| v.generation).hash(&mut h);
+        images.get(&frame.0).map(Image::size).hash(&mut h);
+        let bindings = h.finish();
+        if view.bindings != bindings {
+            view.bindings = bindings;
+        }
+    }
+}
+
+/// Fills the motion entries of `params` for `lookups`: per animated object of `pack`, its
+/// transform at each lookup's key time.
+pub(super) fn fill_motion(params: &mut ViewParams, pack: &RadiancePack, taus: &[f32]) {
+    params.motion.clear();
+    for p in pack.proxies.iter().filter(|p| p.track.is_some()) {
+        for k in 0..MAX_LOOKUPS {
+            params.motion.push(
+                taus.get(k)
+                    .map_or(Mat4::IDENTITY, |&tau| p.transform_at(tau).to_matrix()),
+            );
+        }
+    }
+    // Bindings may not be empty.
+    if params.motion.is_empty() {
+        params.motion.push(Mat4::IDENTITY);
+    }
+}
