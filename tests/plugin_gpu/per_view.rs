@@ -1,5 +1,5 @@
 //! Per-view state: a camera's lookups, time and settings live in its view buffer
-//! (`bevy_plenoptic::reconstruct::view`), which every material it draws binds. When the
+//! (`bevy_plenoptic::reconstruct::geometry::view`), which every material it draws binds. When the
 //! camera's time moves (the lookups' weights, keys and the slider's motion change), only the
 //! view buffer is rewritten; the proxy materials are written again only when something they
 //! bind was replaced, and the frame still equals the CPU's at the new time.
@@ -12,7 +12,7 @@ use crate::pack::{PackSpec, room, write_pack};
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::PlenopticMaterial;
-use bevy_plenoptic::reconstruct::view::ViewBuffer;
+use bevy_plenoptic::reconstruct::geometry::view::ViewBuffer;
 
 /// What happened to the camera's materials and view buffer, frame by frame.
 #[derive(Resource, Default)]

@@ -31,7 +31,7 @@
 //! `mod.rs` and shaders beside the code. The geometry-assisted mode rides on Bevy's `Material`
 //! pipeline (the material's bind group is the "prepare", the main opaque pass the "node"),
 //! which is also what gives correct depth compositing with ordinary meshes for free; image
-//! and volume modes add compute passes to the render graph (`reconstruct/image.rs`).
+//! and volume modes add compute passes to the render graph (`reconstruct/image/`).
 //!
 //! Errors never panic the app: a pack that cannot be opened is an asset load failure whose
 //! message names the section or chunk; a chunk that fails its checksum while streaming is a
@@ -135,7 +135,7 @@ pub enum Backend {
     /// covered pixels × base views × 2 keys, more where the volume fallback or the hole fill
     /// runs). Image mode runs as compute passes ([`reconstruct::image`]: splats of the
     /// weighted views' cube texels, view blend, background fill) shown through the proxies
-    /// and the background. Volume mode ([`reconstruct::volume_mode`]) interpolates each
+    /// and the background. Volume mode ([`reconstruct::volume`]) interpolates each
     /// weighted view's cube at t from its resident temporal-volume blocks on the CPU (off
     /// the main thread, when the time or views change) and warps those cubes with the same
     /// passes. Every camera in image or volume mode has its own passes and frame; until its

@@ -16,11 +16,11 @@
 //! - **Shading.** A matched mesh's material becomes an `ExtendedMaterial<StandardMaterial,
 //!   PlenopticLighting>` ([`LitMaterial`]), a copy of its own material made when it is matched
 //!   (later edits to the original do not reach it), whose fragment shader is the proxies'
-//!   (`reconstruct/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups, weights and
+//!   (`reconstruct/geometry/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups, weights and
 //!   fallbacks, the same marched reflections and runtime sun, with the mesh's own base
 //!   colour, metalness, roughness and normal map per pixel. Its object uniform is filled by
-//!   the same code as a proxy's ([`crate::reconstruct::frame`]) and it binds the camera's
-//!   view buffer ([`crate::reconstruct::view`]), as the camera's proxies do; the shader
+//!   the same code as a proxy's ([`crate::reconstruct::geometry::frame`]) and it binds the camera's
+//!   view buffer ([`crate::reconstruct::geometry::view`]), as the camera's proxies do; the shader
 //!   carries a fragment's point into the pack's object frame with the mesh's own inverse
 //!   transform for an animated object (so the lighting follows the object wherever the app's
 //!   animation puts it), not at all for a static one (its proxy is in world space).
@@ -58,12 +58,13 @@ use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
-use crate::reconstruct::frame::ObjectShading;
-use crate::reconstruct::rays::{CameraRays, PackRays};
-use crate::reconstruct::view::ViewBuffer;
+use crate::reconstruct::geometry::frame::ObjectShading;
+use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
+use crate::reconstruct::geometry::view::ViewBuffer;
+use crate::reconstruct::geometry::volume::VolumeBuffers;
 use crate::reconstruct::{
-    KeyTextures, MaterialFactors, ObjectParams, ResolvedBackend, background, image,
-    material_factors, object_coverage, volume,
+    KeyTextures, MaterialFactors, ObjectParams, ReconstructSystems, ResolvedBackend, background,
+    image, material_factors, object_coverage,
 };
 use crate::{Backend, PlenopticSystems};
 
@@ -116,7 +117,7 @@ pub struct PlenopticLighting {
     /// The resident keys' lighting and non-diffuse radiance.
     #[texture(105, dimension = "2d_array", sample_type = "u_int")]
     pub shading_cubes: Handle<Image>,
-    /// The camera's view buffer ([`crate::reconstruct::view::ViewBuffer`]): its lookups,
+    /// The camera's view buffer ([`crate::reconstruct::geometry::view::ViewBuffer`]): its lookups,
     /// tunables, sun, environment and the animated objects' motion this frame.
     #[storage(110, read_only)]
     pub view: Handle<ShaderBuffer>,
@@ -124,7 +125,7 @@ pub struct PlenopticLighting {
     #[texture(111, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
     /// The pack's proxies as reflected rays are cast against them
-    /// ([`crate::reconstruct::rays`]).
+    /// ([`crate::reconstruct::geometry::rays`]).
     #[storage(112, read_only)]
     pub rays: Handle<ShaderBuffer>,
     /// The camera's moving proxies placed at its time.
@@ -141,7 +142,7 @@ pub struct PlenopticLighting {
 
 impl MaterialExtension for PlenopticLighting {
     fn fragment_shader() -> ShaderRef {
-        "embedded://bevy_plenoptic/reconstruct/geometry.wgsl".into()
+        "embedded://bevy_plenoptic/reconstruct/geometry/geometry.wgsl".into()
     }
 
     fn specialize(
@@ -172,7 +173,7 @@ pub(super) fn build(app: &mut App) {
             )
                 .chain()
                 .after(PlenopticSystems::Streaming)
-                .after(crate::reconstruct::update_materials)
+                .after(ReconstructSystems::Materials)
                 .after(crate::reconstruct::cpu::run_cpu_frames),
         );
 }
@@ -336,7 +337,7 @@ fn attach_lit_materials(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
-    volumes: Res<volume::VolumeBuffers>,
+    volumes: Res<VolumeBuffers>,
     roots: Query<(Entity, &PlenopticLit)>,
     children: Query<&Children>,
     parents: Query<&ChildOf>,
@@ -454,7 +455,7 @@ fn release_lit_materials(
 }
 
 /// Keeps every lit mesh's uniform and bindings up to date with its camera, as the proxies'
-/// are ([`crate::reconstruct::update_materials`]): written only when they changed.
+/// are ([`crate::reconstruct::geometry::prepare::update_materials`]): written only when they changed.
 fn update_lit_materials(
     packs: Res<Assets<RadiancePack>>,
     cameras: Query<(&PlenopticCamera, &ViewBuffer)>,

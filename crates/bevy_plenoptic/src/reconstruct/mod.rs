@@ -1,48 +1,22 @@
-//! GPU geometry-assisted reconstruction (thesis §8.2.3); image mode is in [`image`] (compute
-//! passes whose frame the proxy materials and the background show), and volume mode in
-//! [`volume_mode`] (cubes at t interpolated on the CPU from the temporal volumes, warped by
-//! the image-mode passes).
+//! The GPU reconstruction, one folder per feature (`docs/architecture.md`, "The runtime
+//! plugin"), each with its plugin in `mod.rs`, its main-world and render-world stages in
+//! files of their own and its shaders beside them:
 //!
-//! Every proxy mesh is drawn with a [`PlenopticMaterial`] whose fragment shader
-//! (`geometry.wgsl`, beside this file) does the lookups of `plenoptic_recon`'s geometry mode:
-//! for each resident (base view, bracketing time key) the fragment's point is carried along
-//! its object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, looked up in that key's cube (the nearest
-//! texel, or seamlessly bilinear over the texels of the same object and distance with the
-//! camera's `CubeFilter::Bilinear`, as on the CPU), accepted if the cube saw the same object at the same distance, and blended with
-//! weight `w_view · w_time · ((1 + cos θ)/2)^p`. The result, times the camera's exposure
-//! (`view.exposure`, as Bevy's lights), is written unlit into the camera's HDR target; depth
-//! comes from the rasterised proxy mesh.
+//! - [`geometry`]: geometry-assisted mode (thesis §8.2.3), the proxy material whose fragment
+//!   shader does `plenoptic_recon`'s lookups, with each camera's lookups in its view buffer;
+//! - [`image`]: image mode, `plenoptic_recon`'s warping in compute passes per view, whose
+//!   frame the proxy materials and the background show;
+//! - [`volume`]: volume mode, cubes at t interpolated on the CPU from the temporal volumes and
+//!   warped by the image-mode passes;
+//! - [`background`]: the pack's environment (or the heaviest key's cube) behind the proxies;
+//! - [`cpu`]: the CPU backend, `plenoptic_recon` run off the main thread and shown in screen
+//!   space.
 //!
-//! Where no lookup is accepted, the same fallbacks as `plenoptic_recon`, in its order:
-//! 1. the temporal volumes ([`volume`]): samples of the object near the point's direction
-//!    from each base view, within `t ± tε`;
-//! 2. the same-object hole fill: the nearest ring of pixels (radius up to
-//!    [`ReconSettings::hole_fill_radius`]) whose points have a direct or volume lookup of this object, their
-//!    mean. A fragment cannot read its neighbours' results, so it recomputes them at the
-//!    points the neighbouring pixels show, read from the depth prepass
-//!    ([`PlenopticCamera`] requires one); a lookup accepted there means the neighbour shows
-//!    this object, as the CPU's mask test does. Without a prepass (a camera that removed it)
-//!    each ring pixel's ray is intersected with the fragment's surface plane instead, exact on
-//!    planar faces only;
-//! 3. the heaviest key's texel in the point's direction ("background").
-//!
-//! See-through glazing (objects with a pack coverage c < 1: glass exported as `alphaMode:
-//! BLEND`) is drawn in Bevy's transparent pass with alpha c over what lies behind it, the
-//! environment included, as `plenoptic_recon`'s glazing module composites it; its hole fill
-//! finds ring pixels on its plane (it is not in the depth prepass).
-//!
-//! Pixels no proxy covers show the pack's environment for their viewing direction at the
-//! camera's time, or without one the heaviest key's cube in that direction ([`background`],
-//! a full-screen triangle behind all geometry), as on the CPU.
-//!
-//! Every plenoptic camera has its own proxies, materials, background, image-mode frame and
-//! sun, on its own render layer ([`crate::camera::layers`]): any number of cameras, each with
-//! its own pack, time and mode, render in one app.
-//!
-//! On a pack 3 whose lighting leaves the sun to the runtime, lit objects add the sun's direct
-//! light per fragment through their BSDF, shadowed by Bevy's shadow map of a directional
-//! light the plugin keeps aimed along the pack's sun ([`sun`]). Proxies are drawn with both
-//! faces in every pass (the CPU's raster and shadow rays see both).
+//! Shared here: the key textures and their uploads ([`upload`]), the backend in use, and the
+//! order of the main-world systems ([`ReconstructSystems`]). Every plenoptic camera has its
+//! own proxies, materials, background, image-mode frame and sun, on its own render layer
+//! ([`crate::camera::layers`]): any number of cameras, each with its own pack, time and mode,
+//! render in one app.
 //!
 //! Resident keys live in one `Rgba32Uint` 2D-array texture per pack: texel = (radiance as
 //! RGB9E5, distance as f32 bits, object id, oct-encoded RG16Snorm normal), six layers per
@@ -51,81 +25,80 @@
 
 pub mod background;
 pub mod cpu;
-pub mod frame;
+pub mod geometry;
 pub mod image;
-pub mod rays;
-pub mod reflect;
-pub mod sun;
 pub mod upload;
-pub mod view;
 pub mod volume;
-pub mod volume_mode;
 
 use std::collections::{HashMap, HashSet};
 
-use bevy::asset::embedded_asset;
 use bevy::prelude::*;
-use bevy::render::render_resource::{AsBindGroup, ShaderType};
-use bevy::render::storage::ShaderBuffer;
-use bevy::shader::ShaderRef;
 
 use crate::asset::RadiancePack;
-use crate::camera::PlenopticCamera;
-#[cfg(doc)]
-use crate::camera::{ReconMode, ReconSettings};
-use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::{Backend, PlenopticSettings, PlenopticSystems};
+pub use geometry::{MaterialFactors, ObjectParams, PlenopticMaterial};
+pub(crate) use geometry::{material_factors, object_coverage};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
 /// Most array layers of the key texture (a common device limit is 2048).
 const MAX_LAYERS: u32 = 2046;
 
-/// Adds the GPU reconstruction material.
+/// The order of the reconstruction's main-world systems each frame, after streaming.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ReconstructSystems {
+    /// Keys and volume blocks uploaded; every camera given its frame, view buffer and ray
+    /// placements.
+    Resources,
+    /// Materials attached to new proxies, backgrounds spawned.
+    Attach,
+    /// Per-camera work: volume-mode cubes, image-mode jobs, the runtime suns.
+    Jobs,
+    /// Each camera's view buffer filled for this frame.
+    Views,
+    /// Materials and backgrounds kept bound to their camera.
+    Materials,
+}
+
+/// Adds the GPU reconstruction: its features' plugins and what they share.
 #[derive(Debug, Default)]
 pub struct PlenopticReconstructPlugin;
 
 impl Plugin for PlenopticReconstructPlugin {
     fn build(&self, app: &mut App) {
-        // Cube helpers the reconstruction shaders import (`plenoptic::cube`).
+        // Cube helpers the reconstruction shaders import (`plenoptic::cube`) and the pack's
+        // environment (`plenoptic::environment`).
         bevy::shader::load_shader_library!(app, "cube.wgsl");
-        // The pack's environment (`plenoptic::environment`) and the reflection march
-        // (`plenoptic::reflect`).
         bevy::shader::load_shader_library!(app, "environment.wgsl");
-        bevy::shader::load_shader_library!(app, "reflect.wgsl");
-        bevy::shader::load_shader_library!(app, "rays.wgsl");
-        embedded_asset!(app, "geometry.wgsl");
         upload::build(app);
-        background::build(app);
-        image::build(app);
-        app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
-            .init_resource::<KeyTextures>()
+        app.init_resource::<KeyTextures>()
             .init_resource::<ResolvedBackend>()
-            .init_resource::<volume::VolumeBuffers>()
-            .init_resource::<rays::PackRays>()
-            .add_systems(PreUpdate, resolve_backend)
-            .add_systems(
+            .configure_sets(
                 Update,
                 (
-                    upload::upload_keys,
-                    volume::upload_volumes,
-                    image::add_frames,
-                    rays::add_camera_rays,
-                    rays::place_rays,
-                    view::add_view_buffers,
-                    attach_materials,
-                    background::spawn_backgrounds,
-                    volume_mode::prepare_cubes,
-                    image::prepare_jobs,
-                    sun::update_suns,
-                    view::update_view_buffers,
-                    update_materials,
+                    ReconstructSystems::Resources,
+                    ReconstructSystems::Attach,
+                    ReconstructSystems::Jobs,
+                    ReconstructSystems::Views,
+                    ReconstructSystems::Materials,
                 )
                     .chain()
                     .after(PlenopticSystems::Streaming),
+            )
+            .add_plugins((
+                geometry::GeometryAssistedPlugin,
+                image::WarpPlugin,
+                volume::VolumeModePlugin,
+                background::BackgroundPlugin,
+            ))
+            .add_systems(PreUpdate, resolve_backend)
+            .add_systems(
+                Update,
+                upload::upload_keys
+                    .in_set(ReconstructSystems::Resources)
+                    .before(geometry::volume::upload_volumes),
             );
     }
-
     fn finish(&self, app: &mut App) {
         // Like bevy_solari: check the device once; a missing capability is a warning and the
         // CPU backend, never a panic.
@@ -171,149 +144,6 @@ fn resolve_backend(
     }
 }
 
-/// The proxy material of the GPU path: one instance per proxy object of each camera. Its
-/// uniform holds its object's part ([`ObjectParams`]), and it binds its camera's view buffer
-/// ([`view::ViewBuffer`]) for the camera's lookups, which every material of the camera
-/// shares.
-#[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
-pub struct PlenopticMaterial {
-    /// Resident keys (see the module doc).
-    #[texture(0, dimension = "2d_array", sample_type = "u_int")]
-    pub cubes: Handle<Image>,
-    /// The object's id, motion slot, coverage and material.
-    #[uniform(1)]
-    pub params: ObjectParams,
-    /// Resident temporal-volume samples of the pack ([`volume::PackVolumes::samples`]).
-    #[storage(2, read_only)]
-    pub volume_samples: Handle<ShaderBuffer>,
-    /// Their bin offsets ([`volume::PackVolumes::bins`]).
-    #[storage(3, read_only)]
-    pub volume_bins: Handle<ShaderBuffer>,
-    /// The camera's image-mode frame ([`image::ImageFrame`]), shown instead of the lookups
-    /// while the camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
-    #[texture(4, sample_type = "float", filterable = false)]
-    pub image_frame: Handle<Image>,
-    /// The resident keys' lighting and non-diffuse radiance ([`KeyTexture::shading`]).
-    #[texture(5, dimension = "2d_array", sample_type = "u_int")]
-    pub shading_cubes: Handle<Image>,
-    /// The object's base-colour texture from the pack (sRGB; white when it has none).
-    #[texture(6)]
-    #[sampler(7)]
-    pub base_colour_texture: Option<Handle<Image>>,
-    /// Its metallic-roughness texture (blue: metallic; white when it has none).
-    #[texture(8)]
-    #[sampler(9)]
-    pub metallic_roughness_texture: Option<Handle<Image>>,
-    /// Its normal map (linear; a flat one when it has none).
-    #[texture(14)]
-    #[sampler(15)]
-    pub normal_texture: Option<Handle<Image>>,
-    /// Its emissive texture (sRGB; white when it has none).
-    #[texture(16)]
-    #[sampler(17)]
-    pub emissive_texture: Option<Handle<Image>>,
-    /// The camera's view buffer ([`view::ViewBuffer`]): its lookups, tunables, sun,
-    /// environment and the animated objects' motion this frame.
-    #[storage(10, read_only)]
-    pub view: Handle<ShaderBuffer>,
-    /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
-    #[texture(11, sample_type = "float", filterable = false)]
-    pub environment_image: Handle<Image>,
-    /// The pack's proxies as reflected rays are cast against them ([`rays`]).
-    #[storage(12, read_only)]
-    pub rays: Handle<ShaderBuffer>,
-    /// The camera's moving proxies placed at its time ([`rays::CameraRays`]).
-    #[storage(13, read_only)]
-    pub ray_placements: Handle<ShaderBuffer>,
-    /// The object's diffuse albedo factors from its material in the pack: base-colour factor
-    /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
-    /// (the textures multiply per pixel); `None` for an object without a material, which
-    /// shows its radiance.
-    pub albedo: Option<MaterialFactors>,
-    /// The object's coverage when it is see-through glazing (the pack's
-    /// [`plenoptic_pack::ObjectEntry::coverage`]), else 1. Glazing is drawn in Bevy's
-    /// transparent pass, blended over what lies behind it with this alpha in
-    /// geometry-assisted mode, as `plenoptic_recon`'s glazing module composites it.
-    pub coverage: f32,
-    /// Whether the object's material in the pack is transmissive glass. Such glass is drawn
-    /// in Bevy's transparent pass with premultiplied alpha: where the camera's settings show
-    /// it see-through ([`plenoptic_recon::specular::see_through_transmittance`]), the
-    /// fragment is its reflection marched for the camera over what lies behind, which shows
-    /// through with the mean of the per-surface transmittance T, both faces drawn (T², as
-    /// `plenoptic_recon`'s glazing module composites a pane); elsewhere it is opaque (alpha 1).
-    /// Glazing (`coverage` < 1) is blended as glazing even where its material transmits.
-    pub transmissive: bool,
-    /// The camera's [`view::ViewBuffer::bindings`] when the bind group was last prepared.
-    pub bindings: u64,
-}
-
-impl Material for PlenopticMaterial {
-    fn fragment_shader() -> ShaderRef {
-        "embedded://bevy_plenoptic/reconstruct/geometry.wgsl".into()
-    }
-
-    fn alpha_mode(&self) -> AlphaMode {
-        if self.coverage < 1.0 {
-            AlphaMode::Blend
-        } else if self.transmissive {
-            AlphaMode::Premultiplied
-        } else {
-            AlphaMode::Opaque
-        }
-    }
-
-    /// Both faces, in every pass: the CPU's raster and shadow rays see both, and a room's
-    /// proxies face inwards, so with back faces culled the runtime sun's shadow map would miss
-    /// a ceiling seen from above.
-    fn specialize(
-        _pipeline: &bevy::pbr::MaterialPipeline,
-        descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
-        _layout: &bevy::mesh::MeshVertexBufferLayoutRef,
-        _key: bevy::pbr::MaterialPipelineKey<Self>,
-    ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
-        descriptor.primitive.cull_mode = None;
-        Ok(())
-    }
-}
-
-/// The uniform of a [`PlenopticMaterial`]: what belongs to its object (the camera's part is
-/// in its view buffer, [`view::ViewParams`]). It changes only with the camera's settings.
-#[derive(ShaderType, Debug, Clone, Default, PartialEq)]
-pub struct ObjectParams {
-    /// x: the object's id, y: its motion slot ([`view::ViewParams::motion`]; −1 for a static
-    /// object, in world space), z: its coverage (its output alpha as glazing in
-    /// geometry-assisted mode; 1 for opaque objects), w: 1 to shade as albedo · lighting +
-    /// non-diffuse (`Shading::Materials`; those lookups are always bilinear).
-    pub object: Vec4,
-    /// x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
-    /// mean transmittance per surface.
-    pub glass: Vec4,
-    /// The object's base-colour factor (xyz) and metallic factor (w) when `object.w` is 1.
-    pub albedo: Vec4,
-    /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
-    /// z: the metallic-roughness texture's (0: none); w: the normal map's (0: none).
-    pub material: Vec4,
-    /// The base-colour texture's `KHR_texture_transform`: offset (xy), scale (zw).
-    pub base_uv: Vec4,
-    /// The metallic-roughness texture's: offset (xy), scale (zw).
-    pub mr_uv: Vec4,
-    /// The normal map's: offset (xy), scale (zw).
-    pub normal_uv: Vec4,
-    /// The rotations of the three transforms (x, y, z), radians.
-    pub uv_rotation: Vec4,
-    /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]), z: the normal
-    /// map's scale.
-    pub surface: Vec4,
-    /// The material's emissive factor (xyz; [`MaterialFactors::fill`]).
-    pub emissive: Vec4,
-    /// The emissive texture's `KHR_texture_transform`: offset (xy), scale (zw).
-    pub emissive_uv: Vec4,
-    /// x: the emissive texture's largest side (0: none); y: 1 when the pack leaves the
-    /// emission to the runtime (pack 4: every lit fragment adds it); z: 1 when the material
-    /// is double-sided (else it emits from its front only); w: the texture's UV rotation.
-    pub emission: Vec4,
-}
-
 /// The key texture of each pack and which key each slot holds.
 #[derive(Resource, Debug, Default)]
 pub struct KeyTextures(pub HashMap<AssetId<RadiancePack>, KeyTexture>);
@@ -335,252 +165,4 @@ pub struct KeyTexture {
     /// Slots whose key came with normals (an all-zero texel is the +Z normal, so presence
     /// cannot be read from the texels).
     pub normals: HashSet<u32>,
-}
-
-#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
-fn attach_materials(
-    mut commands: Commands,
-    backend: Res<ResolvedBackend>,
-    keys: Res<KeyTextures>,
-    volumes: Res<volume::VolumeBuffers>,
-    cameras: Query<(&image::ImageFrame, &rays::CameraRays, &view::ViewBuffer)>,
-    packs: Res<Assets<RadiancePack>>,
-    roots: Query<&PlenopticScene>,
-    proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
-    mut materials: ResMut<Assets<PlenopticMaterial>>,
-    mut env_images: ResMut<background::EnvironmentImages>,
-    mut images: ResMut<Assets<Image>>,
-    (mut pack_rays, mut buffers): (ResMut<rays::PackRays>, ResMut<Assets<ShaderBuffer>>),
-) {
-    if backend.0 != Backend::Gpu {
-        return;
-    }
-    for (entity, parent, of) in &proxies {
-        let Ok(scene) = roots.get(parent.parent()) else {
-            continue;
-        };
-        let Ok((image_frame, camera_rays, view_buffer)) = cameras.get(scene.camera) else {
-            continue;
-        };
-        let (Some(tex), Some(vol), Some(pack)) = (
-            keys.0.get(&scene.pack.id()),
-            volumes.0.get(&scene.pack.id()),
-            packs.get(scene.pack.id()),
-        ) else {
-            continue;
-        };
-        let factors = material_factors(pack, of.id);
-        let transmissive = factors
-            .as_ref()
-            .is_some_and(|f| f.material.transmission > 0.0);
-        let environment_image = env_images.get(scene.pack.id(), pack, &mut images);
-        let m = materials.add(PlenopticMaterial {
-            cubes: tex.image.clone(),
-            params: ObjectParams::default(),
-            volume_samples: vol.samples.clone(),
-            volume_bins: vol.bins.clone(),
-            image_frame: image_frame.0.clone(),
-            shading_cubes: tex.shading.clone(),
-            base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
-            metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),
-            normal_texture: factors.as_ref().and_then(|f| f.normal.clone()),
-            emissive_texture: factors.as_ref().and_then(|f| f.emissive.clone()),
-            view: view_buffer.buffer.clone(),
-            environment_image,
-            rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
-            ray_placements: camera_rays.buffer.clone(),
-            albedo: factors,
-            coverage: object_coverage(pack, of.id),
-            transmissive,
-            bindings: view_buffer.bindings,
-        });
-        commands
-            .entity(entity)
-            .remove::<MeshMaterial3d<StandardMaterial>>()
-            .insert(MeshMaterial3d(m));
-    }
-}
-
-/// The coverage of the pack's object `id`: its manifest coverage if it is see-through
-/// glazing, else 1 (opaque).
-pub(crate) fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
-    pack.reader
-        .manifest()
-        .objects
-        .iter()
-        .find(|o| o.id == id)
-        .and_then(|o| o.coverage)
-        .map_or(1.0, |c| c.clamp(1e-3, 1.0))
-}
-
-/// What the shader needs of an object's material to compute its diffuse albedo per pixel as
-/// `plenoptic_recon`'s material module does: `(1 − metallic · mr.b)(1 − transmission) ·
-/// base colour · texture`.
-#[derive(Debug, Clone)]
-pub struct MaterialFactors {
-    /// The material.
-    pub material: plenoptic_pack::MaterialEntry,
-    /// Its base-colour texture, when it has one that loaded.
-    pub base_colour: Option<Handle<Image>>,
-    /// Its metallic-roughness texture, likewise.
-    pub metallic_roughness: Option<Handle<Image>>,
-    /// Its normal map, likewise.
-    pub normal: Option<Handle<Image>>,
-    /// Its emissive texture, likewise.
-    pub emissive: Option<Handle<Image>>,
-    /// Largest sides of level 0 of the base-colour, metallic-roughness and normal textures
-    /// (0: none).
-    pub sizes: (u32, u32, u32),
-    /// The emissive texture's (0: none).
-    pub emissive_size: u32,
-    /// Whether the pack leaves the emission to the runtime
-    /// ([`plenoptic_pack::PackReader::runtime_emission`]).
-    pub runtime_emission: bool,
-}
-
-impl MaterialFactors {
-    /// The uniform's material fields.
-    fn fill(&self, params: &mut ObjectParams) {
-        let m = &self.material;
-        params.object.w = 1.0;
-        params.albedo = m.base_colour.truncate().extend(m.metallic.clamp(0.0, 1.0));
-        params.material = Vec4::new(
-            m.transmission.clamp(0.0, 1.0),
-            self.sizes.0 as f32,
-            self.sizes.1 as f32,
-            self.sizes.2 as f32,
-        );
-        params.surface = Vec4::new(
-            m.roughness.clamp(0.0, 1.0),
-            if m.ior > 0.0 { m.ior } else { 1.5 },
-            m.normal_scale,
-            0.0,
-        );
-        let uv = |b: Option<plenoptic_pack::TextureBinding>| {
-            b.and_then(|b| b.transform)
-                .map_or((Vec4::new(0.0, 0.0, 1.0, 1.0), 0.0), |t| {
-                    (
-                        Vec4::new(t.offset.x, t.offset.y, t.scale.x, t.scale.y),
-                        t.rotation,
-                    )
-                })
-        };
-        let (base, rb) = uv(m.base_colour_texture);
-        let (mr, rm) = uv(m.metallic_roughness_texture);
-        let (normal, rn) = uv(m.normal_texture);
-        let (emissive, re) = uv(m.emissive_texture);
-        params.base_uv = base;
-        params.mr_uv = mr;
-        params.normal_uv = normal;
-        params.uv_rotation = Vec4::new(rb, rm, rn, 0.0);
-        params.emissive = m.emissive.extend(0.0);
-        params.emissive_uv = emissive;
-        params.emission = Vec4::new(
-            self.emissive_size as f32,
-            if self.runtime_emission { 1.0 } else { 0.0 },
-            if m.double_sided { 1.0 } else { 0.0 },
-            re,
-        );
-    }
-}
-
-/// The material of the pack's object `id` with its loaded textures; `None` without one.
-pub(crate) fn material_factors(pack: &RadiancePack, id: u32) -> Option<MaterialFactors> {
-    let m = pack.reader.object_material(id)?;
-    let texture = |b: Option<plenoptic_pack::TextureBinding>| {
-        let b = b?;
-        let handle = pack.textures.get(b.texture as usize)?.clone()?;
-        let entry = pack.reader.textures().get(b.texture as usize)?;
-        Some((handle, entry.width.max(entry.height)))
-    };
-    let base = texture(m.base_colour_texture);
-    let mr = texture(m.metallic_roughness_texture);
-    let normal = texture(m.normal_texture);
-    let emissive = texture(m.emissive_texture);
-    Some(MaterialFactors {
-        material: m.clone(),
-        sizes: (
-            base.as_ref().map_or(0, |t| t.1),
-            mr.as_ref().map_or(0, |t| t.1),
-            normal.as_ref().map_or(0, |t| t.1),
-        ),
-        base_colour: base.map(|t| t.0),
-        metallic_roughness: mr.map(|t| t.0),
-        normal: normal.map(|t| t.0),
-        emissive_size: emissive.as_ref().map_or(0, |t| t.1),
-        emissive: emissive.map(|t| t.0),
-        runtime_emission: pack.reader.runtime_emission(),
-    })
-}
-
-/// Keeps every proxy material's uniform and bindings up to date with its camera, and every
-/// background's environment and key.
-///
-/// A material is written only when its uniform (which changes with the camera's settings)
-/// or its camera's bindings changed: a written asset's bind group is prepared again, and the
-/// per-frame lookups are in the camera's view buffer, so a camera costs no material uploads
-/// from one frame to the next.
-#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
-pub(crate) fn update_materials(
-    packs: Res<Assets<RadiancePack>>,
-    keys: Res<KeyTextures>,
-    cameras: Query<(&PlenopticCamera, &view::ViewBuffer)>,
-    roots: Query<&PlenopticScene>,
-    proxies: Query<(&ChildOf, &ProxyOf, &MeshMaterial3d<PlenopticMaterial>)>,
-    mut materials: ResMut<Assets<PlenopticMaterial>>,
-    backgrounds: Query<(
-        &background::PlenopticBackground,
-        &MeshMaterial3d<background::PlenopticBackgroundMaterial>,
-    )>,
-    mut background_materials: ResMut<Assets<background::PlenopticBackgroundMaterial>>,
-) {
-    for (parent, of, handle) in &proxies {
-        let Ok(scene) = roots.get(parent.parent()) else {
-            continue;
-        };
-        let Ok((cam, view)) = cameras.get(scene.camera) else {
-            continue;
-        };
-        let (Some(pack), Some(mat)) = (packs.get(cam.pack.id()), materials.get(&handle.0)) else {
-            continue;
-        };
-        // Coverage and material were looked up in the manifest once, when the material was
-        // attached.
-        let params = frame::ObjectShading {
-            id: of.id,
-            coverage: mat.coverage,
-            factors: mat.albedo.as_ref(),
-        }
-        .params(cam, pack);
-        if (mat.params != params || mat.bindings != view.bindings || mat.view != view.buffer)
-            && let Some(mut mat) = materials.get_mut(&handle.0)
-        {
-            mat.params = params;
-            mat.bindings = view.bindings;
-            mat.view = view.buffer.clone();
-        }
-    }
-    for (bg, handle) in &backgrounds {
-        let Ok((cam, view)) = cameras.get(bg.camera) else {
-            continue;
-        };
-        if bg.cpu {
-            continue;
-        }
-        let id = cam.pack.id();
-        let face = keys.0.get(&id).map_or(1, |t| t.face);
-        let layer = view.lookups.heaviest_layer();
-        let env = packs
-            .get(id)
-            .map(|p| p.environment.at(cam.time))
-            .unwrap_or_default();
-        background::set_background(
-            &mut background_materials,
-            handle,
-            &env,
-            layer,
-            face,
-            view.params().fill.z == 1.0,
-        );
-    }
 }

@@ -63,7 +63,7 @@ pub struct CpuFrameMaterial {
 
 impl Material for CpuFrameMaterial {
     fn fragment_shader() -> ShaderRef {
-        "embedded://bevy_plenoptic/reconstruct/cpu.wgsl".into()
+        "embedded://bevy_plenoptic/reconstruct/cpu/cpu.wgsl".into()
     }
 }
 

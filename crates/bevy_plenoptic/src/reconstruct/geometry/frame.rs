@@ -13,11 +13,10 @@ use bevy::prelude::*;
 use plenoptic_recon::temporal::bracketing;
 
 use super::view::{ViewParams, motion_slot};
-use super::{
-    KeyTexture, MAX_LOOKUPS, MaterialFactors, ObjectParams, background, reflect, sun, view, volume,
-};
+use super::{MaterialFactors, ObjectParams, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
+use crate::reconstruct::{KeyTexture, MAX_LOOKUPS, background};
 use crate::streaming::StreamCache;
 
 /// One lookup of a frame: a resident, uploaded (base view, time key).

@@ -31,17 +31,31 @@ use bevy::render::render_resource::{
 };
 use plenoptic_recon::background::{Environment, PlacedEnvironment};
 
-use super::{KeyTextures, ResolvedBackend};
+use super::geometry::view::ViewBuffer;
+use super::{KeyTextures, ReconstructSystems, ResolvedBackend};
 use crate::Backend;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 
-/// Adds the background material and keeps one background per GPU camera.
-pub(super) fn build(app: &mut App) {
-    embedded_asset!(app, "background.wgsl");
-    app.add_plugins(MaterialPlugin::<PlenopticBackgroundMaterial>::default())
-        .init_resource::<EnvironmentImages>();
+/// The background behind the proxies: its material, and one background per GPU camera kept
+/// at the camera's time (part of [`super::PlenopticReconstructPlugin`]).
+#[derive(Debug, Default)]
+pub struct BackgroundPlugin;
+
+impl Plugin for BackgroundPlugin {
+    fn build(&self, app: &mut App) {
+        embedded_asset!(app, "background.wgsl");
+        app.add_plugins(MaterialPlugin::<PlenopticBackgroundMaterial>::default())
+            .init_resource::<EnvironmentImages>()
+            .add_systems(
+                Update,
+                (
+                    spawn_backgrounds.in_set(ReconstructSystems::Attach),
+                    update_backgrounds.in_set(ReconstructSystems::Materials),
+                ),
+            );
+    }
 }
 
 /// Draws the environment where no geometry is (see the module doc).
@@ -173,11 +187,11 @@ pub struct BackgroundParams {
 
 impl Material for PlenopticBackgroundMaterial {
     fn vertex_shader() -> ShaderRef {
-        "embedded://bevy_plenoptic/reconstruct/background.wgsl".into()
+        "embedded://bevy_plenoptic/reconstruct/background/background.wgsl".into()
     }
 
     fn fragment_shader() -> ShaderRef {
-        "embedded://bevy_plenoptic/reconstruct/background.wgsl".into()
+        "embedded://bevy_plenoptic/reconstruct/background/background.wgsl".into()
     }
 
     fn enable_prepass() -> bool {
@@ -387,5 +401,42 @@ pub(super) fn set_background(
         && let Some(mut m) = materials.get_mut(&handle.0)
     {
         m.params.key = key;
+    }
+}
+
+/// Keeps every background's environment and key (the heaviest lookup's cube) at its camera's
+/// time.
+pub(super) fn update_backgrounds(
+    keys: Res<KeyTextures>,
+    packs: Res<Assets<RadiancePack>>,
+    cameras: Query<(&PlenopticCamera, &ViewBuffer)>,
+    backgrounds: Query<(
+        &PlenopticBackground,
+        &MeshMaterial3d<PlenopticBackgroundMaterial>,
+    )>,
+    mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
+) {
+    for (bg, handle) in &backgrounds {
+        let Ok((cam, view)) = cameras.get(bg.camera) else {
+            continue;
+        };
+        if bg.cpu {
+            continue;
+        }
+        let id = cam.pack.id();
+        let face = keys.0.get(&id).map_or(1, |t| t.face);
+        let layer = view.lookups.heaviest_layer();
+        let env = packs
+            .get(id)
+            .map(|p| p.environment.at(cam.time))
+            .unwrap_or_default();
+        set_background(
+            &mut background_materials,
+            handle,
+            &env,
+            layer,
+            face,
+            view.params().fill.z == 1.0,
+        );
     }
 }

@@ -31,8 +31,8 @@ use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
 use plenoptic_pack::{ChunkKind, PackReader, cube::rgb9e5_pack};
 use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
 
-use super::ResolvedBackend;
 use super::image::MAX_IMAGE_VIEWS;
+use super::{ReconstructSystems, ResolvedBackend};
 use crate::Backend;
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
@@ -126,9 +126,25 @@ fn texels((radiance, distance, ids): &Cubes) -> Vec<u8> {
     out
 }
 
+/// Volume mode on the GPU: each volume-mode camera's cubes at its time, which the
+/// image-mode passes warp (part of [`super::PlenopticReconstructPlugin`]).
+#[derive(Debug, Default)]
+pub struct VolumeModePlugin;
+
+impl Plugin for VolumeModePlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            Update,
+            prepare_cubes
+                .in_set(ReconstructSystems::Jobs)
+                .before(super::image::extract::prepare_jobs),
+        );
+    }
+}
+
 /// Rebuilds each volume-mode camera's [`VolumeCubes`] on the GPU backend when its time or
 /// views change and their volume blocks are resident.
-pub(super) fn prepare_cubes(
+fn prepare_cubes(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     cache: Res<StreamCache>,

@@ -61,7 +61,7 @@ fn storage(words: &[u32]) -> ShaderBuffer {
 
 /// Creates each shown pack's volume buffers and repacks them when its set of resident
 /// volume blocks changes.
-pub(super) fn upload_volumes(
+pub(crate) fn upload_volumes(
     mut volumes: ResMut<VolumeBuffers>,
     cache: Res<StreamCache>,
     cameras: Query<&PlenopticCamera>,

@@ -27,11 +27,12 @@ use bevy::render::render_resource::ShaderType;
 use bevy::render::storage::ShaderBuffer;
 
 use super::frame::{CameraFrame, FrameLookups, frame_lookups, warped};
-use super::{KeyTextures, MAX_LOOKUPS, background, image, volume};
+use super::volume;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconSettings;
+use crate::reconstruct::{KeyTextures, MAX_LOOKUPS, background, image};
 use crate::streaming::StreamCache;
 
 /// One camera's lookups and settings, as `geometry.wgsl` reads them (`ViewParams` there).
@@ -68,7 +69,7 @@ pub struct ViewParams {
     /// see.
     pub environment: background::EnvironmentUniform,
     /// `M_o(τ)` of each lookup per animated object: entry `slot · MAX_LOOKUPS + k` for the
-    /// object in motion slot `slot` ([`motion_slot`]) and lookup `k`.
+    /// object in motion slot `slot` (its index among the pack's animated objects) and lookup `k`.
     #[shader(size(runtime))]
     pub motion: Vec<Mat4>,
 }

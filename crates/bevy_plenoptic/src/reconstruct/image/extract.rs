@@ -1,0 +1,179 @@
+//! The main-world side of image mode: each camera's [`ImageJob`] for this frame (its
+//! weighted base views, their resident keys and Bézier weights, and every tunable from its
+//! `ReconSettings`), which Bevy extracts onto the camera's render-world view entity; the
+//! camera's [`ImageFrame`] is resized to it.
+
+use bevy::prelude::*;
+use plenoptic_recon::temporal::bezier_weights;
+
+use super::{
+    ImageFrame, ImageJob, ImageParams, ImageWork, KEYS_PER_VIEW, MAX_IMAGE_VIEWS, frame_image,
+};
+use crate::Backend;
+use crate::asset::RadiancePack;
+use crate::camera::{PlenopticCamera, ReconMode};
+use crate::reconstruct::background::{PlenopticBackground, PlenopticBackgroundMaterial};
+use crate::reconstruct::volume::VolumeCubes;
+use crate::reconstruct::{KeyTextures, ResolvedBackend};
+use crate::streaming::StreamCache;
+
+/// A camera in image or volume mode: the components [`prepare_jobs`] reads.
+type WarpCamera<'a> = (
+    Entity,
+    &'a PlenopticCamera,
+    &'a Camera,
+    &'a Projection,
+    &'a GlobalTransform,
+    &'a ImageFrame,
+    Option<&'a VolumeCubes>,
+);
+
+/// Fills each camera's [`ImageJob`] (warping its [`VolumeCubes`] in volume mode) and resizes
+/// its [`ImageFrame`] to it.
+#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+pub fn prepare_jobs(
+    backend: Res<ResolvedBackend>,
+    keys: Res<KeyTextures>,
+    cache: Res<StreamCache>,
+    packs: Res<Assets<RadiancePack>>,
+    mut cameras: Query<(WarpCamera, &mut ImageJob)>,
+    mut images: ResMut<Assets<Image>>,
+    backgrounds: Query<(
+        &PlenopticBackground,
+        &MeshMaterial3d<PlenopticBackgroundMaterial>,
+    )>,
+    mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
+) {
+    for (camera, mut job) in &mut cameras {
+        let work = job_for(&backend, &keys, &cache, &packs, camera);
+        let (entity, frame) = (camera.0, camera.5);
+        if let Some(w) = &work {
+            let size = UVec2::new(w.params.size.x, w.params.size.y);
+            if images.get(&frame.0).is_some_and(|i| i.size() != size) {
+                images.insert(&frame.0, frame_image(size.x, size.y)).ok();
+                // Touch the camera's background so that its bind group takes the new texture
+                // (the proxies and lit meshes see it in their camera's
+                // `view::ViewBuffer::bindings`).
+                for (bg, handle) in &backgrounds {
+                    if bg.camera == entity
+                        && let Some(m) = background_materials.get_mut(&handle.0)
+                    {
+                        // Marks it modified (a bare `get_mut` does not).
+                        m.into_inner();
+                    }
+                }
+            }
+        }
+        job.0 = work;
+    }
+}
+
+/// The image-mode work of one camera, if it is in image or volume mode on the GPU backend.
+fn job_for(
+    backend: &ResolvedBackend,
+    keys: &KeyTextures,
+    cache: &StreamCache,
+    packs: &Assets<RadiancePack>,
+    (_, cam, camera, projection, transform, frame, volume): WarpCamera,
+) -> Option<ImageWork> {
+    if backend.0 != Backend::Gpu || !matches!(cam.mode, ReconMode::Image | ReconMode::Volume) {
+        return None;
+    }
+    let id = cam.pack.id();
+    let (pack, tex) = (packs.get(id)?, keys.0.get(&id)?);
+    let volume_mode = cam.mode == ReconMode::Volume;
+    let size = camera.physical_viewport_size()?;
+    let vfov = match projection {
+        Projection::Perspective(p) => p.fov,
+        _ => std::f32::consts::FRAC_PI_4,
+    };
+    let (_, rotation, position) = transform.to_scale_rotation_translation();
+    let basis = plenoptic_recon::Camera::new(position, rotation, vfov, size.x, size.y)
+        .ok()?
+        .basis();
+    let mut params = ImageParams {
+        eye: basis.position.extend(basis.focal_px),
+        right: basis.right.extend(basis.tan_x),
+        up: basis.up.extend(basis.tan_y),
+        forward: basis.forward.extend(cam.settings.depth_tolerance),
+        size: UVec4::new(size.x, size.y, tex.face, 0),
+        misc: UVec4::new(cam.settings.background_passes, 0, 0, 0),
+        splat: Vec4::new(
+            cam.settings.same_surface,
+            cam.settings.max_splat_px,
+            0.0,
+            0.0,
+        ),
+        ..default()
+    };
+    if volume_mode {
+        // Each view's cube at t is its single key.
+        let volume = volume?;
+        let image = volume.image.clone()?;
+        params.size.z = volume.face;
+        for (n, &(v, w)) in volume.views.iter().enumerate() {
+            let layer = 6 * n as u32;
+            params.views[n] = pack.reader.manifest().base_views[v].position.extend(w);
+            params.nearest[n] = UVec4::new(layer, 1, 0, 0);
+            params.layers[n][0] = layer;
+            params.key_weights[n][0] = 1.0;
+        }
+        params.size.w = volume.views.len() as u32;
+        return Some(ImageWork {
+            cubes: image,
+            output: frame.0.clone(),
+            params,
+        });
+    }
+    let m = pack.reader.manifest();
+    let t = cam.time;
+    let views = cam.settings.view_weights(m, &pack.usable_views, position);
+    let mut n = 0;
+    for (v, w) in views {
+        if n == MAX_IMAGE_VIEWS {
+            break;
+        }
+        let times = &m.base_views[v].time_keys;
+        let wanted = bezier_weights(times, t);
+        let resident: Vec<(usize, f32, u32)> = wanted
+            .iter()
+            .filter_map(|&(k, wk)| {
+                let r = cache.get(id, (v as u32, k as u32))?;
+                (tex.uploaded.get(&r.slot) == Some(&(v as u32, k as u32)))
+                    .then_some((k, wk, r.slot))
+            })
+            .take(KEYS_PER_VIEW)
+            .collect();
+        if resident.is_empty() {
+            continue;
+        }
+        let weights: Vec<f32> = if resident.len() == wanted.len() {
+            resident.iter().map(|r| r.1).collect()
+        } else {
+            resident
+                .iter()
+                .map(|r| 1.0 / ((times[r.0] - t).abs() + 1e-4))
+                .collect()
+        };
+        let total: f32 = weights.iter().sum();
+        let nearest = resident
+            .iter()
+            .min_by(|a, b| (times[a.0] - t).abs().total_cmp(&(times[b.0] - t).abs()))?;
+        params.views[n] = m.base_views[v].position.extend(w);
+        params.nearest[n] = UVec4::new(nearest.2 * 6, resident.len() as u32, 0, 0);
+        for (k, (r, wk)) in resident.iter().zip(&weights).enumerate() {
+            params.layers[n][k] = r.2 * 6;
+            params.key_weights[n][k] = wk / total;
+        }
+        n += 1;
+    }
+    if n == 0 {
+        return None;
+    }
+    params.size.w = n as u32;
+    Some(ImageWork {
+        cubes: tex.image.clone(),
+        output: frame.0.clone(),
+        params,
+    })
+}
