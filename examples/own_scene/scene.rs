@@ -79,7 +79,7 @@ pub fn add(app: &mut App, scene: OwnScene, camera: impl Bundle) {
                         WorldAssetRoot(
                             assets.load(GltfAssetLabel::Scene(0).from_asset(scene.glb.clone())),
                         ),
-                        PlenopticLit { camera: id },
+                        PlenopticLit::new(id),
                     ));
                 }
                 // Not in the pack: lit by the pack's light probes.

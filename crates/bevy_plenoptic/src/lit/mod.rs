@@ -36,6 +36,7 @@
 //! volume over the scene, each voxel taking the ambient cube of its nearest base view
 //! ([`volume`]), on every device.
 
+pub mod exclusive;
 pub mod probes;
 pub mod scene;
 pub mod volume;

@@ -39,7 +39,9 @@
 //! What it assumes, as a lightmap does: the scene is spawned where it was baked (its root at
 //! the identity), and the matched meshes are the baked ones. A mesh is lit for one camera's
 //! time and lookups, whichever cameras see it (it is one entity for all of them); the
-//! lookups' angular weights and reflections are per view. On the CPU backend a matched mesh
+//! lookups' angular weights and reflections are per view. An app with several plenoptic
+//! cameras spawns the scene once per camera with [`PlenopticLit::only_for`], and each camera
+//! draws its own copy ([`super::exclusive`]). On the CPU backend a matched mesh
 //! shows the camera's CPU frame in screen space, as the proxies do there (the pack's own
 //! materials: the app's are not used).
 
@@ -74,6 +76,30 @@ use crate::{Backend, PlenopticSystems};
 pub struct PlenopticLit {
     /// The [`PlenopticCamera`] whose pack and time light the scene.
     pub camera: Entity,
+    /// Whether only that camera draws the scene's meshes ([`super::exclusive`]): for an app
+    /// with several plenoptic cameras that spawns the scene once per camera, each copy lit
+    /// for its own camera. Otherwise every camera that sees the meshes draws them, lit for
+    /// `camera`'s time and lookups.
+    pub only_this_camera: bool,
+}
+
+impl PlenopticLit {
+    /// The scene lit by `camera`'s pack at its time, drawn by every camera that sees it.
+    pub fn new(camera: Entity) -> Self {
+        PlenopticLit {
+            camera,
+            only_this_camera: false,
+        }
+    }
+
+    /// The scene lit by `camera`'s pack at its time and drawn by `camera` only (one copy of
+    /// the scene per camera).
+    pub fn only_for(camera: Entity) -> Self {
+        PlenopticLit {
+            camera,
+            only_this_camera: true,
+        }
+    }
 }
 
 /// A mesh of a [`PlenopticLit`] scene matched to a pack object, shaded with the pack's
@@ -170,6 +196,8 @@ pub(super) fn build(app: &mut App) {
                 attach_cpu_frames,
                 update_lit_materials,
                 proxy_layers,
+                super::exclusive::release_camera_layers,
+                super::exclusive::camera_layers,
             )
                 .chain()
                 .after(PlenopticSystems::Streaming)
