@@ -10,6 +10,7 @@ use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
+use bevy_plenoptic::lit::exclusive::OnCameraLayer;
 use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack, PlenopticLit};
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::proxy::ProxyOf;
@@ -423,6 +424,27 @@ fn two_cameras(
                 .count()
         })
         .collect();
+    if own_scene && exclusive {
+        // The first copy no longer lit: its meshes leave the camera's layer (they had none).
+        let root = world
+            .query::<(Entity, &PlenopticLit)>()
+            .iter(world)
+            .find(|(_, l)| l.camera == cameras[0])
+            .map(|(e, _)| e)
+            .unwrap();
+        world.entity_mut(root).remove::<PlenopticLit>();
+        app.update();
+        app.update();
+        let world = app.world_mut();
+        let mut placed = world.query::<&OnCameraLayer>();
+        assert!(placed.iter(world).all(|p| p.camera == cameras[1]));
+        let freed = world
+            .query_filtered::<Option<&bevy::camera::visibility::RenderLayers>, With<Mesh3d>>()
+            .iter(world)
+            .filter(|l| l.is_none())
+            .count();
+        assert!(freed >= 40, "{freed} meshes back on their own layers");
+    }
     (frames, on_layers)
 }
 
