@@ -113,7 +113,6 @@ pub(crate) fn plugin_and_cpu_frames_with(
         ball,
     } = extras.into();
     use bevy::camera::Hdr;
-    use bevy::render::render_resource::{TextureFormat, TextureUsages};
     use plenoptic_recon::Reconstructor;
 
     let dir = tempfile::tempdir().unwrap();
@@ -169,12 +168,7 @@ pub(crate) fn plugin_and_cpu_frames_with(
         }
     }
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
-    let image = {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        images.add(img)
-    };
+    let image = hdr_target(&mut app);
     let detour: &[f32] = if budget_keys.is_some() {
         &[1.7, 0.3, t]
     } else {

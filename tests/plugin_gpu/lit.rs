@@ -9,7 +9,6 @@ use crate::pack::{PackSpec, room, write_pack};
 use bevy::camera::Hdr;
 use bevy::light::GlobalAmbientLight;
 use bevy::prelude::*;
-use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::lit::PackEnvironmentLight;
 use bevy_plenoptic::lit::probes::{PlenopticProbe, ReflectionProbes};
 use bevy_plenoptic::prelude::*;
@@ -81,12 +80,7 @@ fn sphere_scene(
         GlobalAmbientLight::default().brightness
     );
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
-    let image = {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        images.add(img)
-    };
+    let image = hdr_target(&mut app);
     let transform = Transform::from_translation(eye).looking_at(target, Vec3::Y);
     let camera = app
         .world_mut()

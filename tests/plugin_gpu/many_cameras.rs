@@ -12,7 +12,6 @@ use crate::pack::{Materials, PackSpec, open_room, room, write_pack};
 use bevy::camera::Hdr;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
-use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
 use plenoptic_recon::Reconstructor;
@@ -67,13 +66,7 @@ pub(crate) fn plugin_cameras(
     let mut targets = Vec::new();
     let mut cameras = Vec::new();
     for (n, eye) in eyes.iter().enumerate() {
-        let image = {
-            let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-            let mut img =
-                Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-            img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-            images.add(img)
-        };
+        let image = hdr_target(&mut app);
         let id = app
             .world_mut()
             .spawn((

@@ -9,7 +9,6 @@ use crate::many_cameras::settled_frames;
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::lit::exclusive::OnCameraLayer;
 use bevy_plenoptic::lit::scene::{LitMaterial, LitObject, NotInPack, PlenopticLit};
 use bevy_plenoptic::prelude::*;
@@ -72,12 +71,7 @@ fn frame(dir: &std::path::Path, own_scene: bool) -> Shown {
 fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool, backend: Backend) -> Shown {
     let mut app = headless_app_in(dir);
     app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
-    let image = {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        images.add(img)
-    };
+    let image = hdr_target(&mut app);
     let target = (
         Camera3d::default(),
         Camera {
@@ -341,13 +335,7 @@ fn two_cameras(
     let mut targets = Vec::new();
     let mut cameras = Vec::new();
     for (n, t) in TIMES.into_iter().enumerate() {
-        let image = {
-            let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-            let mut img =
-                Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-            img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-            images.add(img)
-        };
+        let image = hdr_target(&mut app);
         let camera = app
             .world_mut()
             .spawn((

@@ -12,7 +12,6 @@ use crate::pack::{
 };
 use bevy::camera::{Exposure, Hdr};
 use bevy::prelude::*;
-use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy_plenoptic::camera::EV100_UNIT;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
@@ -100,12 +99,7 @@ fn sky_app(
     let mut app = headless_app_in(dir);
     app.world_mut().resource_mut::<PlenopticSettings>().backend = backend;
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("sky.pack");
-    let image = {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
-        img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        images.add(img)
-    };
+    let image = hdr_target(&mut app);
     let camera = app
         .world_mut()
         .spawn((

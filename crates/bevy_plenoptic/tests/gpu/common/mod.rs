@@ -67,6 +67,13 @@ pub fn headless_app_in(dir: &std::path::Path) -> App {
     app
 }
 
+/// A `WIDTH` × `HEIGHT` `Rgba16Float` render target that can be read back.
+pub fn hdr_target(app: &mut App) -> Handle<Image> {
+    let mut img = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba16Float, None);
+    img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+    app.world_mut().resource_mut::<Assets<Image>>().add(img)
+}
+
 /// Creates the render target image and returns the camera's target for it.
 pub fn target_image(images: &mut Assets<Image>) -> Handle<Image> {
     let mut image = Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba8Unorm, None);
