@@ -80,6 +80,7 @@ impl Plugin for PlenopticLitPlugin {
         )
         .init_resource::<probes::ProbeKeys>();
         scene::build(app);
+        exclusive::build(app);
     }
 
     fn finish(&self, app: &mut App) {

@@ -83,25 +83,6 @@ pub struct PlenopticLit {
     pub only_this_camera: bool,
 }
 
-impl PlenopticLit {
-    /// The scene lit by `camera`'s pack at its time, drawn by every camera that sees it.
-    pub fn new(camera: Entity) -> Self {
-        PlenopticLit {
-            camera,
-            only_this_camera: false,
-        }
-    }
-
-    /// The scene lit by `camera`'s pack at its time and drawn by `camera` only (one copy of
-    /// the scene per camera).
-    pub fn only_for(camera: Entity) -> Self {
-        PlenopticLit {
-            camera,
-            only_this_camera: true,
-        }
-    }
-}
-
 /// A mesh of a [`PlenopticLit`] scene matched to a pack object, shaded with the pack's
 /// lighting.
 #[derive(Component, Debug, Clone, PartialEq, Eq)]
@@ -196,8 +177,6 @@ pub(super) fn build(app: &mut App) {
                 attach_cpu_frames,
                 update_lit_materials,
                 proxy_layers,
-                super::exclusive::release_camera_layers,
-                super::exclusive::camera_layers,
             )
                 .chain()
                 .after(PlenopticSystems::Streaming)
