@@ -17,8 +17,8 @@
 //! to the whole view as if from infinitely far (no parallax correction), so a mesh far from
 //! that base view is lit by light arriving where the base view stands. On a pack whose sun is
 //! left to the runtime, the sun's direct light reaches the app's meshes through the
-//! plugin's sun light ([`crate::reconstruct::geometry::sun`]), and the radiance cube lacks the light
-//! the sunlit surfaces would bounce.
+//! plugin's sun light ([`crate::reconstruct::geometry::sun`]), and the radiance cube lacks
+//! the light the sunlit surfaces would bounce.
 //!
 //! A camera that already has an `EnvironmentMapLight` or a `GeneratedEnvironmentMapLight`
 //! of its own keeps it; [`crate::PlenopticSettings::environment_light`] turns this off.

@@ -16,14 +16,15 @@
 //! - **Shading.** A matched mesh's material becomes an `ExtendedMaterial<StandardMaterial,
 //!   PlenopticLighting>` ([`LitMaterial`]), a copy of its own material made when it is matched
 //!   (later edits to the original do not reach it), whose fragment shader is the proxies'
-//!   (`reconstruct/geometry/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups, weights and
-//!   fallbacks, the same marched reflections and runtime sun, with the mesh's own base
-//!   colour, metalness, roughness and normal map per pixel. Its object uniform is filled by
-//!   the same code as a proxy's ([`crate::reconstruct::geometry::frame`]) and it binds the camera's
-//!   view buffer ([`crate::reconstruct::geometry::view`]), as the camera's proxies do; the shader
-//!   carries a fragment's point into the pack's object frame with the mesh's own inverse
-//!   transform for an animated object (so the lighting follows the object wherever the app's
-//!   animation puts it), not at all for a static one (its proxy is in world space).
+//!   (`reconstruct/geometry/geometry.wgsl` with `PLENOPTIC_STANDARD`): the same lookups,
+//!   weights and fallbacks, the same marched reflections and runtime sun, with the mesh's own
+//!   base colour, metalness, roughness and normal map per pixel. Its object uniform is filled
+//!   by the same code as a proxy's ([`crate::reconstruct::geometry::frame`]) and it binds the
+//!   camera's view buffer ([`crate::reconstruct::geometry::view`]), as the camera's proxies
+//!   do; the shader carries a fragment's point into the pack's object frame with the mesh's
+//!   own inverse transform for an animated object (so the lighting follows the object
+//!   wherever the app's animation puts it), not at all for a static one (its proxy is in
+//!   world space).
 //! - **Proxies.** The camera's proxy of a matched object is moved from the camera's render
 //!   layer to its shadow-only layer ([`crate::camera::layers::ViewLayer::shadow_only`]): the
 //!   camera no longer draws it (the app's mesh is there instead, no depth fight), but the
@@ -462,7 +463,8 @@ fn release_lit_materials(
 }
 
 /// Keeps every lit mesh's uniform and bindings up to date with its camera, as the proxies'
-/// are ([`crate::reconstruct::geometry::prepare::update_materials`]): written only when they changed.
+/// are ([`crate::reconstruct::geometry::prepare::update_materials`]): written only when they
+/// changed.
 fn update_lit_materials(
     packs: Res<Assets<RadiancePack>>,
     cameras: Query<(&PlenopticCamera, &ViewBuffer)>,

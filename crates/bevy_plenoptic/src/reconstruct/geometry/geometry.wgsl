@@ -147,15 +147,24 @@ var<private> pixel_emission: vec3<f32>;
 // the camera's time, the app mesh's own inverse transform for a lit mesh.
 var<private> local_from_world: mat4x4<f32>;
 
-// Point `p` of this object carried to lookup k's key time τ: M_o(τ) · local_from_world · p
-// for an animated object, `p` itself for a static one (in world space).
-fn carried(p: vec3<f32>, k: u32) -> vec3<f32> {
+// Point `p` of this object in the object's own frame (homogeneous): local_from_world · p
+// for an animated object; `p` itself for a static one (in world space), which is not
+// carried. Computed once per point, before its lookups.
+fn object_point(p: vec3<f32>) -> vec4<f32> {
+    if params.object.y < 0.0 {
+        return vec4<f32>(p, 1.0);
+    }
+    return local_from_world * vec4<f32>(p, 1.0);
+}
+
+// The point whose `object_point` is `local`, carried to lookup k's key time τ: M_o(τ) · local
+// for an animated object, the point itself for a static one.
+fn carried(local: vec4<f32>, k: u32) -> vec3<f32> {
     let slot = params.object.y;
     if slot < 0.0 {
-        return p;
+        return local.xyz;
     }
-    let m = cam.motion[u32(slot) * MAX_LOOKUPS + k];
-    return (m * (local_from_world * vec4<f32>(p, 1.0))).xyz;
+    return (cam.motion[u32(slot) * MAX_LOOKUPS + k] * local).xyz;
 }
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
@@ -301,8 +310,9 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let to_eye = normalize(eye - p);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
+    let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = carried(p, k);
+        let q = carried(local, k);
         let d = q - cam.base[k].xyz;
         let dist = length(d);
         if dist <= 1e-6 {
@@ -365,8 +375,9 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
     let n = u32(cam.header.y);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
+    let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = carried(p, k);
+        let q = carried(local, k);
         let d = q - cam.base[k].xyz;
         let dist = length(d);
         if dist <= 1e-6 {

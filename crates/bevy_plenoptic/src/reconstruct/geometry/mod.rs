@@ -118,11 +118,13 @@ pub struct PlenopticMaterial {
     /// Their bin offsets ([`volume::PackVolumes::bins`]).
     #[storage(3, read_only)]
     pub volume_bins: Handle<ShaderBuffer>,
-    /// The camera's image-mode frame ([`crate::reconstruct::image::ImageFrame`]), shown instead of the lookups
-    /// while the camera is in [`ReconMode::Image`] or [`ReconMode::Volume`].
+    /// The camera's image-mode frame ([`crate::reconstruct::image::ImageFrame`]), shown
+    /// instead of the lookups while the camera is in [`ReconMode::Image`] or
+    /// [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
-    /// The resident keys' lighting and non-diffuse radiance ([`crate::reconstruct::KeyTexture::shading`]).
+    /// The resident keys' lighting and non-diffuse radiance
+    /// ([`crate::reconstruct::KeyTexture::shading`]).
     #[texture(5, dimension = "2d_array", sample_type = "u_int")]
     pub shading_cubes: Handle<Image>,
     /// The object's base-colour texture from the pack (sRGB; white when it has none).
