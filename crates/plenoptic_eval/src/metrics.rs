@@ -84,6 +84,82 @@ impl CorrectedLrms {
     };
 }
 
+/// Running sums of a test image's squared error against two reference halves, over any
+/// set of pixels (luminance): [`corrected_relative_lrms`] over a whole frame, or a region of
+/// one (a band along a shadow edge against the rest of a floor) with
+/// [`ErrorSums::corrected_rms`] relative to a mean of one's choosing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ErrorSums {
+    /// Pixels added.
+    pub count: usize,
+    /// Σ (x − m)².
+    pub squared_error: f64,
+    /// Σ (a − b)²/4: the reference mean's variance, estimated.
+    pub variance: f64,
+    /// Σ m.
+    pub reference: f64,
+    /// Σ x.
+    pub test: f64,
+}
+
+impl ErrorSums {
+    /// Adds one pixel: test `x`, reference halves `a` and `b` (luminances).
+    pub fn add(&mut self, x: f64, a: f64, b: f64) {
+        let m = 0.5 * (a + b);
+        self.count += 1;
+        self.squared_error += (x - m) * (x - m);
+        self.variance += 0.25 * (a - b) * (a - b);
+        self.reference += m;
+        self.test += x;
+    }
+
+    /// Adds one pixel of colours (their luminances).
+    pub fn add_colours(&mut self, x: Vec3, a: Vec3, b: Vec3) {
+        self.add(
+            f64::from(luminance(x)),
+            f64::from(luminance(a)),
+            f64::from(luminance(b)),
+        );
+    }
+
+    /// Mean reference luminance (NaN when empty).
+    pub fn mean_reference(&self) -> f64 {
+        self.reference / self.count as f64
+    }
+
+    /// √max(0, mean (x − m)² − mean (a − b)²/4): the RMS error with the reference's noise
+    /// removed (NaN when empty).
+    pub fn corrected_rms(&self) -> f64 {
+        let n = self.count as f64;
+        (self.squared_error / n - self.variance / n).max(0.0).sqrt()
+    }
+
+    /// √mean (x − m)²: the RMS error against the mean of the halves (NaN when empty).
+    pub fn rms(&self) -> f64 {
+        (self.squared_error / self.count as f64).sqrt()
+    }
+
+    /// √mean (a − b)²/4: the RMS of the reference's own noise (NaN when empty).
+    pub fn noise_rms(&self) -> f64 {
+        (self.variance / self.count as f64).sqrt()
+    }
+
+    /// The sums as [`CorrectedLrms`], relative to their own mean reference luminance (all NaN
+    /// when empty or black).
+    pub fn relative(&self) -> CorrectedLrms {
+        let mean = self.mean_reference();
+        if self.count == 0 || mean <= 0.0 || !mean.is_finite() {
+            return CorrectedLrms::NAN;
+        }
+        CorrectedLrms {
+            corrected: self.corrected_rms() / mean,
+            uncorrected: self.rms() / mean,
+            noise_floor: self.noise_rms() / mean,
+            mean_ratio: self.test / self.reference,
+        }
+    }
+}
+
 /// The relative LRMS of `test` against the noisy reference given as two independent halves
 /// `ref_a` and `ref_b`, with the reference's variance estimated from |A − B|²/4 and
 /// subtracted (see the module docs for the derivation). All NaN when the sizes differ or
@@ -98,35 +174,14 @@ pub fn corrected_relative_lrms(
         || size != (ref_b.width, ref_b.height)
         || test.pixels.len() != ref_a.pixels.len()
         || test.pixels.len() != ref_b.pixels.len()
-        || test.pixels.is_empty()
     {
         return CorrectedLrms::NAN;
     }
-    let (mut err, mut var, mut sum_m, mut sum_x) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut sums = ErrorSums::default();
     for ((&x, &a), &b) in test.pixels.iter().zip(&ref_a.pixels).zip(&ref_b.pixels) {
-        let (x, a, b) = (
-            f64::from(luminance(x)),
-            f64::from(luminance(a)),
-            f64::from(luminance(b)),
-        );
-        let m = 0.5 * (a + b);
-        err += (x - m) * (x - m);
-        var += 0.25 * (a - b) * (a - b);
-        sum_m += m;
-        sum_x += x;
+        sums.add_colours(x, a, b);
     }
-    let n = test.pixels.len() as f64;
-    let mean = sum_m / n;
-    if mean <= 0.0 || !mean.is_finite() {
-        return CorrectedLrms::NAN;
-    }
-    let (mse, var) = (err / n, var / n);
-    CorrectedLrms {
-        corrected: (mse - var).max(0.0).sqrt() / mean,
-        uncorrected: mse.sqrt() / mean,
-        noise_floor: var.sqrt() / mean,
-        mean_ratio: sum_x / n / mean,
-    }
+    sums.relative()
 }
 
 /// SSIM (Wang, Bovik, Sheikh and Simoncelli 2004) of `test` against `reference` as the PNG
@@ -244,6 +299,32 @@ mod tests {
         // the reference's share, leaving the test's own noise (σ = 0.3 over mean 1).
         let m = corrected_relative_lrms(&noisy(&s, 0.3, 5), &a, &b);
         assert!((m.corrected - 0.3).abs() < 0.015, "{m:?}");
+    }
+
+    #[test]
+    fn error_sums_measure_a_region_of_a_frame() {
+        let s = signal();
+        let (a, b) = (noisy(&s, 0.3, 11), noisy(&s, 0.3, 12));
+        // A bias of 0.2 in the left half only: that half's corrected RMS is 0.2, the other's
+        // near zero, though both are equally noisy against the reference.
+        let (mut left, mut right) = (ErrorSums::default(), ErrorSums::default());
+        for (j, ((&x, &pa), &pb)) in s.pixels.iter().zip(&a.pixels).zip(&b.pixels).enumerate() {
+            if (j as u32 % W) < W / 2 {
+                left.add_colours(x + Vec3::splat(0.2), pa, pb);
+            } else {
+                right.add_colours(x, pa, pb);
+            }
+        }
+        assert!((left.corrected_rms() - 0.2).abs() < 0.02, "{left:?}");
+        assert!(
+            right.corrected_rms() < 0.05 && right.rms() > 0.2,
+            "{right:?}"
+        );
+        assert!(
+            (right.relative().mean_ratio - 1.0).abs() < 0.01,
+            "{right:?}"
+        );
+        assert!(ErrorSums::default().relative().corrected.is_nan());
     }
 
     #[test]

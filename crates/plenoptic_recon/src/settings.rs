@@ -51,6 +51,12 @@ pub struct ReconSettings {
     /// footprint and the sun's disc. More: smoother shadow edges and penumbrae, linear cost;
     /// 1 gives the pixel centre's hard shadow.
     pub sun_shadow_rays: u32,
+    /// Shadow rays for a pixel whose first [`Self::sun_shadow_rays`] disagree (some blocked,
+    /// some not: the pixel straddles a shadow edge or lies in a penumbra). Its estimate is
+    /// made again with this many, so edges are antialiased as finely as the path tracer's
+    /// while lit and shadowed pixels cost only the first rays. At most
+    /// [`crate::sun::MAX_SUN_RAYS`]; not above `sun_shadow_rays` turns the refinement off.
+    pub sun_edge_rays: u32,
     /// How the geometry-assisted mode shows the specular part of surfaces with a material:
     /// as the base views saw it, or for the actual camera by marching the reflected ray
     /// through the distance cubes ([`crate::specular`]; the default, for mirrors and glossy
@@ -112,6 +118,7 @@ impl Default for ReconSettings {
             max_splat_px: 8.0,
             shading: Shading::Materials,
             sun_shadow_rays: 4,
+            sun_edge_rays: 32,
             specular: Specular::default(),
             supersampling: 1,
         }

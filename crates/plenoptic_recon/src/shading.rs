@@ -151,10 +151,10 @@ pub(crate) fn render(
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
     let start = std::time::Instant::now();
-    let sun = rec
-        .runtime_sun()
-        .zip(rec.proxy_rays())
-        .map(|(s, rays)| s.at(rays, proxy, t, rec.settings.sun_shadow_rays));
+    let sun = rec.runtime_sun().zip(rec.proxy_rays()).map(|(s, shadows)| {
+        let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
+        s.at(shadows, proxy, t, rays)
+    });
     let glossy = specular::glossy_allowed(rec);
     let runtime_emission = rec.pack().runtime_emission();
     let (surface, raster_ms) =

@@ -16,6 +16,13 @@
 //! cos θ and φ, the strata turned per pixel). The rays also leave from `K` points spread over
 //! the pixel's footprint on the surface (a rotated R₂ lattice), so that a shadow edge is
 //! antialiased as the path tracer's jittered pixels show it; `K` applies to a delta sun too.
+//! Where the `K` rays disagree (some blocked, some not), the pixel straddles an edge or lies
+//! in a penumbra, and its estimate is made again with
+//! [`crate::ReconSettings::sun_edge_rays`] (32): adaptive sampling, so that only edge pixels
+//! pay for a finely antialiased edge. The first rays then spread over twice the pixel's
+//! footprint, so that an edge clipping only a corner of the pixel still splits them (with
+//! 4 rays over the pixel itself, a near-horizontal edge went unrefined in most of the pixels
+//! it crossed).
 //! Shadow edges are therefore at screen resolution, and a highlight moves with the camera.
 //!
 //! Surfaces whose every lobe is ideal (a mirror, clear glass) take no light sample, as in the
@@ -32,6 +39,11 @@ use crate::shadow::{PlacedShadows, ShadowScene};
 /// Largest number of shadow rays per pixel a setting may ask for.
 pub const MAX_SUN_RAYS: u32 = 64;
 
+/// How much wider than the pixel the first rays spread when edges are refined: an edge that
+/// only clips a corner of the pixel still splits them, and where they agree the sun's
+/// visibility is the same all over the pixel, so their estimate stands.
+const DETECT_SPREAD: f32 = 2.0;
+
 /// The pack's runtime sun with the proxies its shadow rays test.
 #[derive(Debug)]
 pub struct RuntimeSun {
@@ -47,6 +59,8 @@ pub struct PlacedSun<'s> {
     frame: (Vec3, Vec3),
     cos_max: f32,
     rays: u32,
+    /// Rays for a pixel whose first `rays` disagree (no more than `rays`: no refinement).
+    edge_rays: u32,
     shadows: PlacedShadows<'s>,
 }
 
@@ -61,13 +75,14 @@ impl RuntimeSun {
     }
 
     /// The sun at time `t`, its shadow rays against `shadows` (of `proxy`) placed then;
-    /// `rays` shadow rays per pixel (clamped to 1..=[`MAX_SUN_RAYS`]).
+    /// `rays` shadow rays per pixel, and `edge_rays` where those disagree (both clamped to
+    /// 1..=[`MAX_SUN_RAYS`]).
     pub fn at<'s>(
         &self,
         shadows: &'s ShadowScene,
         proxy: &ProxyGeometry,
         t: f32,
-        rays: u32,
+        (rays, edge_rays): (u32, u32),
     ) -> PlacedSun<'s> {
         let (towards, illuminance) = self.track.at(t);
         let towards = towards.normalize_or(Vec3::Y);
@@ -77,6 +92,7 @@ impl RuntimeSun {
             frame: towards.any_orthonormal_pair(),
             cos_max: self.angular_radius.min(0.5).cos(),
             rays: rays.clamp(1, MAX_SUN_RAYS),
+            edge_rays: edge_rays.clamp(1, MAX_SUN_RAYS),
             shadows: shadows.at(proxy, t),
         }
     }
@@ -91,6 +107,7 @@ impl PlacedSun<'_> {
     /// Radiance towards the viewer of the sun's direct light at `p` (geometric normal `ng`,
     /// either side) through `bsdf`; the pixel's footprint on the surface spans `footprint`
     /// (the displacements of a step of one pixel in x and in y) and `pixel` turns the strata.
+    /// Where the first rays disagree, the estimate is made again with the edge rays.
     pub fn radiance(
         &self,
         p: Vec3,
@@ -102,19 +119,51 @@ impl PlacedSun<'_> {
         if self.illuminance == Vec3::ZERO || !bsdf.takes_light_samples() {
             return Vec3::ZERO;
         }
+        let ray = |count, spread| Rays {
+            p,
+            ng,
+            footprint: (footprint.0 * spread, footprint.1 * spread),
+            count,
+            turn: hash01(pixel),
+            shift: hash01(pixel ^ 0x5bd1_e995),
+        };
+        let refine = self.edge_rays > self.rays;
+        let spread = if refine { DETECT_SPREAD } else { 1.0 };
+        let first = self.estimate(&ray(self.rays, spread), bsdf);
+        let sum = if first.open > 0 && first.blocked > 0 && refine {
+            self.estimate(&ray(self.edge_rays, 1.0), bsdf).sum / self.edge_rays as f32
+        } else {
+            first.sum / self.rays as f32
+        };
+        sum * self.illuminance
+    }
+
+    /// The sum over `rays` of the BSDF-weighted cosines of the unblocked ones, with how many
+    /// rays were blocked and how many open.
+    fn estimate(&self, rays: &Rays, bsdf: &Bsdf) -> Estimate {
         let n = bsdf.normal();
+        let Rays {
+            p,
+            ng,
+            footprint,
+            count,
+            turn,
+            shift,
+        } = *rays;
         let eps = 1e-4 * (1.0 + p.abs().max_element());
-        let turn = hash01(pixel);
-        let shift = hash01(pixel ^ 0x5bd1_e995);
-        let mut sum = Vec3::ZERO;
-        for k in 0..self.rays {
-            let wi = self.direction(k, turn);
+        let mut out = Estimate {
+            sum: Vec3::ZERO,
+            blocked: 0,
+            open: 0,
+        };
+        for k in 0..count {
+            let wi = self.direction(k, count, turn);
             let f = bsdf.eval(wi);
             if f == Vec3::ZERO {
                 continue;
             }
             // Point k of the R₂ sequence in the pixel, turned per pixel; one ray: the centre.
-            let q = if self.rays == 1 {
+            let q = if count == 1 {
                 p
             } else {
                 let u = (turn + k as f32 * 0.754_877_7).fract() - 0.5;
@@ -127,26 +176,47 @@ impl PlacedSun<'_> {
                 q - ng * eps
             };
             if self.shadows.occluded(origin, wi, 1e9) {
+                out.blocked += 1;
                 continue;
             }
-            sum += f * wi.dot(n).abs();
+            out.open += 1;
+            out.sum += f * wi.dot(n).abs();
         }
-        sum * self.illuminance / self.rays as f32
+        out
     }
 
-    /// Shadow-ray direction `k` of [`Self::radiance`]: uniform over the disc's cone, stratum
-    /// `k` of `rays` in cos θ, a golden-angle step in φ, all turned by `turn`.
-    fn direction(&self, k: u32, turn: f32) -> Vec3 {
+    /// Shadow-ray direction `k` of `rays`: uniform over the disc's cone, stratum `k` in
+    /// cos θ, a golden-angle step in φ, all turned by `turn`.
+    fn direction(&self, k: u32, rays: u32, turn: f32) -> Vec3 {
         if self.cos_max >= 1.0 {
             return self.towards;
         }
-        let u = (k as f32 + 0.5) / self.rays as f32;
+        let u = (k as f32 + 0.5) / rays as f32;
         let cos_t = 1.0 - u * (1.0 - self.cos_max);
         let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * (turn + k as f32 * 0.618_034).fract();
         let (t, b) = self.frame;
         (t * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + self.towards * cos_t).normalize()
     }
+}
+
+/// The shadow rays of one estimate: from the pixel's point `p` (geometric normal `ng`) over
+/// its `footprint`, `count` of them, their sequences turned by `turn` and `shift`.
+#[derive(Clone, Copy)]
+struct Rays {
+    p: Vec3,
+    ng: Vec3,
+    footprint: (Vec3, Vec3),
+    count: u32,
+    turn: f32,
+    shift: f32,
+}
+
+/// What [`PlacedSun::estimate`] found.
+struct Estimate {
+    sum: Vec3,
+    blocked: u32,
+    open: u32,
 }
 
 /// A number in [0, 1) from `x` (a 32-bit integer hash).
