@@ -31,6 +31,7 @@ use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
 use plenoptic_pack::CubeImage;
+use rayon::iter::Either;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
@@ -47,6 +48,8 @@ struct ViewKey {
     base: Vec3,
     weight: f32,
     cubes: KeyCubes,
+    /// The pass's second channel at this key (same face size as `cubes`).
+    second: Option<Arc<CubeImage<Vec3>>>,
     packed: Arc<PackedTexels>,
     /// Per object slot: M(τ) M(t)⁻¹.
     motion: Vec<Affine3A>,
@@ -80,6 +83,10 @@ pub(crate) struct Pass<'a> {
     pub skip: &'a [u32],
     /// How the cubes are read.
     pub filter: CubeFilter,
+    /// A second colour looked up with the same lookups, weights and fallbacks (the
+    /// non-diffuse radiance beside the lighting), returned beside the frame by
+    /// [`render_pair`]. A key whose second cube cannot be read is not used.
+    pub second: Option<Channel>,
 }
 
 impl<'a> Pass<'a> {
@@ -90,6 +97,7 @@ impl<'a> Pass<'a> {
             channel: Channel::Radiance,
             skip: &[],
             filter,
+            second: None,
         }
     }
 }
@@ -104,11 +112,29 @@ pub(crate) fn render(
     pass: Pass<'_>,
     report: &mut Report,
 ) -> Result<Frame> {
+    let pass = Pass {
+        second: None,
+        ..pass
+    };
+    render_pair(rec, camera, t, mask, pass, report).map(|(frame, _)| frame)
+}
+
+/// [`render`], with the colour of `pass.second` per pixel beside the frame (black where the
+/// frame has no lookup: nothing, or a skipped object).
+pub(crate) fn render_pair(
+    rec: &Reconstructor,
+    camera: &Camera,
+    t: f32,
+    mask: Option<&GeometryMask>,
+    pass: Pass<'_>,
+    report: &mut Report,
+) -> Result<(Frame, Vec<Vec3>)> {
     let Pass {
         layer,
         channel,
         skip,
         filter,
+        second,
     } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
@@ -124,7 +150,7 @@ pub(crate) fn render(
         .map(|&o| proxy.transform(o, t).inverse())
         .collect();
     let mut keys: Vec<ViewKey> = Vec::new();
-    let mut volumes: Vec<(Vec3, f32, VolumeIndex)> = Vec::new();
+    let mut volumes: Vec<(Vec3, f32, VolumeIndex, Option<VolumeIndex>)> = Vec::new();
     for &(v, w) in &views {
         let bv = &manifest.base_views[v];
         let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
@@ -134,9 +160,18 @@ pub(crate) fn render(
         if k1 != k0 {
             pairs.push((k1, s));
         }
+        // A key's cubes, and its second channel's cube of the same size.
+        let mut read = |k: usize| {
+            let c = rec.key_cubes_in(v, k, channel, &mut report.missing)?;
+            let Some(ch) = second else {
+                return Some((c, None));
+            };
+            let s = rec.key_cubes_in(v, k, ch, &mut report.missing)?.radiance;
+            (s.face_size == c.ids.face_size).then_some((c, Some(s)))
+        };
         let mut got = Vec::new();
         for (k, wt) in pairs {
-            if let Some(c) = rec.key_cubes_in(v, k, channel, &mut report.missing) {
+            if let Some(c) = read(k) {
                 got.push((k, wt, c));
             }
         }
@@ -152,16 +187,13 @@ pub(crate) fn render(
                 .into_iter()
                 .filter(|&k| k != k0 && k != k1)
                 .take(2)
-                .find_map(|k| {
-                    rec.key_cubes_in(v, k, channel, &mut report.missing)
-                        .map(|c| (k, c))
-                })
+                .find_map(|k| read(k).map(|c| (k, c)))
             {
                 got.push((k, 1.0, c));
             }
         }
         let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
-        for (k, wt, c) in got {
+        for (k, wt, (c, second)) in got {
             let tau = bv.time_keys[k];
             let motion = ids
                 .iter()
@@ -173,11 +205,13 @@ pub(crate) fn render(
                 weight: w * wt / total,
                 packed: rec.packed_texels(v, k, channel, &c),
                 cubes: c,
+                second,
                 motion,
             });
         }
         if let Some(index) = VolumeIndex::build(rec, v, t, channel, &mut report.missing) {
-            volumes.push((bv.position, w, index));
+            let other = second.map(|c| index.with_channel(c));
+            volumes.push((bv.position, w, index, other));
         }
     }
     if keys.is_empty() {
@@ -218,6 +252,10 @@ pub(crate) fn render(
         .depth
         .par_extend(rayon::iter::repeat_n(f32::INFINITY, n));
     frame.object.par_extend(rayon::iter::repeat_n(0, n));
+    let mut plane2: Vec<Vec3> = Vec::new();
+    if second.is_some() {
+        plane2.par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
+    }
     // Flat views of the cubes for the pixel loop; keys of negligible weight are skipped.
     let mut fast: Vec<FastKey<'_>> = keys
         .iter()
@@ -227,6 +265,7 @@ pub(crate) fn render(
             weight: k.weight,
             face: k.cubes.ids.face_size,
             texels: &k.packed.texels,
+            second: k.second.as_deref().map(|c| c.texels.as_slice()),
             normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
             motion: &k.motion,
             reuse: Vec::new(),
@@ -266,84 +305,103 @@ pub(crate) fn render(
         bilinear,
     };
     let band = ROWS * w.max(1);
+    // The second colour's band, where there is one.
+    let bands2 = if second.is_some() {
+        Either::Left(plane2.par_chunks_mut(band).map(Some))
+    } else {
+        Either::Right((0..n.div_ceil(band)).into_par_iter().map(|_| None))
+    };
     frame
         .radiance
         .par_chunks_mut(band)
         .zip(frame.depth.par_chunks_mut(band))
         .zip(frame.object.par_chunks_mut(band))
         .zip(class.par_chunks_mut(band))
+        .zip(bands2)
         .enumerate()
-        .for_each_init(Scratch::default, |s, (i, (((rad, dep), obj), cls))| {
-            let y0 = i * ROWS;
-            if let MaskSource::Raster(tris) = &source {
-                // Camera-space depth into `dep`, object into `obj`.
-                crate::raster::raster_band(tris, w, y0, dep, obj, None);
-            }
-            let rows = rad
-                .chunks_mut(w)
-                .zip(dep.chunks_mut(w))
-                .zip(obj.chunks_mut(w))
-                .zip(cls.chunks_mut(w));
-            for (r, (((rad, dep), obj), cls)) in rows.enumerate() {
-                let y = y0 + r;
-                s.resize(w);
-                s.directions(&basis, y, w);
-                // The hit point of every pixel of the row.
-                match &source {
-                    MaskSource::Raster(_) => {
-                        for (z, &o) in dep.iter_mut().zip(obj.iter()) {
-                            if o == 0 {
-                                *z = f32::INFINITY;
+        .for_each_init(
+            Scratch::default,
+            |s, (i, ((((rad, dep), obj), cls), mut rad2))| {
+                let y0 = i * ROWS;
+                if let MaskSource::Raster(tris) = &source {
+                    // Camera-space depth into `dep`, object into `obj`.
+                    crate::raster::raster_band(tris, w, y0, dep, obj, None);
+                }
+                let rows = rad
+                    .chunks_mut(w)
+                    .zip(dep.chunks_mut(w))
+                    .zip(obj.chunks_mut(w))
+                    .zip(cls.chunks_mut(w));
+                for (r, (((rad, dep), obj), cls)) in rows.enumerate() {
+                    let y = y0 + r;
+                    s.resize(w);
+                    s.directions(&basis, y, w);
+                    // The hit point of every pixel of the row.
+                    match &source {
+                        MaskSource::Raster(_) => {
+                            for (z, &o) in dep.iter_mut().zip(obj.iter()) {
+                                if o == 0 {
+                                    *z = f32::INFINITY;
+                                }
+                            }
+                            s.points_from_depth(&basis, dep);
+                        }
+                        MaskSource::Mask(m) => {
+                            for x in 0..w {
+                                let o = m.object[y * w + x];
+                                if o != 0 {
+                                    obj[x] = o;
+                                    dep[x] = m.depth[y * w + x];
+                                }
+                                s.set_p(x, m.position[y * w + x]);
+                            }
+                            s.eye_directions(basis.position, w);
+                        }
+                    }
+                    for x in 0..w {
+                        let o = obj[x];
+                        s.slot[x] = NO_SLOT;
+                        if o == 0 {
+                            cls[x] = NONE;
+                            if let Some((_, env)) = &env {
+                                rad[x] = if bilinear {
+                                    sample::bilinear(env, s.dir_at(x))
+                                } else {
+                                    env.texels[sample::texel(env.face_size, s.dir_at(x))]
+                                };
+                            }
+                            continue;
+                        }
+                        match slot_of.get(o) {
+                            Some(slot) if !skipped[slot] => s.slot[x] = slot as u32,
+                            _ => cls[x] = NONE,
+                        }
+                    }
+                    shade.row(s, obj);
+                    let row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
+                    if let Some(row2) = row2 {
+                        let sums = s.slot.iter().zip(&s.sum).zip(&s.sum2);
+                        for (out, ((&slot, c), c2)) in row2.iter_mut().zip(sums) {
+                            if slot != NO_SLOT && c.w > 0.0 {
+                                *out = *c2 / c.w;
                             }
                         }
-                        s.points_from_depth(&basis, dep);
                     }
-                    MaskSource::Mask(m) => {
-                        for x in 0..w {
-                            let o = m.object[y * w + x];
-                            if o != 0 {
-                                obj[x] = o;
-                                dep[x] = m.depth[y * w + x];
-                            }
-                            s.set_p(x, m.position[y * w + x]);
+                    for x in 0..w {
+                        if s.slot[x] == NO_SLOT {
+                            continue;
                         }
-                        s.eye_directions(basis.position, w);
-                    }
-                }
-                for x in 0..w {
-                    let o = obj[x];
-                    s.slot[x] = NO_SLOT;
-                    if o == 0 {
-                        cls[x] = NONE;
-                        if let Some((_, env)) = &env {
-                            rad[x] = if bilinear {
-                                sample::bilinear(env, s.dir_at(x))
-                            } else {
-                                env.texels[sample::texel(env.face_size, s.dir_at(x))]
-                            };
+                        let c = s.sum[x];
+                        if c.w > 0.0 {
+                            rad[x] = c.truncate() / c.w;
+                            cls[x] = DIRECT;
+                        } else {
+                            cls[x] = HOLE;
                         }
-                        continue;
-                    }
-                    match slot_of.get(o) {
-                        Some(slot) if !skipped[slot] => s.slot[x] = slot as u32,
-                        _ => cls[x] = NONE,
                     }
                 }
-                shade.row(s, obj);
-                for x in 0..w {
-                    if s.slot[x] == NO_SLOT {
-                        continue;
-                    }
-                    let c = s.sum[x];
-                    if c.w > 0.0 {
-                        rad[x] = c.truncate() / c.w;
-                        cls[x] = DIRECT;
-                    } else {
-                        cls[x] = HOLE;
-                    }
-                }
-            }
-        });
+            },
+        );
     report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
     let start = Instant::now();
     // The hit point of a pixel (for the fallbacks), as the pixel loop computed it.
@@ -358,22 +416,32 @@ pub(crate) fn render(
     // Volume fallback where no lookup was accepted.
     let misses: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
     if !volumes.is_empty() && !misses.is_empty() {
-        let found: Vec<(usize, Vec3)> = misses
+        let found: Vec<(usize, Vec3, Vec3)> = misses
             .par_iter()
             .filter_map(|&j| {
                 let (p, o) = (point(j), frame.object[j]);
-                let (mut vs, mut vw) = (Vec3::ZERO, 0.0f32);
-                for (base, w, index) in &volumes {
+                let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
+                for (base, w, index, other) in &volumes {
                     if let Some((c, wt)) = index.lookup(p - *base, o, tol * 3.0) {
                         vs += c * wt * *w;
                         vw += wt * *w;
+                        // The same samples with the same weights.
+                        if let Some((c2, _)) = other
+                            .as_ref()
+                            .and_then(|i| i.lookup(p - *base, o, tol * 3.0))
+                        {
+                            vs2 += c2 * wt * *w;
+                        }
                     }
                 }
-                (vw > 0.0).then(|| (j, vs / vw))
+                (vw > 0.0).then(|| (j, vs / vw, vs2 / vw))
             })
             .collect();
-        for (j, c) in found {
+        for (j, c, c2) in found {
             frame.radiance[j] = c;
+            if let Some(x) = plane2.get_mut(j) {
+                *x = c2;
+            }
             class[j] = VOLUME;
         }
     }
@@ -382,6 +450,7 @@ pub(crate) fn render(
     let slot = |o: u32| slot_of.get(o);
     let (hole, background) = hole_fill(
         &mut frame,
+        &mut plane2,
         &mut class,
         rec.settings.hole_fill_radius as i64,
         &keys,
@@ -393,7 +462,7 @@ pub(crate) fn render(
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
     report.fallback =
         FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
-    Ok(frame)
+    Ok((frame, plane2))
 }
 
 /// Rows per band of the pixel loop (a band is rasterized, then shaded, while in cache).
@@ -409,30 +478,42 @@ enum MaskSource<'a> {
 
 /// The colour of the nearest texel at about the distance of point `p` (at the frame's time;
 /// `slot` its motion's slot) within [`crate::NEIGHBOUR_TEXELS`] of each key's lookup texel on
-/// the same face ([`crate::neighbour::nearest_texel`]), the keys blended with their weights;
-/// `None` where no key has one.
-fn neighbour_texel(keys: &[ViewKey], slot: Option<usize>, object: u32, p: Vec3) -> Option<Vec3> {
-    let (mut sum, mut ws) = (Vec3::ZERO, 0.0f32);
+/// the same face ([`crate::neighbour::nearest_texel`]), the keys blended with their weights,
+/// with the second channel's colour at the same texels; `None` where no key has one.
+fn neighbour_texel(
+    keys: &[ViewKey],
+    slot: Option<usize>,
+    object: u32,
+    p: Vec3,
+) -> Option<(Vec3, Vec3)> {
+    let (mut sum, mut sum2, mut ws) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
     for k in keys.iter().filter(|k| k.weight > 1e-4) {
         let q = slot
             .and_then(|s| k.motion.get(s))
             .map_or(p, |m| m.transform_point3(p));
         let best =
             crate::neighbour::nearest_texel(&k.cubes.ids, &k.cubes.distance, q - k.base, object);
-        if let Some(c) = best.and_then(|idx| k.cubes.radiance.texels.get(idx)) {
+        if let Some(idx) = best
+            && let Some(c) = k.cubes.radiance.texels.get(idx)
+        {
             sum += *c * k.weight;
+            if let Some(c2) = k.second.as_ref().and_then(|s| s.texels.get(idx)) {
+                sum2 += *c2 * k.weight;
+            }
             ws += k.weight;
         }
     }
-    (ws > 0.0).then(|| sum / ws)
+    (ws > 0.0).then(|| (sum / ws, sum2 / ws))
 }
 
 /// Fills HOLE pixels from the nearest DIRECT/VOLUME pixel of the same object (ring search),
 /// then from the nearest texels of the object around the lookups ([`neighbour_texel`]); what
-/// remains takes the heaviest view's cube in the point's direction. Returns the counts
-/// (filled, background).
+/// remains takes the heaviest view's cube in the point's direction. `plane2` (the second
+/// channel, or empty) is filled from the same pixels and texels. Returns the counts (filled,
+/// background).
 fn hole_fill(
     frame: &mut Frame,
+    plane2: &mut [Vec3],
     class: &mut [u8],
     radius: i64,
     keys: &[ViewKey],
@@ -444,13 +525,13 @@ fn hole_fill(
     if holes.is_empty() {
         return (0, 0);
     }
-    let fills: Vec<(usize, Option<Vec3>)> = holes
+    let fills: Vec<(usize, Option<(Vec3, Vec3)>)> = holes
         .par_iter()
         .map(|&j| {
             let (x, y) = (j as i64 % w, j as i64 / w);
             let o = frame.object[j];
             for r in 1..=radius {
-                let (mut sum, mut n) = (Vec3::ZERO, 0);
+                let (mut sum, mut sum2, mut n) = (Vec3::ZERO, Vec3::ZERO, 0);
                 for dy in -r..=r {
                     for dx in -r..=r {
                         if dx.abs() != r && dy.abs() != r {
@@ -463,34 +544,38 @@ fn hole_fill(
                         let k = (ny * w + nx) as usize;
                         if (class[k] == DIRECT || class[k] == VOLUME) && frame.object[k] == o {
                             sum += frame.radiance[k];
+                            sum2 += plane2.get(k).copied().unwrap_or_default();
                             n += 1;
                         }
                     }
                 }
                 if n > 0 {
-                    return (j, Some(sum / n as f32));
+                    return (j, Some((sum / n as f32, sum2 / n as f32)));
                 }
             }
             (j, neighbour_texel(keys, slot(o), o, point(j)))
         })
         .collect();
-    let env: Option<(Vec3, Arc<CubeImage<Vec3>>)> = keys
-        .iter()
-        .max_by(|a, b| a.weight.total_cmp(&b.weight))
-        .map(|k| (k.base, k.cubes.radiance.clone()));
+    let heaviest = keys.iter().max_by(|a, b| a.weight.total_cmp(&b.weight));
     let (mut filled, mut rest) = (0, 0);
     for (j, c) in fills {
         match c {
-            Some(c) => {
+            Some((c, c2)) => {
                 frame.radiance[j] = c;
+                if let Some(x) = plane2.get_mut(j) {
+                    *x = c2;
+                }
                 filled += 1;
             }
             None => {
                 rest += 1;
                 class[j] = NONE + 1;
-                if let Some((base, cube)) = &env {
-                    frame.radiance[j] =
-                        cube.lookup(point(j) - *base).copied().unwrap_or(Vec3::ZERO);
+                if let Some(k) = heaviest {
+                    let d = point(j) - k.base;
+                    frame.radiance[j] = k.cubes.radiance.lookup(d).copied().unwrap_or_default();
+                    if let (Some(x), Some(cube)) = (plane2.get_mut(j), &k.second) {
+                        *x = cube.lookup(d).copied().unwrap_or_default();
+                    }
                 }
             }
         }

@@ -75,6 +75,11 @@
 //! assert!(frame.radiance[12 * 32 + 16].abs_diff_eq(Vec3::new(0.0, 0.0, 1.0), 0.1));
 //! ```
 
+// The integration tests' pack writer, shared with unit tests that need a pack (it names
+// this crate).
+#[cfg(test)]
+extern crate self as plenoptic_recon;
+
 pub mod background;
 pub mod brdf;
 mod cache;
@@ -83,6 +88,9 @@ pub mod delaunay3;
 pub mod flat_rays;
 pub mod frame;
 mod geometry;
+#[cfg(test)]
+#[path = "geometry_tests.rs"]
+mod geometry_tests;
 mod glazing;
 mod lookup;
 mod material;

@@ -74,6 +74,9 @@ pub(crate) struct FastKey<'a> {
     pub face: u32,
     /// Id, distance and radiance per texel.
     pub texels: &'a [Texel],
+    /// A second colour per texel, blended with the same weights as the radiance (the
+    /// non-diffuse radiance beside the lighting: one pass looks up both).
+    pub second: Option<&'a [Vec3]>,
     pub normal: Option<&'a [Vec3]>,
     /// Per object slot: M(τ) M(t)⁻¹.
     pub motion: &'a [Affine3A],
@@ -113,6 +116,8 @@ pub(crate) struct Scratch {
     fy: Vec<f32>,
     /// Weighted radiance sum and, in `w`, the weight sum.
     pub sum: Vec<Vec4>,
+    /// Weighted sum of the keys' second colours (same weights as `sum`).
+    pub sum2: Vec<Vec3>,
 }
 
 impl Scratch {
@@ -133,6 +138,7 @@ impl Scratch {
         self.fx.resize(n, 0.0);
         self.fy.resize(n, 0.0);
         self.sum.resize(n, Vec4::ZERO);
+        self.sum2.resize(n, Vec3::ZERO);
     }
 
     /// The unit ray directions of row `y` (what [`CameraBasis::direction`] gives at the pixel
@@ -244,6 +250,7 @@ impl Shade<'_> {
     pub fn row(&self, s: &mut Scratch, obj: &[u32]) {
         let n = obj.len();
         s.sum[..n].fill(Vec4::ZERO);
+        s.sum2[..n].fill(Vec3::ZERO);
         for (ki, k) in self.fast.iter().enumerate() {
             self.lookups(s, k, ki == 0, n);
             self.accumulate(s, k, obj);
@@ -398,8 +405,9 @@ impl Shade<'_> {
                     continue;
                 }
             }
-            let radiance = if !self.bilinear {
-                tx.radiance
+            // The colour and, with a second colour, that one with the same weights.
+            let (radiance, second) = if !self.bilinear {
+                (tx.radiance, k.second.and_then(|c| c.get(t).copied()))
             } else if tap[x] != NO_TEXEL {
                 // The footprint inside one face: its texels of the same object at the same
                 // distance, and the nearest texel.
@@ -414,39 +422,63 @@ impl Shade<'_> {
                     j == t || (tj.id == o && (tj.distance - l).abs() <= tol * l)
                 };
                 let w = |tj: &Texel, j: usize, w: f32| if keep(tj, j) { w } else { 0.0 };
-                let acc = a[0].radiance * w(&a[0], i, (1.0 - fx) * (1.0 - fy))
-                    + a[1].radiance * w(&a[1], i + 1, fx * (1.0 - fy))
-                    + b[0].radiance * w(&b[0], i + n, (1.0 - fx) * fy)
-                    + b[1].radiance * w(&b[1], i + n + 1, fx * fy);
+                let taps = [
+                    (i, w(&a[0], i, (1.0 - fx) * (1.0 - fy))),
+                    (i + 1, w(&a[1], i + 1, fx * (1.0 - fy))),
+                    (i + n, w(&b[0], i + n, (1.0 - fx) * fy)),
+                    (i + n + 1, w(&b[1], i + n + 1, fx * fy)),
+                ];
+                let acc = a[0].radiance * taps[0].1
+                    + a[1].radiance * taps[1].1
+                    + b[0].radiance * taps[2].1
+                    + b[1].radiance * taps[3].1;
                 if acc.w > 0.0 {
-                    acc * (1.0 / acc.w)
+                    let second = k.second.map(|c| {
+                        taps.iter().fold(Vec3::ZERO, |s, &(j, w)| {
+                            s + c.get(j).copied().unwrap_or_default() * w
+                        }) * (1.0 / acc.w)
+                    });
+                    (acc * (1.0 / acc.w), second)
                 } else {
-                    tx.radiance
+                    (tx.radiance, k.second.and_then(|c| c.get(t).copied()))
                 }
             } else {
                 let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
                 filtered(k, d, t, obj[x], l, tol)
             };
-            sum[x] += radiance * (k.weight * wa[x]);
+            let weight = k.weight * wa[x];
+            sum[x] += radiance * weight;
+            if let Some(c) = second {
+                s.sum2[x] += c * weight;
+            }
         }
     }
 }
 
 /// The radiance of key `k` in direction `d` (length `l`) filtered over the bilinear taps that
 /// show object `o` at distance `l` (relative tolerance `tol`) or are the nearest texel `t`,
-/// as radiance and 1.
-fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> Vec4 {
-    let mut acc = Vec4::ZERO;
+/// as radiance and 1; and its second colour filtered alike.
+fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> (Vec4, Option<Vec3>) {
+    let (mut acc, mut acc2) = (Vec4::ZERO, Vec3::ZERO);
     for (i, w) in sample::bilinear_taps(k.face, d) {
         let Some(tx) = k.texels.get(i) else { continue };
         if w > 0.0 && (i == t || (tx.id == o && (tx.distance - l).abs() <= tol * l)) {
             acc += tx.radiance * w;
+            if let Some(c) = k.second.and_then(|c| c.get(i)) {
+                acc2 += *c * w;
+            }
         }
     }
     if acc.w > 0.0 {
-        (acc.truncate() / acc.w).extend(1.0)
+        (
+            (acc.truncate() / acc.w).extend(1.0),
+            k.second.map(|_| acc2 / acc.w),
+        )
     } else {
-        k.texels[t].radiance
+        (
+            k.texels[t].radiance,
+            k.second.and_then(|c| c.get(t).copied()),
+        )
     }
 }
 

@@ -15,9 +15,10 @@
 //! The lighting and non-diffuse lookups are always seam-aware bilinear
 //! ([`CubeFilter::Bilinear`]): at cube resolution, nearest texels show as blocks.
 //!
-//! One geometry pass runs per channel: radiance for objects without a material (and for the
-//! environment where nothing is), lighting and non-diffuse for the others, each skipping the
-//! objects another pass shades. A separate raster pass gives each pixel its triangle, from
+//! Two geometry passes run: radiance for objects without a material (and for the environment
+//! where nothing is), and one for the others that looks up the lighting and the non-diffuse
+//! radiance together (the same lookups, weights and fallbacks for both channels; two passes
+//! before, one per channel), each skipping the objects the other shades. A separate raster pass gives each pixel its triangle, from
 //! which the UV is interpolated (barycentric coordinates of the pixel's point on the placed
 //! triangle) and the footprint computed (the square root of the surface area the pixel
 //! covers, `distance · pixel angle · cos^1.5 α / √|cos θ|` for a pixel whose ray is at α
@@ -120,33 +121,41 @@ pub(crate) fn render(
         layer,
         channel,
         skip,
+        second: None,
         filter: if channel == Channel::Radiance {
             rec.settings.cube_filter
         } else {
             CubeFilter::Bilinear
         },
     };
+    // The lighting and the non-diffuse radiance in one pass (the same lookups, weights and
+    // fallbacks for both). A pack v2 always has them; a damaged one is shown from its
+    // radiance instead.
     let mut stages = Vec::new();
-    // One geometry pass, timed as stage `name`.
-    let mut run = |name: &str, channel, skip, report: &mut Report| {
-        let start = std::time::Instant::now();
-        let frame = geometry::render(rec, camera, t, mask, pass(channel, skip), report);
-        stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
-        frame
-    };
-    // The lighting first: a pack v2 always has it, and a damaged one is then shown from its
-    // radiance in one pass instead of two.
     let mut side = Report::default();
-    let lighting = run("lighting_pass", Channel::Lighting, &unlit, &mut side);
-    let non_diffuse = run("non_diffuse_pass", Channel::NonDiffuse, &unlit, &mut side);
-    let (lighting, non_diffuse) = match (lighting, non_diffuse) {
-        (Ok(l), Ok(s)) => (l, s),
-        (Err(e), _) | (_, Err(e)) => {
+    let start = std::time::Instant::now();
+    let fused = Pass {
+        second: Some(Channel::NonDiffuse),
+        ..pass(Channel::Lighting, &unlit)
+    };
+    let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
+    stages.push((
+        "lighting_pass".to_string(),
+        start.elapsed().as_secs_f64() * 1e3,
+    ));
+    let (lighting, non_diffuse) = match both {
+        Ok(pair) => pair,
+        Err(e) => {
             report.missing.push(format!("materials not applied: {e}"));
             return radiance_only(report);
         }
     };
-    let mut frame = run("radiance_pass", Channel::Radiance, &lit, report)?;
+    let start = std::time::Instant::now();
+    let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
+    stages.push((
+        "radiance_pass".to_string(),
+        start.elapsed().as_secs_f64() * 1e3,
+    ));
     let mut timed = |name: &str, start: std::time::Instant| {
         stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
     };
@@ -218,9 +227,9 @@ pub(crate) fn render(
                 Vec3::ZERO
             } else if runtime_emission {
                 // Pack 4: the emission at the pixel's UV, the specular part from the cubes.
-                non_diffuse.radiance[j] + px.emission
+                non_diffuse[j] + px.emission
             } else {
-                non_diffuse.radiance[j]
+                non_diffuse[j]
             };
             *c = px.material.albedo() * lighting.radiance[j] + specular.unwrap_or(baked);
             if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {

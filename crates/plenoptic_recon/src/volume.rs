@@ -156,6 +156,14 @@ impl VolumeIndex {
         })
     }
 
+    /// The same samples, looked up for another of their colours.
+    pub(crate) fn with_channel(&self, channel: Channel) -> Self {
+        VolumeIndex {
+            channel,
+            ..self.clone()
+        }
+    }
+
     /// Number of samples in the window.
     pub fn len(&self) -> usize {
         self.blocks

@@ -1,0 +1,74 @@
+//! Unit tests of [`crate::geometry`] that need a pack (written by the integration tests'
+//! writer, `tests/common`).
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::{Materials, PackSpec, room, write_pack};
+use glam::Vec3;
+
+use crate::frame::Report;
+use crate::geometry::{self, Layer, Pass};
+use crate::settings::CubeFilter;
+use crate::shading::Channel;
+use crate::{Camera, Reconstructor};
+
+/// One pass that looks up two channels gives each what a pass of its own gives: the same
+/// lookups, weights and fallbacks, nearest and bilinear.
+#[test]
+fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pair.pack");
+    let spec = PackSpec {
+        materials: Materials::Textured,
+        ..PackSpec::segment(2, vec![0.0, 1.0, 2.0], 32)
+    };
+    write_pack(&room(true), &spec, &path);
+    let rec = Reconstructor::open(&path).unwrap();
+    let camera = Camera::look_at(
+        Vec3::new(0.3, 1.2, 0.8),
+        Vec3::new(-0.2, 0.7, -2.0),
+        Vec3::Y,
+        1.2,
+        96,
+        64,
+    )
+    .unwrap();
+    for filter in [CubeFilter::Nearest, CubeFilter::Bilinear] {
+        let pass = |channel, second| Pass {
+            layer: Layer::All,
+            channel,
+            skip: &[],
+            filter,
+            second,
+        };
+        let mut report = Report::default();
+        let (lighting, non_diffuse) = geometry::render_pair(
+            &rec,
+            &camera,
+            0.6,
+            None,
+            pass(Channel::Lighting, Some(Channel::NonDiffuse)),
+            &mut report,
+        )
+        .unwrap();
+        let alone = |channel| {
+            let mut report = Report::default();
+            geometry::render(&rec, &camera, 0.6, None, pass(channel, None), &mut report)
+                .unwrap()
+                .radiance
+        };
+        let close = |a: &[Vec3], b: &[Vec3]| {
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(x, y)| (*x - *y).abs().max_element() <= 1e-5 * (1.0 + y.max_element()))
+        };
+        assert!(close(&lighting.radiance, &alone(Channel::Lighting)));
+        let nd = alone(Channel::NonDiffuse);
+        assert!(close(&non_diffuse, &nd), "{filter:?}");
+        // The non-diffuse radiance is not the lighting: the test compares something.
+        assert!(nd.iter().any(|c| c.max_element() > 1e-4));
+        assert!(!close(&non_diffuse, &lighting.radiance));
+    }
+}
