@@ -45,6 +45,9 @@ use crate::volume::VolumeIndex;
 use crate::{Error, Result, sample};
 
 struct ViewKey {
+    /// Base view and time key indices.
+    view: usize,
+    key: usize,
     base: Vec3,
     weight: f32,
     cubes: KeyCubes,
@@ -87,6 +90,21 @@ pub(crate) struct Pass<'a> {
     /// non-diffuse radiance beside the lighting), returned beside the frame by
     /// [`render_pair`]. A key whose second cube cannot be read is not used.
     pub second: Option<Channel>,
+    /// Where no proxy is, the environment: the heaviest key's cube of this channel read with
+    /// this filter (`None`: the pass's own channel and filter).
+    pub environment: Option<(Channel, CubeFilter)>,
+}
+
+/// What [`render_pair`] renders.
+pub(crate) struct PairFrame {
+    /// The frame of the pass's channel.
+    pub frame: Frame,
+    /// The second channel per pixel (black where the frame has no lookup: nothing, or a
+    /// skipped object; empty without a second channel).
+    pub second: Vec<Vec3>,
+    /// Whether the environment's cube could be read (pixels where nothing is are black
+    /// otherwise).
+    pub environment: bool,
 }
 
 impl<'a> Pass<'a> {
@@ -98,6 +116,7 @@ impl<'a> Pass<'a> {
             skip: &[],
             filter,
             second: None,
+            environment: None,
         }
     }
 }
@@ -116,11 +135,10 @@ pub(crate) fn render(
         second: None,
         ..pass
     };
-    render_pair(rec, camera, t, mask, pass, report).map(|(frame, _)| frame)
+    render_pair(rec, camera, t, mask, pass, report).map(|p| p.frame)
 }
 
-/// [`render`], with the colour of `pass.second` per pixel beside the frame (black where the
-/// frame has no lookup: nothing, or a skipped object).
+/// [`render`], with the colour of `pass.second` per pixel beside the frame.
 pub(crate) fn render_pair(
     rec: &Reconstructor,
     camera: &Camera,
@@ -128,13 +146,14 @@ pub(crate) fn render_pair(
     mask: Option<&GeometryMask>,
     pass: Pass<'_>,
     report: &mut Report,
-) -> Result<(Frame, Vec<Vec3>)> {
+) -> Result<PairFrame> {
     let Pass {
         layer,
         channel,
         skip,
         filter,
         second,
+        environment,
     } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
@@ -201,6 +220,8 @@ pub(crate) fn render_pair(
                 .map(|(&o, inv)| proxy.transform(o, tau) * *inv)
                 .collect();
             keys.push(ViewKey {
+                view: v,
+                key: k,
                 base: bv.position,
                 weight: w * wt / total,
                 packed: rec.packed_texels(v, k, channel, &c),
@@ -292,10 +313,18 @@ pub(crate) fn render_pair(
         0
     };
     // The environment lookup uses the heaviest key.
+    let (env_channel, env_filter) = environment.unwrap_or((channel, filter));
     let env = keys
         .iter()
         .max_by(|a, b| a.weight.total_cmp(&b.weight))
-        .map(|k| (k.base, k.cubes.radiance.clone()));
+        .and_then(|k| {
+            if env_channel == channel {
+                return Some(k.cubes.radiance.clone());
+            }
+            rec.key_cubes_in(k.view, k.key, env_channel, &mut report.missing)
+                .map(|c| c.radiance)
+        });
+    let env_bilinear = env_filter == CubeFilter::Bilinear;
     let bilinear = filter == CubeFilter::Bilinear;
     let shade = Shade {
         fast: &fast,
@@ -363,8 +392,8 @@ pub(crate) fn render_pair(
                         s.slot[x] = NO_SLOT;
                         if o == 0 {
                             cls[x] = NONE;
-                            if let Some((_, env)) = &env {
-                                rad[x] = if bilinear {
+                            if let Some(env) = &env {
+                                rad[x] = if env_bilinear {
                                     sample::bilinear(env, s.dir_at(x))
                                 } else {
                                     env.texels[sample::texel(env.face_size, s.dir_at(x))]
@@ -462,7 +491,11 @@ pub(crate) fn render_pair(
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
     report.fallback =
         FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
-    Ok((frame, plane2))
+    Ok(PairFrame {
+        frame,
+        second: plane2,
+        environment: env.is_some(),
+    })
 }
 
 /// Rows per band of the pixel loop (a band is rasterized, then shaded, while in cache).

@@ -4,7 +4,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::{Materials, PackSpec, room, write_pack};
+use common::{Materials, PackSpec, open_room, room, write_pack};
 use glam::Vec3;
 
 use crate::frame::Report;
@@ -41,9 +41,10 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
             skip: &[],
             filter,
             second,
+            environment: None,
         };
         let mut report = Report::default();
-        let (lighting, non_diffuse) = geometry::render_pair(
+        let pair = geometry::render_pair(
             &rec,
             &camera,
             0.6,
@@ -52,6 +53,7 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
             &mut report,
         )
         .unwrap();
+        let (lighting, non_diffuse) = (pair.frame, pair.second);
         let alone = |channel| {
             let mut report = Report::default();
             geometry::render(&rec, &camera, 0.6, None, pass(channel, None), &mut report)
@@ -70,5 +72,79 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
         // The non-diffuse radiance is not the lighting: the test compares something.
         assert!(nd.iter().any(|c| c.max_element() > 1e-4));
         assert!(!close(&non_diffuse, &lighting.radiance));
+    }
+}
+
+/// A pass asked for the environment of another channel shows, where nothing is, what a pass
+/// of that channel and filter shows there (the radiance pass that the materials' frame then
+/// skips when every object has a material).
+#[test]
+fn a_pass_shows_the_environment_of_the_channel_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    let spec = PackSpec {
+        materials: Materials::Textured,
+        ..PackSpec::segment(2, vec![0.0, 1.0, 2.0], 32)
+    };
+    write_pack(&open_room(), &spec, &path);
+    let rec = Reconstructor::open(&path).unwrap();
+    // Looking up through the skylight.
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 1.2, 0.5),
+        Vec3::new(0.2, 4.0, -1.0),
+        Vec3::Y,
+        1.4,
+        64,
+        48,
+    )
+    .unwrap();
+    let all: Vec<u32> = rec.proxy().unwrap().object_ids().to_vec();
+    for filter in [CubeFilter::Nearest, CubeFilter::Bilinear] {
+        let mut report = Report::default();
+        let pair = geometry::render_pair(
+            &rec,
+            &camera,
+            0.6,
+            None,
+            Pass {
+                layer: Layer::All,
+                channel: Channel::Lighting,
+                skip: &[],
+                filter: CubeFilter::Bilinear,
+                second: Some(Channel::NonDiffuse),
+                environment: Some((Channel::Radiance, filter)),
+            },
+            &mut report,
+        )
+        .unwrap();
+        assert!(pair.environment);
+        let radiance = geometry::render(
+            &rec,
+            &camera,
+            0.6,
+            None,
+            Pass {
+                skip: &all,
+                ..Pass::radiance(Layer::All, filter)
+            },
+            &mut report,
+        )
+        .unwrap();
+        let sky: Vec<usize> = (0..radiance.object.len())
+            .filter(|&j| radiance.object[j] == 0)
+            .collect();
+        assert!(sky.len() > 100, "{} sky pixels", sky.len());
+        assert_eq!(pair.frame.object, radiance.object);
+        for &j in &sky {
+            let (a, b) = (pair.frame.radiance[j], radiance.radiance[j]);
+            assert!(
+                (a - b).abs().max_element() <= 1e-6 * (1.0 + b.max_element()),
+                "{a} {b}"
+            );
+        }
+        assert!(
+            sky.iter()
+                .any(|&j| radiance.radiance[j].max_element() > 0.0)
+        );
     }
 }

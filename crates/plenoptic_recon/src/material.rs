@@ -209,6 +209,9 @@ fn wrap(i: i64, n: i64, mode: WrapMode) -> usize {
         return i as usize;
     }
     (match mode {
+        // One period off (the texel beside an edge of a reduced coordinate): no division.
+        WrapMode::Repeat if (-n..0).contains(&i) => i + n,
+        WrapMode::Repeat if (n..2 * n).contains(&i) => i - n,
         WrapMode::Repeat => i.rem_euclid(n),
         WrapMode::ClampToEdge => i.clamp(0, n - 1),
         WrapMode::MirroredRepeat => {
@@ -232,7 +235,7 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
     let texels = footprint * scale * top.width.max(top.height) as f32;
     let lod = if texels > 1.0 { texels.log2() } else { 0.0 };
     let last = texture.levels.len() - 1;
-    let l0 = (lod.floor() as usize).min(last);
+    let l0 = (floor(lod) as usize).min(last);
     let l1 = (l0 + 1).min(last);
     let f = (lod - l0 as f32).clamp(0.0, 1.0);
     let a = bilinear(texture, l0, b, uv);
@@ -243,15 +246,38 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
     a.lerp(bilinear(texture, l1, b, uv), f)
 }
 
+/// `x.floor()` without a call into libm (the baseline x86-64 target has no rounding
+/// instruction, and the texture lookups are hot): exact for every finite `x`.
+#[inline]
+fn floor(x: f32) -> f32 {
+    // From 2²³ up every f32 is an integer.
+    if x.abs() >= 8_388_608.0 {
+        return x;
+    }
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
+}
+
+/// `uv` reduced to [0, 1) where the wrap mode repeats (the same texels, without an integer
+/// division per texel to wrap them).
+#[inline]
+fn reduce(uv: f32, mode: WrapMode) -> f32 {
+    if mode == WrapMode::Repeat && !(0.0..1.0).contains(&uv) {
+        uv - floor(uv)
+    } else {
+        uv
+    }
+}
+
 fn bilinear(texture: &TextureImage, level: usize, b: TextureBinding, uv: Vec2) -> Vec4 {
     let l = &texture.levels[level];
     let (w, h) = (l.width as i64, l.height as i64);
-    let x = uv.x * w as f32 - 0.5;
-    let y = uv.y * h as f32 - 0.5;
+    let x = reduce(uv.x, b.wrap_s) * w as f32 - 0.5;
+    let y = reduce(uv.y, b.wrap_t) * h as f32 - 0.5;
     if !(x.is_finite() && y.is_finite()) || l.texels.len() < 4 * (w * h) as usize {
         return Vec4::ONE;
     }
-    let (x0, y0) = (x.floor(), y.floor());
+    let (x0, y0) = (floor(x), floor(y));
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0 as i64, y0 as i64);
     // The two columns and rows of the footprint, wrapped once each.
@@ -344,6 +370,39 @@ mod tests {
         );
         // A tangent along the normal has no frame.
         assert_eq!(bend_normal(up, Vec3::Y, 1.0, tilted), up);
+    }
+
+    #[test]
+    fn floor_is_libm_floor() {
+        for x in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999_999_8,
+            -2.999_999_8,
+            1e-30,
+            -1e-30,
+            8_388_607.5,
+            -8_388_607.5,
+            3e9,
+            -3e9,
+            123.0,
+            -123.0,
+        ] {
+            assert_eq!(floor(x), x.floor(), "{x}");
+        }
+        // Repeating coordinates reduce to the same texel coordinates as wrapping them.
+        for u in [-3.25f32, -1.0, -0.001, 0.0, 0.4, 1.0, 7.75] {
+            let r = reduce(u, WrapMode::Repeat);
+            assert!(
+                (0.0..1.0).contains(&r) && (r - u - (r - u).round()).abs() < 1e-6,
+                "{u}"
+            );
+            assert_eq!(reduce(u, WrapMode::ClampToEdge), u);
+        }
     }
 
     #[test]

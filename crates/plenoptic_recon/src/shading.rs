@@ -122,6 +122,7 @@ pub(crate) fn render(
         channel,
         skip,
         second: None,
+        environment: None,
         filter: if channel == Channel::Radiance {
             rec.settings.cube_filter
         } else {
@@ -134,8 +135,12 @@ pub(crate) fn render(
     let mut stages = Vec::new();
     let mut side = Report::default();
     let start = std::time::Instant::now();
+    // Where every object has a material, the radiance pass would only show the environment:
+    // this pass looks it up instead, in the radiance cube as that pass would.
+    let all_lit = unlit.is_empty();
     let fused = Pass {
         second: Some(Channel::NonDiffuse),
+        environment: all_lit.then_some((Channel::Radiance, rec.settings.cube_filter)),
         ..pass(Channel::Lighting, &unlit)
     };
     let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
@@ -143,15 +148,30 @@ pub(crate) fn render(
         "lighting_pass".to_string(),
         start.elapsed().as_secs_f64() * 1e3,
     ));
-    let (lighting, non_diffuse) = match both {
-        Ok(pair) => pair,
+    let (lighting, non_diffuse, environment) = match both {
+        Ok(pair) => (pair.frame, pair.second, pair.environment),
         Err(e) => {
             report.missing.push(format!("materials not applied: {e}"));
             return radiance_only(report);
         }
     };
     let start = std::time::Instant::now();
-    let mut frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
+    let mut frame = if all_lit && environment {
+        // What the radiance pass gives when it skips every object: the environment where
+        // nothing is, black elsewhere (the compose below shades the objects).
+        report.base_views = side.base_views.clone();
+        Frame {
+            width: lighting.width,
+            height: lighting.height,
+            radiance: (lighting.radiance.par_iter().zip(&lighting.object))
+                .map(|(&c, &o)| if o == 0 { c } else { Vec3::ZERO })
+                .collect(),
+            depth: lighting.depth.clone(),
+            object: lighting.object.clone(),
+        }
+    } else {
+        geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?
+    };
     stages.push((
         "radiance_pass".to_string(),
         start.elapsed().as_secs_f64() * 1e3,
