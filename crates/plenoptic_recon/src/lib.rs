@@ -107,6 +107,7 @@ pub mod shadow;
 pub mod specular;
 pub mod streamed;
 pub mod sun;
+mod surface;
 pub mod temporal;
 pub mod viewspace;
 pub mod volume;

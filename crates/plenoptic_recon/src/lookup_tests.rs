@@ -1,0 +1,72 @@
+//! Tests of [`super`]: the branch-free texel addressing and powers against the reference.
+
+use super::*;
+
+#[test]
+fn branch_free_texel_matches_the_reference() {
+    let mut s = 987654321u32;
+    let mut rnd = || {
+        s ^= s << 13;
+        s ^= s >> 17;
+        s ^= s << 5;
+        s as f32 / u32::MAX as f32 * 2.0 - 1.0
+    };
+    let mut dirs: Vec<Vec3> = (0..20000).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+    dirs.extend([
+        Vec3::ZERO,
+        Vec3::X,
+        -Vec3::Y,
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 1.0),
+        Vec3::new(0.0, -1.0, -1.0),
+        Vec3::new(f32::NAN, 1.0, 0.0),
+        Vec3::new(f32::INFINITY, 1.0, 0.0),
+    ]);
+    for d in dirs {
+        for n in [1u32, 16, 128, 1182, 1183, 2048] {
+            let (lanes, taps, fx, fy) = CubeLanes::new(n).texels(
+                Vec4::splat(d.x),
+                Vec4::splat(d.y),
+                Vec4::splat(d.z),
+                true,
+            );
+            assert_eq!(lanes[0] as usize, sample::texel(n, d), "{d} {n}");
+            // Inside a face, the footprint is the scalar filter's.
+            if taps[0] != NO_TEXEL {
+                let reference = sample::bilinear_taps(n, d);
+                let (fx, fy) = (fx.x, fy.x);
+                let i = taps[0] as usize;
+                let n = n as usize;
+                let weights = [
+                    (i, (1.0 - fx) * (1.0 - fy)),
+                    (i + 1, fx * (1.0 - fy)),
+                    (i + n, (1.0 - fx) * fy),
+                    (i + n + 1, fx * fy),
+                ];
+                for ((a, wa), (b, wb)) in weights.into_iter().zip(reference) {
+                    assert!(a == b || wa.abs() < 1e-6, "{d} {n}: {a} {b}");
+                    assert!((wa - wb).abs() < 1e-5, "{d} {n}: {wa} {wb}");
+                }
+            }
+        }
+    }
+    // The Phong lobe's power by repeated squaring equals `powi` up to rounding: `powi` is
+    // an LLVM intrinsic whose multiplication order differs between debug and release
+    // builds, so the two agree within a few ulp (one rounding per multiplication; the
+    // floor covers 1e-3^13, a subnormal), not bit for bit.
+    for c in [0.0f32, 1e-3, 0.3, 0.77, 1.0] {
+        for k in [1, 2, 3, 8, 13] {
+            let (got, want) = (powi4(Vec4::splat(c), k).x, c.powi(k as i32));
+            let tolerance = 2.0 * k as f32 * f32::EPSILON * want.abs().max(f32::MIN_POSITIVE);
+            assert!(
+                (got - want).abs() <= tolerance,
+                "{c}^{k}: {got} vs powi {want}"
+            );
+        }
+    }
+    assert_eq!(
+        powi4(Vec4::splat(0.5), 3).x,
+        0.125,
+        "exact where no rounding occurs"
+    );
+}

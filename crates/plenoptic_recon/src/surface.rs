@@ -1,0 +1,314 @@
+//! The surface seen through each pixel, for the materials' frame ([`crate::shading`]): a
+//! raster pass gives each pixel its proxy triangle, from which the point, the normals, the UV
+//! (barycentric coordinates of the pixel's point on the placed triangle) and the footprint
+//! follow, and the material at that UV with the texture's mip chosen by the footprint
+//! ([`crate::material`]).
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::Reconstructor;
+use crate::brdf::SurfaceMaterial;
+use crate::camera::Camera;
+use crate::geometry::Layer;
+use crate::material::Materials;
+
+/// What the compose stage needs of the surface seen through one pixel.
+pub(crate) struct SurfacePixel {
+    pub object: u32,
+    pub material: SurfaceMaterial,
+    /// The point on the proxy (world).
+    pub position: Vec3,
+    /// Geometric normal as the mesh winds it (world, unit).
+    pub ng: Vec3,
+    /// Shading normal on `ng`'s side: the proxy's vertex normals interpolated, else `ng`.
+    pub ns: Vec3,
+    /// Unit direction of the pixel's ray.
+    pub view: Vec3,
+    /// How far the point moves on the surface's plane for a step of one pixel in x and in y
+    /// (the footprint the runtime sun's shadow rays spread over).
+    pub footprint: (Vec3, Vec3),
+    /// Whether its specular part is marched for the camera ([`crate::specular::Specular::marches`]).
+    pub marched: bool,
+    /// Transmissive glass drawn in the see-through layer: only its reflection is shown.
+    pub see_through: bool,
+    /// Emitted radiance at the pixel's UV where the pack leaves the emission to the runtime
+    /// (pack 4) or the specular part is marched (which replaces the baked non-diffuse
+    /// radiance, holding the emission before pack 4); else zero.
+    pub emission: Vec3,
+}
+
+/// Per pixel, the surface of an object with a material seen there (`None` where there is
+/// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it), its
+/// emission where the pack leaves it to the runtime or its specular part is marched
+/// (`glossy`: [`crate::specular::glossy_allowed`]); and
+/// the milliseconds its raster pass took.
+pub(crate) fn surface_image(
+    rec: &Reconstructor,
+    materials: &Materials,
+    camera: &Camera,
+    t: f32,
+    layer: Layer<'_>,
+    with_footprint: bool,
+    glossy: bool,
+) -> (Vec<Option<SurfacePixel>>, f64) {
+    let n = camera.pixel_count();
+    let Some(proxy) = rec.proxy() else {
+        return ((0..n).map(|_| None).collect(), 0.0);
+    };
+    let start = std::time::Instant::now();
+    let runtime_emission = rec.pack().runtime_emission();
+    // Glazing (coverage) is composited as such even where its material transmits
+    // (crate::glazing); only other transmissive glass shows its reflection alone.
+    let glazing: Vec<u32> = match layer {
+        Layer::Only(_) => rec
+            .pack()
+            .manifest()
+            .objects
+            .iter()
+            .filter(|o| o.coverage.is_some())
+            .map(|o| o.id)
+            .collect(),
+        _ => Vec::new(),
+    };
+    let mut placed = proxy.placed_meshes(t);
+    match layer {
+        Layer::All => {}
+        Layer::Without(ids) => placed.retain(|o| !ids.contains(&o.0)),
+        Layer::Only(ids) => placed.retain(|o| ids.contains(&o.0)),
+    }
+    let projected = crate::raster::project(camera, &placed);
+    let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
+    let raster_ms = start.elapsed().as_secs_f64() * 1e3;
+    // Per projected triangle, once: its placed corners, normals, UVs and UV-per-metre scale.
+    let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
+        .sources
+        .par_iter()
+        .map(|&(oi, ti)| {
+            let (id, xf, mesh) = placed.get(oi as usize)?;
+            let m = materials.object(*id)?;
+            let tri = mesh.triangles.get(ti as usize)?;
+            let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
+            let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
+                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                _ => None,
+            };
+            let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
+                let to_world = xf.matrix3.inverse().transpose();
+                tri.map(|i| to_world * mesh.normals[i as usize])
+            });
+            // Tangents only where a normal map needs them (placed as the tracer places them).
+            let tangents = (m.material.normal_texture.is_some()
+                && m.tangents.len() == mesh.positions.len())
+            .then(|| {
+                let t = tri.map(|i| m.tangents[i as usize]);
+                // A mirroring placement flips the bitangent's handedness, as in the tracer.
+                let sign = t[0].w * xf.matrix3.determinant().signum();
+                (t.map(|t| xf.matrix3 * t.truncate()), sign)
+            });
+            let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
+            if xf.matrix3.determinant() < 0.0 {
+                // The tracer's geometric normal is the object-space one carried by the normal
+                // matrix, which a mirroring transform turns against the placed winding.
+                t.normal = -t.normal;
+            }
+            t.normals = normals;
+            t.tangents = tangents;
+            Some(t)
+        })
+        .collect();
+    let basis = camera.basis();
+    let w = camera.width as usize;
+    // The angle one pixel subtends at the image centre.
+    let pixel_angle = 2.0 * basis.tan_y / basis.height;
+    let surface = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let t = triangles.get(prim[j] as usize)?.as_ref()?;
+            if t.object != object[j] {
+                return None;
+            }
+            let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+            let view = dir.normalize_or(basis.forward);
+            // The pixel's ray met on the triangle's plane: the raster's interpolated depth is
+            // off by ~10⁻⁴ of the distance, enough to put the point under the surface for a
+            // shadow ray.
+            let den = dir.dot(t.normal);
+            let along = if den.abs() > 1e-4 {
+                (t.origin - basis.position).dot(t.normal) / den
+            } else {
+                depth[j]
+            };
+            let position = basis.position + dir * along;
+            let b = t.barycentric(position);
+            let (uv, uv_footprint) = match &t.uv {
+                Some(uv) => {
+                    let cos = t.normal.dot(dir).abs().max(0.05);
+                    // A pixel off the axis subtends cos³α of the central pixel's solid angle.
+                    let c = dir.dot(basis.forward).max(0.0);
+                    let off_axis = c * c.sqrt();
+                    (
+                        uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
+                        t.scale * along * pixel_angle * off_axis / cos.sqrt(),
+                    )
+                }
+                None => (Vec2::ZERO, f32::INFINITY),
+            };
+            let ng = t.normal;
+            let mut ns = t.normals.map_or(ng, |[a, c, d]| {
+                (a * b.x + c * b.y + d * b.z).normalize_or(ng)
+            });
+            if let Some(([ta, tb, tc], sign)) = t.tangents
+                && let Some(local) =
+                    materials.normal(rec.pack(), &t.material.material, uv, uv_footprint)
+            {
+                let tangent = ta * b.x + tb * b.y + tc * b.z;
+                ns = crate::material::bend_normal(ns, tangent, sign, local);
+            }
+            if ns.dot(ng) < 0.0 {
+                ns = -ns;
+            }
+            // The neighbouring pixels' rays met on the triangle's plane; at most 4 pixels'
+            // worth of depth away, so that a grazing plane does not smear the footprint.
+            let (x, y) = ((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
+            let limit = 4.0 * along * pixel_angle;
+            let step = |d: Vec3| {
+                let den = d.dot(ng);
+                let s = if den.abs() > 1e-6 {
+                    (position - basis.position).dot(ng) / den
+                } else {
+                    along
+                };
+                (basis.position + d * s - position).clamp_length_max(limit)
+            };
+            let footprint = if with_footprint {
+                (
+                    step(basis.direction(x + 1.0, y)),
+                    step(basis.direction(x, y + 1.0)),
+                )
+            } else {
+                (Vec3::ZERO, Vec3::ZERO)
+            };
+            let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
+            // In the see-through layer, transmissive glass shows its reflection alone: what
+            // it lets through is composited from the layer behind (crate::glazing).
+            let see_through = matches!(layer, Layer::Only(_))
+                && material.transmission > 0.0
+                && !glazing.contains(&t.object);
+            let reflection_of = SurfaceMaterial {
+                transmission: 0.0,
+                ..material
+            };
+            let marched = rec.settings.specular.marches(
+                if see_through {
+                    &reflection_of
+                } else {
+                    &material
+                },
+                glossy || see_through,
+            );
+            // A single-sided emitter emits from its front only, as the tracer has it.
+            let emits = t.material.material.double_sided || view.dot(ng) < 0.0;
+            let emission = if emits && (marched || runtime_emission) {
+                materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
+            } else {
+                Vec3::ZERO
+            };
+            Some(SurfacePixel {
+                object: t.object,
+                material,
+                marched,
+                see_through,
+                emission,
+                position,
+                ng,
+                ns,
+                view,
+                footprint,
+            })
+        })
+        .collect();
+    (surface, raster_ms)
+}
+
+/// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
+struct SurfaceTriangle<'m> {
+    object: u32,
+    material: &'m crate::material::ObjectMaterial,
+    origin: Vec3,
+    e0: Vec3,
+    e1: Vec3,
+    /// The inverse Gram matrix of (e0, e1): barycentrics from dot products.
+    inv: [f32; 3],
+    normal: Vec3,
+    /// Vertex normals placed in the world, when the proxy has them.
+    normals: Option<[Vec3; 3]>,
+    /// Vertex tangents placed in the world and the bitangent's sign, when the material has a
+    /// normal map and the proxy tangents.
+    tangents: Option<([Vec3; 3], f32)>,
+    uv: Option<[Vec2; 3]>,
+    /// √(UV area / world area).
+    scale: f32,
+}
+
+impl<'m> SurfaceTriangle<'m> {
+    fn new(
+        object: u32,
+        material: &'m crate::material::ObjectMaterial,
+        v: [Vec3; 3],
+        uv: Option<[Vec2; 3]>,
+    ) -> Option<Self> {
+        let (e0, e1) = (v[1] - v[0], v[2] - v[0]);
+        let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+        let den = d00 * d11 - d01 * d01;
+        if den.is_nan() || den.abs() <= 1e-20 {
+            return None;
+        }
+        let world = e0.cross(e1);
+        let scale = uv.map_or(0.0, |[a, b, c]| {
+            ((b - a).perp_dot(c - a).abs() / world.length().max(1e-12)).sqrt()
+        });
+        Some(SurfaceTriangle {
+            object,
+            material,
+            origin: v[0],
+            e0,
+            e1,
+            inv: [d11 / den, -d01 / den, d00 / den],
+            normal: world.normalize_or_zero(),
+            normals: None,
+            tangents: None,
+            uv,
+            scale,
+        })
+    }
+
+    /// Barycentric coordinates of `p` (on or near the triangle's plane).
+    fn barycentric(&self, p: Vec3) -> Vec3 {
+        let e2 = p - self.origin;
+        let (d20, d21) = (e2.dot(self.e0), e2.dot(self.e1));
+        let b1 = self.inv[0] * d20 + self.inv[1] * d21;
+        let b2 = self.inv[1] * d20 + self.inv[2] * d21;
+        Vec3::new(1.0 - b1 - b2, b1, b2)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn barycentric_coordinates_recover_the_point() {
+        let m = crate::material::ObjectMaterial {
+            material: Default::default(),
+            uvs: Vec::new(),
+            tangents: Vec::new(),
+        };
+        let v = [Vec3::ZERO, Vec3::X * 2.0, Vec3::new(0.0, 3.0, 1.0)];
+        let t = SurfaceTriangle::new(1, &m, v, None).unwrap();
+        let q = v[0] * 0.2 + v[1] * 0.5 + v[2] * 0.3;
+        let b = t.barycentric(q);
+        assert!((b - Vec3::new(0.2, 0.5, 0.3)).length() < 1e-5, "{b}");
+        assert!(SurfaceTriangle::new(1, &m, [Vec3::ZERO; 3], None).is_none());
+    }
+}
