@@ -50,7 +50,7 @@ use crate::geometry::{self, Layer, Pass};
 use crate::proxy::GeometryMask;
 use crate::settings::{CubeFilter, Shading};
 use crate::specular::{self, Reflections};
-use crate::surface::surface_image;
+use crate::surface::{SurfacePixel, Surfaces};
 use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
@@ -156,21 +156,18 @@ pub(crate) fn render(
         }
     };
     let start = std::time::Instant::now();
-    let mut frame = if all_lit && environment {
-        // What the radiance pass gives when it skips every object: the environment where
-        // nothing is, black elsewhere (the compose below shades the objects).
+    // The lighting per pixel apart from the frame, or (`None`) in the frame itself: where
+    // every object has a material the lighting pass's frame becomes the frame, its pixels
+    // shaded in place (each read before it is written), the environment where nothing is and
+    // black on objects left unshaded, as the radiance pass would leave them.
+    let (mut frame, lighting) = if all_lit && environment {
         report.base_views = side.base_views.clone();
-        Frame {
-            width: lighting.width,
-            height: lighting.height,
-            radiance: (lighting.radiance.par_iter().zip(&lighting.object))
-                .map(|(&c, &o)| if o == 0 { c } else { Vec3::ZERO })
-                .collect(),
-            depth: lighting.depth.clone(),
-            object: lighting.object.clone(),
-        }
+        (lighting, None)
     } else {
-        geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?
+        let frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
+        // The same proxies rasterized the same way: the same objects per pixel.
+        debug_assert_eq!(frame.object, lighting.object);
+        (frame, Some(lighting.radiance))
     };
     stages.push((
         "radiance_pass".to_string(),
@@ -186,92 +183,116 @@ pub(crate) fn render(
     });
     let glossy = specular::glossy_allowed(rec);
     let runtime_emission = rec.pack().runtime_emission();
-    let (surface, raster_ms) =
-        surface_image(rec, materials, camera, t, layer, sun.is_some(), glossy);
-    timed("albedo", start);
-    let start = std::time::Instant::now();
-    let reflections = if surface.iter().flatten().any(|px| px.marched) {
-        Some(Reflections::new(
-            rec,
-            camera.position,
-            t,
-            &mut report.missing,
-        ))
-    } else {
-        None
+    let with_footprint = sun.is_some();
+    let surfaces = Surfaces::new(
+        rec,
+        proxy,
+        materials,
+        camera,
+        t,
+        layer,
+        with_footprint,
+        glossy,
+    );
+    // Pixel `j` of surface `px` under `light`, with the incoming radiance of its marched
+    // reflection.
+    let shade = |j: usize, px: &SurfacePixel, light: Vec3, reflected: Option<Option<Vec3>>| {
+        // The BSDF only where the sun or a reflection needs it.
+        let front = px.view.dot(px.ng) < 0.0;
+        let bsdf = (sun.is_some() || px.marched)
+            .then(|| Bsdf::new(px.material, px.ng, px.ns, -px.view, front));
+        let specular = reflected.zip(bsdf.as_ref()).and_then(|(incoming, bsdf)| {
+            let n = bsdf.normal();
+            let cos_o = -px.view.dot(n);
+            let eta = if front {
+                px.material.ior
+            } else {
+                1.0 / px.material.ior
+            };
+            Some(px.emission + specular::reflectance(&px.material, cos_o, eta) * incoming?)
+        });
+        // Glass in the see-through layer that no view answers shows no reflection (its
+        // baked radiance holds what it lets through, which is composited apart).
+        let baked = if px.see_through {
+            Vec3::ZERO
+        } else if runtime_emission {
+            // Pack 4: the emission at the pixel's UV, the specular part from the cubes.
+            non_diffuse[j] + px.emission
+        } else {
+            non_diffuse[j]
+        };
+        let mut c = px.material.albedo() * light + specular.unwrap_or(baked);
+        if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {
+            c += sun.radiance(px.position, px.ng, px.footprint, bsdf, j as u32);
+        }
+        c
     };
-    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    frame
+    // Each pixel shaded as soon as its surface is known; those whose reflection is marched
+    // wait for the reflections' set-up, which only a frame that has them pays for.
+    let object = &frame.object;
+    let marched: Vec<(usize, SurfacePixel)> = frame
         .radiance
         .par_iter_mut()
         .enumerate()
-        .for_each(|(j, c)| {
-            let Some(px) = &surface[j] else { return };
-            if lighting.object[j] != px.object {
-                return;
-            }
-            // The BSDF only where the sun or a reflection needs it.
-            let front = px.view.dot(px.ng) < 0.0;
-            let bsdf = (sun.is_some() || px.marched)
-                .then(|| Bsdf::new(px.material, px.ng, px.ns, -px.view, front));
-            let specular = reflections
-                .as_ref()
-                .zip(bsdf.as_ref())
-                .filter(|_| px.marched)
-                .and_then(|(r, bsdf)| {
-                    let n = bsdf.normal();
-                    let cos_o = -px.view.dot(n);
-                    let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
-                    let eta = if front {
-                        px.material.ior
-                    } else {
-                        1.0 / px.material.ior
-                    };
-                    let alpha = px.material.roughness * px.material.roughness;
-                    let incoming = if px.material.roughness < DELTA_ROUGHNESS {
-                        r.incoming(px.position, dir, 0.0)
-                    } else {
-                        // A per-pixel turn of the lobe's directions (golden-ratio sequence).
-                        let turn = (j as f32 * 0.618_034).fract();
-                        r.lobe(px.position, n, -px.view, alpha, turn)
-                    };
-                    marched_pixels.fetch_add(1, Ordering::Relaxed);
-                    if incoming.is_none() {
-                        unanswered.fetch_add(1, Ordering::Relaxed);
-                    }
-                    Some(px.emission + specular::reflectance(&px.material, cos_o, eta) * incoming?)
-                });
-            // Glass in the see-through layer that no view answers shows no reflection (its
-            // baked radiance holds what it lets through, which is composited apart).
-            let baked = if px.see_through {
-                Vec3::ZERO
-            } else if runtime_emission {
-                // Pack 4: the emission at the pixel's UV, the specular part from the cubes.
-                non_diffuse[j] + px.emission
-            } else {
-                non_diffuse[j]
+        .filter_map(|(j, c)| {
+            let light = lighting.as_ref().map_or(*c, |l| l[j]);
+            let px = surfaces.pixel(j).filter(|px| px.object == object[j]);
+            let Some(px) = px else {
+                if lighting.is_none() && object[j] != 0 {
+                    *c = Vec3::ZERO;
+                }
+                return None;
             };
-            *c = px.material.albedo() * lighting.radiance[j] + specular.unwrap_or(baked);
-            if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {
-                *c += sun.radiance(px.position, px.ng, px.footprint, bsdf, j as u32);
+            if px.marched {
+                return Some((j, px));
             }
-        });
+            *c = shade(j, &px, light, None);
+            None
+        })
+        .collect();
+    timed("albedo", start);
+    let start = std::time::Instant::now();
+    let reflections = (!marched.is_empty())
+        .then(|| Reflections::new(rec, camera.position, t, &mut report.missing));
+    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let reflected: Vec<(usize, Vec3)> = marched
+        .par_iter()
+        .map(|(j, px)| {
+            let incoming = reflections.as_ref().map(|r| {
+                let front = px.view.dot(px.ng) < 0.0;
+                let n = Bsdf::new(px.material, px.ng, px.ns, -px.view, front).normal();
+                let cos_o = -px.view.dot(n);
+                let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
+                let alpha = px.material.roughness * px.material.roughness;
+                let incoming = if px.material.roughness < DELTA_ROUGHNESS {
+                    r.incoming(px.position, dir, 0.0)
+                } else {
+                    // A per-pixel turn of the lobe's directions (golden-ratio sequence).
+                    let turn = (*j as f32 * 0.618_034).fract();
+                    r.lobe(px.position, n, -px.view, alpha, turn)
+                };
+                marched_pixels.fetch_add(1, Ordering::Relaxed);
+                if incoming.is_none() {
+                    unanswered.fetch_add(1, Ordering::Relaxed);
+                }
+                incoming
+            });
+            let light = lighting.as_ref().map_or(frame.radiance[*j], |l| l[*j]);
+            (*j, shade(*j, px, light, incoming))
+        })
+        .collect();
+    for (j, c) in reflected {
+        frame.radiance[j] = c;
+    }
     report.reflections = (marched_pixels.into_inner(), unanswered.into_inner());
-    timed(
-        if sun.is_some() {
-            "compose_sun"
-        } else {
-            "compose"
-        },
-        start,
-    );
+    timed("reflections", start);
     report.fallback = side.fallback;
     for m in side.missing.into_iter().chain(materials.messages()) {
         if !report.missing.contains(&m) {
             report.missing.push(m);
         }
     }
-    stages.push(("albedo_raster".to_string(), raster_ms));
+    stages.push(("albedo_raster".to_string(), surfaces.raster_ms));
     report.stage_ms = stages;
     Ok(frame)
 }

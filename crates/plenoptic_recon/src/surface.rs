@@ -9,9 +9,10 @@ use rayon::prelude::*;
 
 use crate::Reconstructor;
 use crate::brdf::SurfaceMaterial;
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraBasis};
 use crate::geometry::Layer;
 use crate::material::Materials;
+use crate::proxy::ProxyGeometry;
 
 /// What the compose stage needs of the surface seen through one pixel.
 pub(crate) struct SurfacePixel {
@@ -38,197 +39,240 @@ pub(crate) struct SurfacePixel {
     pub emission: Vec3,
 }
 
-/// Per pixel, the surface of an object with a material seen there (`None` where there is
-/// none), its footprint only `with_footprint` (the runtime sun's shadow rays need it), its
-/// emission where the pack leaves it to the runtime or its specular part is marched
-/// (`glossy`: [`crate::specular::glossy_allowed`]); and
-/// the milliseconds its raster pass took.
-pub(crate) fn surface_image(
-    rec: &Reconstructor,
-    materials: &Materials,
-    camera: &Camera,
-    t: f32,
-    layer: Layer<'_>,
+/// Per pixel, the surface of an object with a material seen there: the raster of the
+/// proxies and their triangles prepared once per frame, the pixels computed on demand
+/// ([`Surfaces::pixel`]) so that a caller shades each while it is in cache.
+pub(crate) struct Surfaces<'a> {
+    rec: &'a Reconstructor,
+    materials: &'a Materials,
+    /// Per pixel of the raster: object, projected triangle and depth.
+    object: Vec<u32>,
+    prim: Vec<u32>,
+    depth: Vec<f32>,
+    /// Per projected triangle: what its pixels need, `None` without a material.
+    triangles: Vec<Option<SurfaceTriangle<'a>>>,
+    basis: CameraBasis,
+    width: usize,
+    /// The angle one pixel subtends at the image centre.
+    pixel_angle: f32,
+    /// The see-through layer ([`Layer::Only`]), and the glazing in it.
+    see_through_layer: bool,
+    glazing: Vec<u32>,
     with_footprint: bool,
     glossy: bool,
-) -> (Vec<Option<SurfacePixel>>, f64) {
-    let n = camera.pixel_count();
-    let Some(proxy) = rec.proxy() else {
-        return ((0..n).map(|_| None).collect(), 0.0);
-    };
-    let start = std::time::Instant::now();
-    let runtime_emission = rec.pack().runtime_emission();
-    // Glazing (coverage) is composited as such even where its material transmits
-    // (crate::glazing); only other transmissive glass shows its reflection alone.
-    let glazing: Vec<u32> = match layer {
-        Layer::Only(_) => rec
-            .pack()
-            .manifest()
-            .objects
-            .iter()
-            .filter(|o| o.coverage.is_some())
-            .map(|o| o.id)
-            .collect(),
-        _ => Vec::new(),
-    };
-    let mut placed = proxy.placed_meshes(t);
-    match layer {
-        Layer::All => {}
-        Layer::Without(ids) => placed.retain(|o| !ids.contains(&o.0)),
-        Layer::Only(ids) => placed.retain(|o| ids.contains(&o.0)),
-    }
-    let projected = crate::raster::project(camera, &placed);
-    let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
-    let raster_ms = start.elapsed().as_secs_f64() * 1e3;
-    // Per projected triangle, once: its placed corners, normals, UVs and UV-per-metre scale.
-    let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
-        .sources
-        .par_iter()
-        .map(|&(oi, ti)| {
-            let (id, xf, mesh) = placed.get(oi as usize)?;
-            let m = materials.object(*id)?;
-            let tri = mesh.triangles.get(ti as usize)?;
-            let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
-            let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
-                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-                _ => None,
-            };
-            let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
-                let to_world = xf.matrix3.inverse().transpose();
-                tri.map(|i| to_world * mesh.normals[i as usize])
-            });
-            // Tangents only where a normal map needs them (placed as the tracer places them).
-            let tangents = (m.material.normal_texture.is_some()
-                && m.tangents.len() == mesh.positions.len())
-            .then(|| {
-                let t = tri.map(|i| m.tangents[i as usize]);
-                // A mirroring placement flips the bitangent's handedness, as in the tracer.
-                let sign = t[0].w * xf.matrix3.determinant().signum();
-                (t.map(|t| xf.matrix3 * t.truncate()), sign)
-            });
-            let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
-            if xf.matrix3.determinant() < 0.0 {
-                // The tracer's geometric normal is the object-space one carried by the normal
-                // matrix, which a mirroring transform turns against the placed winding.
-                t.normal = -t.normal;
-            }
-            t.normals = normals;
-            t.tangents = tangents;
-            Some(t)
-        })
-        .collect();
-    let basis = camera.basis();
-    let w = camera.width as usize;
-    // The angle one pixel subtends at the image centre.
-    let pixel_angle = 2.0 * basis.tan_y / basis.height;
-    let surface = (0..n)
-        .into_par_iter()
-        .map(|j| {
-            let t = triangles.get(prim[j] as usize)?.as_ref()?;
-            if t.object != object[j] {
-                return None;
-            }
-            let dir = basis.direction((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
-            let view = dir.normalize_or(basis.forward);
-            // The pixel's ray met on the triangle's plane: the raster's interpolated depth is
-            // off by ~10⁻⁴ of the distance, enough to put the point under the surface for a
-            // shadow ray.
-            let den = dir.dot(t.normal);
-            let along = if den.abs() > 1e-4 {
-                (t.origin - basis.position).dot(t.normal) / den
-            } else {
-                depth[j]
-            };
-            let position = basis.position + dir * along;
-            let b = t.barycentric(position);
-            let (uv, uv_footprint) = match &t.uv {
-                Some(uv) => {
-                    let cos = t.normal.dot(dir).abs().max(0.05);
-                    // A pixel off the axis subtends cos³α of the central pixel's solid angle.
-                    let c = dir.dot(basis.forward).max(0.0);
-                    let off_axis = c * c.sqrt();
-                    (
-                        uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
-                        t.scale * along * pixel_angle * off_axis / cos.sqrt(),
-                    )
-                }
-                None => (Vec2::ZERO, f32::INFINITY),
-            };
-            let ng = t.normal;
-            let mut ns = t.normals.map_or(ng, |[a, c, d]| {
-                (a * b.x + c * b.y + d * b.z).normalize_or(ng)
-            });
-            if let Some(([ta, tb, tc], sign)) = t.tangents
-                && let Some(local) =
-                    materials.normal(rec.pack(), &t.material.material, uv, uv_footprint)
-            {
-                let tangent = ta * b.x + tb * b.y + tc * b.z;
-                ns = crate::material::bend_normal(ns, tangent, sign, local);
-            }
-            if ns.dot(ng) < 0.0 {
-                ns = -ns;
-            }
-            // The neighbouring pixels' rays met on the triangle's plane; at most 4 pixels'
-            // worth of depth away, so that a grazing plane does not smear the footprint.
-            let (x, y) = ((j % w) as f32 + 0.5, (j / w) as f32 + 0.5);
-            let limit = 4.0 * along * pixel_angle;
-            let step = |d: Vec3| {
-                let den = d.dot(ng);
-                let s = if den.abs() > 1e-6 {
-                    (position - basis.position).dot(ng) / den
-                } else {
-                    along
+    runtime_emission: bool,
+    /// Milliseconds the raster pass took.
+    pub raster_ms: f64,
+}
+
+impl<'a> Surfaces<'a> {
+    /// The surfaces of the proxies of `layer` seen by `camera` at `t`; with their footprint
+    /// only `with_footprint` (the runtime sun's shadow rays need it), their emission where the
+    /// pack leaves it to the runtime or their specular part is marched (`glossy`:
+    /// [`crate::specular::glossy_allowed`]).
+    #[expect(clippy::too_many_arguments, reason = "one frame's set-up, called once")]
+    pub fn new(
+        rec: &'a Reconstructor,
+        proxy: &ProxyGeometry,
+        materials: &'a Materials,
+        camera: &Camera,
+        t: f32,
+        layer: Layer<'_>,
+        with_footprint: bool,
+        glossy: bool,
+    ) -> Self {
+        let start = std::time::Instant::now();
+        let runtime_emission = rec.pack().runtime_emission();
+        // Glazing (coverage) is composited as such even where its material transmits
+        // (crate::glazing); only other transmissive glass shows its reflection alone.
+        let glazing: Vec<u32> = match layer {
+            Layer::Only(_) => rec
+                .pack()
+                .manifest()
+                .objects
+                .iter()
+                .filter(|o| o.coverage.is_some())
+                .map(|o| o.id)
+                .collect(),
+            _ => Vec::new(),
+        };
+        let mut placed = proxy.placed_meshes(t);
+        match layer {
+            Layer::All => {}
+            Layer::Without(ids) => placed.retain(|o| !ids.contains(&o.0)),
+            Layer::Only(ids) => placed.retain(|o| ids.contains(&o.0)),
+        }
+        let projected = crate::raster::project(camera, &placed);
+        let (object, prim, depth) = crate::raster::rasterize_sources(camera, &projected);
+        let raster_ms = start.elapsed().as_secs_f64() * 1e3;
+        // Per projected triangle, once: its placed corners, normals, UVs and UV-per-metre scale.
+        let triangles: Vec<Option<SurfaceTriangle<'_>>> = projected
+            .sources
+            .par_iter()
+            .map(|&(oi, ti)| {
+                let (id, xf, mesh) = placed.get(oi as usize)?;
+                let m = materials.object(*id)?;
+                let tri = mesh.triangles.get(ti as usize)?;
+                let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
+                let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
+                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                    _ => None,
                 };
-                (basis.position + d * s - position).clamp_length_max(limit)
-            };
-            let footprint = if with_footprint {
-                (
-                    step(basis.direction(x + 1.0, y)),
-                    step(basis.direction(x, y + 1.0)),
-                )
-            } else {
-                (Vec3::ZERO, Vec3::ZERO)
-            };
-            let material = materials.surface(rec.pack(), &t.material.material, uv, uv_footprint);
-            // In the see-through layer, transmissive glass shows its reflection alone: what
-            // it lets through is composited from the layer behind (crate::glazing).
-            let see_through = matches!(layer, Layer::Only(_))
-                && material.transmission > 0.0
-                && !glazing.contains(&t.object);
-            let reflection_of = SurfaceMaterial {
-                transmission: 0.0,
-                ..material
-            };
-            let marched = rec.settings.specular.marches(
-                if see_through {
-                    &reflection_of
-                } else {
-                    &material
-                },
-                glossy || see_through,
-            );
-            // A single-sided emitter emits from its front only, as the tracer has it.
-            let emits = t.material.material.double_sided || view.dot(ng) < 0.0;
-            let emission = if emits && (marched || runtime_emission) {
-                materials.emission(rec.pack(), &t.material.material, uv, uv_footprint)
-            } else {
-                Vec3::ZERO
-            };
-            Some(SurfacePixel {
-                object: t.object,
-                material,
-                marched,
-                see_through,
-                emission,
-                position,
-                ng,
-                ns,
-                view,
-                footprint,
+                let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
+                    let to_world = xf.matrix3.inverse().transpose();
+                    tri.map(|i| to_world * mesh.normals[i as usize])
+                });
+                // Tangents only where a normal map needs them (placed as the tracer places them).
+                let tangents = (m.material.normal_texture.is_some()
+                    && m.tangents.len() == mesh.positions.len())
+                .then(|| {
+                    let t = tri.map(|i| m.tangents[i as usize]);
+                    // A mirroring placement flips the bitangent's handedness, as in the tracer.
+                    let sign = t[0].w * xf.matrix3.determinant().signum();
+                    (t.map(|t| xf.matrix3 * t.truncate()), sign)
+                });
+                let mut t = SurfaceTriangle::new(*id, m, v, uv)?;
+                if xf.matrix3.determinant() < 0.0 {
+                    // The tracer's geometric normal is the object-space one carried by the normal
+                    // matrix, which a mirroring transform turns against the placed winding.
+                    t.normal = -t.normal;
+                }
+                t.normals = normals;
+                t.tangents = tangents;
+                Some(t)
             })
+            .collect();
+        let basis = camera.basis();
+        Surfaces {
+            rec,
+            materials,
+            object,
+            prim,
+            depth,
+            triangles,
+            width: camera.width as usize,
+            pixel_angle: 2.0 * basis.tan_y / basis.height,
+            basis,
+            see_through_layer: matches!(layer, Layer::Only(_)),
+            glazing,
+            with_footprint,
+            glossy,
+            runtime_emission,
+            raster_ms,
+        }
+    }
+
+    /// The surface seen through pixel `j`, `None` where there is none with a material.
+    pub fn pixel(&self, j: usize) -> Option<SurfacePixel> {
+        let t = self.triangles.get(self.prim[j] as usize)?.as_ref()?;
+        if t.object != self.object[j] {
+            return None;
+        }
+        let dir = self
+            .basis
+            .direction((j % self.width) as f32 + 0.5, (j / self.width) as f32 + 0.5);
+        let view = dir.normalize_or(self.basis.forward);
+        // The pixel's ray met on the triangle's plane: the raster's interpolated depth is
+        // off by ~10⁻⁴ of the distance, enough to put the point under the surface for a
+        // shadow ray.
+        let den = dir.dot(t.normal);
+        let along = if den.abs() > 1e-4 {
+            (t.origin - self.basis.position).dot(t.normal) / den
+        } else {
+            self.depth[j]
+        };
+        let position = self.basis.position + dir * along;
+        let b = t.barycentric(position);
+        let (uv, uv_footprint) = match &t.uv {
+            Some(uv) => {
+                let cos = t.normal.dot(dir).abs().max(0.05);
+                // A pixel off the axis subtends cos³α of the central pixel's solid angle.
+                let c = dir.dot(self.basis.forward).max(0.0);
+                let off_axis = c * c.sqrt();
+                (
+                    uv[0] * b.x + uv[1] * b.y + uv[2] * b.z,
+                    t.scale * along * self.pixel_angle * off_axis / cos.sqrt(),
+                )
+            }
+            None => (Vec2::ZERO, f32::INFINITY),
+        };
+        let ng = t.normal;
+        let mut ns = t.normals.map_or(ng, |[a, c, d]| {
+            (a * b.x + c * b.y + d * b.z).normalize_or(ng)
+        });
+        if let Some(([ta, tb, tc], sign)) = t.tangents
+            && let Some(local) =
+                self.materials
+                    .normal(self.rec.pack(), &t.material.material, uv, uv_footprint)
+        {
+            let tangent = ta * b.x + tb * b.y + tc * b.z;
+            ns = crate::material::bend_normal(ns, tangent, sign, local);
+        }
+        if ns.dot(ng) < 0.0 {
+            ns = -ns;
+        }
+        // The neighbouring pixels' rays met on the triangle's plane; at most 4 pixels'
+        // worth of depth away, so that a grazing plane does not smear the footprint.
+        let (x, y) = ((j % self.width) as f32 + 0.5, (j / self.width) as f32 + 0.5);
+        let limit = 4.0 * along * self.pixel_angle;
+        let step = |d: Vec3| {
+            let den = d.dot(ng);
+            let s = if den.abs() > 1e-6 {
+                (position - self.basis.position).dot(ng) / den
+            } else {
+                along
+            };
+            (self.basis.position + d * s - position).clamp_length_max(limit)
+        };
+        let footprint = if self.with_footprint {
+            (
+                step(self.basis.direction(x + 1.0, y)),
+                step(self.basis.direction(x, y + 1.0)),
+            )
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let material =
+            self.materials
+                .surface(self.rec.pack(), &t.material.material, uv, uv_footprint);
+        // In the see-through layer, transmissive glass shows its reflection alone: what
+        // it lets through is composited from the layer behind (crate::glazing).
+        let see_through = self.see_through_layer
+            && material.transmission > 0.0
+            && !self.glazing.contains(&t.object);
+        let reflection_of = SurfaceMaterial {
+            transmission: 0.0,
+            ..material
+        };
+        let marched = self.rec.settings.specular.marches(
+            if see_through {
+                &reflection_of
+            } else {
+                &material
+            },
+            self.glossy || see_through,
+        );
+        // A single-sided emitter emits from its front only, as the tracer has it.
+        let emits = t.material.material.double_sided || view.dot(ng) < 0.0;
+        let emission = if emits && (marched || self.runtime_emission) {
+            self.materials
+                .emission(self.rec.pack(), &t.material.material, uv, uv_footprint)
+        } else {
+            Vec3::ZERO
+        };
+        Some(SurfacePixel {
+            object: t.object,
+            material,
+            marched,
+            see_through,
+            emission,
+            position,
+            ng,
+            ns,
+            view,
+            footprint,
         })
-        .collect();
-    (surface, raster_ms)
+    }
 }
 
 /// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
