@@ -63,16 +63,28 @@ fn measure(test: &Image<Vec3>, a: &Image<Vec3>, b: &Image<Vec3>) -> Figures {
     let (mut blocks, mut within) = (0usize, 0usize);
     for by in 0..h / 8 {
         for bx in 0..w / 8 {
-            let (mut st, mut sr) = (0.0, 0.0);
+            let (mut st, mut sr, mut sa, mut sb) = (0.0, 0.0, 0.0, 0.0);
             for y in by * 8..by * 8 + 8 {
                 for x in bx * 8..bx * 8 + 8 {
                     st += t[y * w + x];
                     sr += r[y * w + x];
+                    sa += a_l[y * w + x];
+                    sb += b_l[y * w + x];
                 }
             }
             blocks += 1;
             if sr > 0.0 && (st / sr - 1.0).abs() <= 0.05 {
                 within += 1;
+            } else {
+                // How far the reference's own halves disagree there: a block whose halves
+                // differ by several per cent is beyond what this reference can judge.
+                println!(
+                    "   block ({bx}, {by}): bake / reference {:.3}, half A / half B {:.3}, \
+                     reference mean {:.4}",
+                    st / sr,
+                    sa / sb,
+                    sr / 64.0
+                );
             }
         }
     }
@@ -91,21 +103,22 @@ fn bake_field(accel: &SceneAccel<'_>, quality: &Quality, t: f32) -> AmbientField
 
 /// Renders the bake's view of `camera` at the field's time (the multi-stage renderer over
 /// the bake's ambient field, as for a range image) and a two-half path-traced reference.
-/// The bake's frame gets 1024 samples per pixel so that what is measured is its lighting,
-/// not its pixel noise (the corrected error subtracts only the reference's noise). Images go
-/// to `target/tmp/bake_accuracy/`.
+/// The reference gets `reference_spp` samples per pixel in all, the bake's frame `bake_spp`
+/// (1024 or more, so that what is measured is its lighting, not its pixel noise: the
+/// corrected error subtracts only the reference's noise). Images go to
+/// `target/tmp/bake_accuracy/`.
 fn base_view_frame(
     name: &str,
     accel: &SceneAccel<'_>,
     field: &AmbientField,
     camera: &PinholeCamera,
-    reference_spp: u32,
+    (reference_spp, bake_spp): (u32, u32),
 ) -> Figures {
     let placed = accel.at_time(field.time());
     let start = std::time::Instant::now();
     let ms = MultiStageRenderer::new(
         MultiStageSettings {
-            samples_per_pixel: 1024,
+            samples_per_pixel: bake_spp,
             shadow_samples: 2,
             glossy_samples: 2,
             max_specular_depth: 4,
@@ -282,7 +295,13 @@ fn base_views_agree_with_the_path_tracer() {
     let views = VIEWS;
     let mut failures = Vec::new();
     for (name, p, yaw, pitch) in views {
-        let f = base_view_frame(name, &accel, &field, &camera(p, yaw, pitch, w, h), 4096);
+        let f = base_view_frame(
+            name,
+            &accel,
+            &field,
+            &camera(p, yaw, pitch, w, h),
+            (4096, 1024),
+        );
         println!("{name}: {f}");
         if (f.mean_ratio - 1.0).abs() > 0.03 || f.blocks_within < 0.9 || f.corrected_lrms > 0.1 {
             failures.push((name, f));
@@ -454,7 +473,13 @@ fn tour_base_views() {
             field.bounces(),
             start.elapsed().as_secs_f64()
         );
-        let f = base_view_frame(name, &accel, &field, &camera(p, yaw, pitch, w, h), 1024);
+        let f = base_view_frame(
+            name,
+            &accel,
+            &field,
+            &camera(p, yaw, pitch, w, h),
+            (1024, 1024),
+        );
         println!("{name}: {f}");
     }
 }
@@ -473,6 +498,9 @@ fn tour_atrium_under_its_daylight() {
     let field = bake_field(&accel, &Quality::draft(), 10.5);
     let name = "atrium north under daylight, t = 10.5";
     let cam = camera(Vec3::new(0.0, 1.6, 2.5), 0.0, 0.0, 64, 40);
-    let f = base_view_frame(name, &accel, &field, &cam, 2048);
+    // 8 × 8 blocks of 64 pixels, judged to 5 %: at 2 × 1024 reference samples and 1024 for
+    // the bake, the two frames' own noise (the halves disagreed by up to 2.6 % on a block)
+    // put 85 % of the blocks within; at these counts 93 %, the same three blocks outside.
+    let f = base_view_frame(name, &accel, &field, &cam, (8192, 4096));
     println!("{name}: {f}");
 }

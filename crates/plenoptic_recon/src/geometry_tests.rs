@@ -13,18 +13,25 @@ use crate::settings::CubeFilter;
 use crate::shading::Channel;
 use crate::{Camera, Reconstructor};
 
-/// One pass that looks up two channels gives each what a pass of its own gives: the same
-/// lookups, weights and fallbacks, nearest and bilinear.
-#[test]
-fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
+/// A small pack of `scene` with textured materials (two views, three keys, 32-px cubes),
+/// opened; the directory holds it.
+fn textured_pack(scene: &plenoptic_scene::Scene) -> (tempfile::TempDir, Reconstructor) {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("pair.pack");
+    let path = dir.path().join("textured.pack");
     let spec = PackSpec {
         materials: Materials::Textured,
         ..PackSpec::segment(2, vec![0.0, 1.0, 2.0], 32)
     };
-    write_pack(&room(true), &spec, &path);
+    write_pack(scene, &spec, &path);
     let rec = Reconstructor::open(&path).unwrap();
+    (dir, rec)
+}
+
+/// One pass that looks up two channels gives each what a pass of its own gives: the same
+/// lookups, weights and fallbacks, nearest and bilinear.
+#[test]
+fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
+    let (_dir, rec) = textured_pack(&room(true));
     let camera = Camera::look_at(
         Vec3::new(0.3, 1.2, 0.8),
         Vec3::new(-0.2, 0.7, -2.0),
@@ -80,14 +87,7 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
 /// skips when every object has a material).
 #[test]
 fn a_pass_shows_the_environment_of_the_channel_asked_for() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sky.pack");
-    let spec = PackSpec {
-        materials: Materials::Textured,
-        ..PackSpec::segment(2, vec![0.0, 1.0, 2.0], 32)
-    };
-    write_pack(&open_room(), &spec, &path);
-    let rec = Reconstructor::open(&path).unwrap();
+    let (_dir, rec) = textured_pack(&open_room());
     // Looking up through the skylight.
     let camera = Camera::look_at(
         Vec3::new(0.0, 1.2, 0.5),
