@@ -9,11 +9,11 @@
 //! different random sequences) and use their mean M = (A + B)/2 as the reference. Per pixel,
 //! with luminances a, b, m and true luminance s: if each half has variance σ²_half, then
 //!
-//! - Var[m] = σ²_half / 2 (the mean of two independent estimates), and
-//! - E[(a − b)²] = Var[a] + Var[b] = 2 σ²_half,
+//! - Var(m) = σ²_half / 2 (the mean of two independent estimates), and
+//! - E((a − b)²) = Var(a) + Var(b) = 2 σ²_half,
 //!
-//! so (a − b)²/4 is an unbiased estimate of Var[m]. For a test image x independent of the
-//! reference's noise, E[(x − m)²] = (x − s)² + Var[m]: the squared error against a noisy
+//! so (a − b)²/4 is an unbiased estimate of Var(m). For a test image x independent of the
+//! reference's noise, E((x − m)²) = (x − s)² + Var(m): the squared error against a noisy
 //! reference overstates the true squared error by the reference's variance. The corrected
 //! mean squared error is therefore
 //!
