@@ -17,13 +17,16 @@
 //!
 //! Two geometry passes run: radiance for objects without a material (and for the environment
 //! where nothing is), and one for the others that looks up the lighting and the non-diffuse
-//! radiance together (the same lookups, weights and fallbacks for both channels; two passes
-//! before, one per channel), each skipping the objects the other shades. A separate raster pass gives each pixel its triangle, from
-//! which the UV is interpolated (barycentric coordinates of the pixel's point on the placed
-//! triangle) and the footprint computed (the square root of the surface area the pixel
-//! covers, `distance · pixel angle · cos^1.5 α / √|cos θ|` for a pixel whose ray is at α
-//! to the axis and meets the surface at θ, times the triangle's UV-per-metre scale: the
-//! `√|det ∂uv/∂(x, y)|` a GPU's derivatives give).
+//! radiance together (the same lookups, weights and fallbacks for both channels), each
+//! skipping the objects the other shades. Where every object has a material the second pass
+//! also shows the environment (from the radiance cubes) and the first does not run. The
+//! surface seen through each pixel ([`crate::surface`]) comes from a raster pass that gives
+//! each pixel its triangle, from which the UV is interpolated (barycentric coordinates of the
+//! pixel's point on the placed triangle) and the footprint computed (the square root of the
+//! surface area the pixel covers, `distance · pixel angle · cos^1.5 α / √|cos θ|` for a pixel
+//! whose ray is at α to the axis and meets the surface at θ, times the triangle's UV-per-metre
+//! scale: the `√|det ∂uv/∂(x, y)|` a GPU's derivatives give). Each pixel is shaded as soon as
+//! its surface is known; those whose reflection is marched wait for the reflections' set-up.
 //!
 //! Mirrors and glossy metals reflect for the actual camera ([`crate::specular`]): their
 //! non-diffuse radiance is replaced by their emission at the pixel's UV plus the reflected
