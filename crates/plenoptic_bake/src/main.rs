@@ -227,7 +227,13 @@ fn run(command: Command) -> Result<()> {
                 output,
                 volume_complex,
             };
-            let report = plenoptic_bake::bake_recipe(&recipe, &options)?;
+            // What the import could not take over (an unsupported feature, a value out of
+            // range), before the bake's minutes start: the author can stop and fix it.
+            let (recipe, scene) = plenoptic_bake::input::load_recipe(&recipe)?;
+            for w in &scene.warnings {
+                eprintln!("plenoptic: warning: {w}");
+            }
+            let report = plenoptic_bake::bake(&recipe, &scene, &options)?;
             match (&report.output, shard) {
                 (Some(out), _) => out!(
                     "wrote {} ({} items rendered, {} resumed)",

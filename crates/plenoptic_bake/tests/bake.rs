@@ -6,8 +6,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::*;
+use glam::Vec3;
 use plenoptic_bake::{BakeError, BakeOptions, bake_recipe};
 use plenoptic_pack::{ChunkKind, MAGIC, PackReader};
+use plenoptic_scene::builder::{MaterialDesc, NodeDesc};
 
 const BIN: &str = env!("CARGO_BIN_EXE_plenoptic");
 
@@ -253,6 +255,29 @@ fn recipe_and_scene_errors_leave_no_pack() {
     let err = bake_recipe(&recipe, &BakeOptions::default()).unwrap_err();
     assert!(matches!(err, BakeError::Recipe(_)), "{err}");
     no_pack_in(dir.path());
+}
+
+/// What the glTF import could not take over is printed before the bake, and the bake still
+/// runs (an alpha cutoff above 1 is read as 1 with a warning).
+#[test]
+fn import_warnings_are_printed_by_the_bake_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = static_room();
+    let fence = scene.add_material(
+        MaterialDesc::diffuse(Vec3::splat(0.5))
+            .alpha_mode(plenoptic_scene::AlphaMode::Mask { cutoff: 1.5 }),
+    );
+    let panel = scene.add_box("panel", Vec3::new(0.4, 0.4, 0.05), fence);
+    scene.add_node(NodeDesc::new("fence").mesh(panel));
+    let recipe = write_recipe(dir.path(), &scene, STATIC_SEGMENT, "");
+    let out = plenoptic(&["bake", recipe.to_str().unwrap(), "-q"], None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("plenoptic: warning:") && err.contains("alphaCutoff 1.5"),
+        "{err}"
+    );
+    assert!(pack_path(dir.path()).exists());
 }
 
 #[test]
