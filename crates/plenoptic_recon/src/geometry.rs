@@ -171,7 +171,7 @@ pub(crate) fn render_pair(
         .map(|&o| proxy.transform(o, t).inverse())
         .collect();
     let mut keys: Vec<ViewKey> = Vec::new();
-    let mut volumes: Vec<(Vec3, f32, VolumeIndex, Option<VolumeIndex>)> = Vec::new();
+    let mut volumes: Vec<(Vec3, f32, VolumeIndex)> = Vec::new();
     for &(v, w) in &views {
         let bv = &manifest.base_views[v];
         let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
@@ -233,8 +233,7 @@ pub(crate) fn render_pair(
             });
         }
         if let Some(index) = VolumeIndex::build(rec, v, t, channel, &mut report.missing) {
-            let other = second.map(|c| index.with_channel(c));
-            volumes.push((bv.position, w, index, other));
+            volumes.push((bv.position, w, index));
         }
     }
     if keys.is_empty() {
@@ -452,17 +451,12 @@ pub(crate) fn render_pair(
             .filter_map(|&j| {
                 let (p, o) = (point(j), frame.object[j]);
                 let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-                for (base, w, index, other) in &volumes {
-                    if let Some((c, wt)) = index.lookup(p - *base, o, tol * 3.0) {
+                for (base, w, index) in &volumes {
+                    // Both colours of the same samples, with the same weights.
+                    if let Some((c, c2, wt)) = index.lookup_pair(p - *base, o, tol * 3.0, second) {
                         vs += c * wt * *w;
+                        vs2 += c2 * wt * *w;
                         vw += wt * *w;
-                        // The same samples with the same weights.
-                        if let Some((c2, _)) = other
-                            .as_ref()
-                            .and_then(|i| i.lookup(p - *base, o, tol * 3.0))
-                        {
-                            vs2 += c2 * wt * *w;
-                        }
                     }
                 }
                 (vw > 0.0).then(|| (j, vs / vw, vs2 / vw))

@@ -197,16 +197,31 @@ pub(crate) fn render(
         with_footprint,
         glossy,
     );
-    // Pixel `j` of surface `px` under `light`, with the incoming radiance of its marched
-    // reflection.
-    let shade = |j: usize, px: &SurfacePixel, light: Vec3, reflected: Option<Option<Vec3>>| {
+    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    // Pixel `j` of surface `px` under `light`; its reflection marched through `reflections`
+    // where it is marched.
+    let shade = |j: usize, px: &SurfacePixel, light: Vec3, reflections: Option<&Reflections>| {
         // The BSDF only where the sun or a reflection needs it.
         let front = px.view.dot(px.ng) < 0.0;
         let bsdf = (sun.is_some() || px.marched)
             .then(|| Bsdf::new(px.material, px.ng, px.ns, -px.view, front));
-        let specular = reflected.zip(bsdf.as_ref()).and_then(|(incoming, bsdf)| {
+        let marching = reflections.filter(|_| px.marched).zip(bsdf.as_ref());
+        let specular = marching.and_then(|(r, bsdf)| {
             let n = bsdf.normal();
             let cos_o = -px.view.dot(n);
+            let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
+            let alpha = px.material.roughness * px.material.roughness;
+            let incoming = if px.material.roughness < DELTA_ROUGHNESS {
+                r.incoming(px.position, dir, 0.0)
+            } else {
+                // A per-pixel turn of the lobe's directions (golden-ratio sequence).
+                let turn = (j as f32 * 0.618_034).fract();
+                r.lobe(px.position, n, -px.view, alpha, turn)
+            };
+            marched_pixels.fetch_add(1, Ordering::Relaxed);
+            if incoming.is_none() {
+                unanswered.fetch_add(1, Ordering::Relaxed);
+            }
             let eta = if front {
                 px.material.ior
             } else {
@@ -257,31 +272,11 @@ pub(crate) fn render(
     let start = std::time::Instant::now();
     let reflections = (!marched.is_empty())
         .then(|| Reflections::new(rec, camera.position, t, &mut report.missing));
-    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let reflected: Vec<(usize, Vec3)> = marched
         .par_iter()
         .map(|(j, px)| {
-            let incoming = reflections.as_ref().map(|r| {
-                let front = px.view.dot(px.ng) < 0.0;
-                let n = Bsdf::new(px.material, px.ng, px.ns, -px.view, front).normal();
-                let cos_o = -px.view.dot(n);
-                let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
-                let alpha = px.material.roughness * px.material.roughness;
-                let incoming = if px.material.roughness < DELTA_ROUGHNESS {
-                    r.incoming(px.position, dir, 0.0)
-                } else {
-                    // A per-pixel turn of the lobe's directions (golden-ratio sequence).
-                    let turn = (*j as f32 * 0.618_034).fract();
-                    r.lobe(px.position, n, -px.view, alpha, turn)
-                };
-                marched_pixels.fetch_add(1, Ordering::Relaxed);
-                if incoming.is_none() {
-                    unanswered.fetch_add(1, Ordering::Relaxed);
-                }
-                incoming
-            });
             let light = lighting.as_ref().map_or(frame.radiance[*j], |l| l[*j]);
-            (*j, shade(*j, px, light, incoming))
+            (*j, shade(*j, px, light, reflections.as_ref()))
         })
         .collect();
     for (j, c) in reflected {

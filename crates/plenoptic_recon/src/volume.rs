@@ -156,14 +156,6 @@ impl VolumeIndex {
         })
     }
 
-    /// The same samples, looked up for another of their colours.
-    pub(crate) fn with_channel(&self, channel: Channel) -> Self {
-        VolumeIndex {
-            channel,
-            ..self.clone()
-        }
-    }
-
     /// Number of samples in the window.
     pub fn len(&self) -> usize {
         self.blocks
@@ -184,6 +176,19 @@ impl VolumeIndex {
     /// within `tol` (relative): `(radiance, total weight)`. Samples weigh by the tent filter
     /// `1 − |t_s − t|/tε` times their cone's falloff.
     pub fn lookup(&self, d: Vec3, object: u32, tol: f32) -> Option<(Vec3, f32)> {
+        self.lookup_pair(d, object, tol, None)
+            .map(|(c, _, w)| (c, w))
+    }
+
+    /// [`VolumeIndex::lookup`], with the samples' `second` colour filtered with the same
+    /// weights in the same walk (black without one): `(colour, second colour, total weight)`.
+    pub(crate) fn lookup_pair(
+        &self,
+        d: Vec3,
+        object: u32,
+        tol: f32,
+        second: Option<Channel>,
+    ) -> Option<(Vec3, Vec3, f32)> {
         let dist = d.length();
         if dist.is_nan() || dist <= 1e-6 {
             return None;
@@ -191,7 +196,7 @@ impl VolumeIndex {
         let dir = d / dist;
         let b = crate::sample::texel(BIN_FACE, dir);
         let bin_angle = 2.0 / BIN_FACE as f32;
-        let (mut sum, mut ws) = (Vec3::ZERO, 0.0);
+        let (mut sum, mut sum2, mut ws) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         for bins in &self.blocks {
             let range = bins.offsets[b] as usize..bins.offsets[b + 1] as usize;
             for &i in &bins.order[range] {
@@ -207,11 +212,14 @@ impl VolumeIndex {
                 if angle < r {
                     let w = tw * (1.0 - angle / r).max(1e-3);
                     sum += self.channel.of_sample(s) * w;
+                    if let Some(c) = second {
+                        sum2 += c.of_sample(s) * w;
+                    }
                     ws += w;
                 }
             }
         }
-        (ws > 0.0).then(|| (sum / ws, ws))
+        (ws > 0.0).then(|| (sum / ws, sum2 / ws, ws))
     }
 }
 
