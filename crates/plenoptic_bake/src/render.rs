@@ -27,7 +27,7 @@ use plenoptic_trace::{
 };
 use rayon::prelude::*;
 
-use crate::denoise::{DenoiseSettings, LightingCube};
+use crate::denoise::{DenoiseSettings, LightingCube, ambient_passes};
 use crate::error::Result;
 use crate::plan::{Plan, ambient::field_at};
 
@@ -46,6 +46,19 @@ pub fn seed_of(parts: &[u64]) -> u64 {
         h ^= h >> 31;
     }
     h
+}
+
+/// Final-gather rays per sample at the first hit (`MultiStageSettings::final_gather`) for
+/// range images of face size `n`: the ambient field's interpolation smooths away the
+/// darkening of light into corners and under objects, which one bounce traced from the texel
+/// resolves (docs/bake-accuracy.md, cause 6). One ray per sample at 256-px faces and above,
+/// four times as many per halving below, so that a texel's solid angle gets the same number
+/// of rays whatever the face size (16 at 64 px: the bake costs the same as at 256 px).
+/// Range images smooth the gathered ambient light afterwards
+/// ([`LightingCube::smooth_ambient`]).
+pub fn final_gather_rays(n: u32) -> u32 {
+    let halvings = 8u32.saturating_sub(n.max(1).ilog2()).min(4);
+    1 << (2 * halvings)
 }
 
 /// Renders range images and volume samples for a plan.
@@ -85,6 +98,7 @@ impl<'a> BakeRenderer<'a> {
             glossy_samples: 2,
             max_specular_depth: self.plan.quality.max_specular_depth,
             seed,
+            final_gather: final_gather_rays(self.plan.quality.range_image_size),
         }
     }
 
@@ -173,7 +187,9 @@ fn bake_the_sun(s: &mut RadianceSample) {
 /// The range image of face size `n` seen from `position` with `renderer`, its diffuse
 /// lighting denoised with `denoise` when given ([`crate::denoise`]); the sun's direct light
 /// left out of the lighting and non-diffuse radiance for the runtime when `runtime_sun`.
-/// Without denoising the result is exactly [`to_range_image`] of the rendered faces.
+/// The ambient light is smoothed when the renderer final-gathers
+/// ([`LightingCube::smooth_ambient`]). Without either the result is exactly
+/// [`to_range_image`] of the rendered faces.
 pub fn render_range_image(
     renderer: &MultiStageRenderer<'_>,
     placed: &PlacedScene<'_>,
@@ -189,20 +205,23 @@ pub fn render_range_image(
             face.pixels.iter_mut().for_each(bake_the_sun);
         }
     }
-    Ok(match denoise {
-        None => to_range_image(n, &faces),
-        Some(settings) => {
-            let mut lighting = LightingCube::from_faces(n, &faces);
-            // One sample per pixel reports no variance: estimate it from the image.
-            let settings = DenoiseSettings {
-                sample_variance: settings.sample_variance
-                    && renderer.settings.samples_per_pixel >= 2,
-                ..*settings
-            };
-            crate::denoise::denoise(&mut lighting, &settings);
-            lighting.to_range_image()
-        }
-    })
+    let smooth = renderer.settings.final_gather > 0;
+    if denoise.is_none() && !smooth {
+        return Ok(to_range_image(n, &faces));
+    }
+    let mut lighting = LightingCube::from_faces(n, &faces);
+    if smooth {
+        lighting.smooth_ambient(ambient_passes(n));
+    }
+    if let Some(settings) = denoise {
+        // One sample per pixel reports no variance: estimate it from the image.
+        let settings = DenoiseSettings {
+            sample_variance: settings.sample_variance && renderer.settings.samples_per_pixel >= 2,
+            ..*settings
+        };
+        crate::denoise::denoise(&mut lighting, &settings);
+    }
+    Ok(lighting.to_range_image())
 }
 
 /// Converts six rendered faces (KTX2 layer order, `n`² pixels each) into a range image: the

@@ -10,6 +10,7 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 use plenoptic_bake::denoise::{DenoiseSettings, LightingCube, denoise};
 use plenoptic_bake::plan::ambient;
+use plenoptic_bake::render::final_gather_rays;
 use plenoptic_eval::metrics::corrected_relative_lrms;
 use plenoptic_scene::Scene;
 use plenoptic_scene::recipe::Quality;
@@ -123,6 +124,10 @@ fn base_view_frame(
             glossy_samples: 2,
             max_specular_depth: 4,
             seed: 3,
+            final_gather: std::env::var("FG")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0),
         },
         field,
     )
@@ -367,6 +372,7 @@ fn denoise_sweep(which: &[usize], variants: &[(&str, DenoiseSettings)]) {
                 glossy_samples: 2,
                 max_specular_depth: quality.max_specular_depth,
                 seed: 5,
+                final_gather: 0,
             },
             &field,
         )
@@ -503,4 +509,85 @@ fn tour_atrium_under_its_daylight() {
     // put 85 % of the blocks within; at these counts 93 %, the same three blocks outside.
     let f = base_view_frame(name, &accel, &field, &cam, (8192, 4096));
     println!("{name}: {f}");
+}
+
+/// The tour's range images as the draft bake stores them (256-px faces, 4 samples per
+/// texel), seen through the cameras of [`tour_base_views`]: the field read directly at
+/// each texel (the bake before cause 6 of docs/bake-accuracy.md) against the final gather
+/// of the bake, without and with its ambient smoothing (`LightingCube::smooth_ambient`,
+/// 2–4 passes). Prints the figures for the issue note.
+#[test]
+#[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture tour_range_images"]
+fn tour_range_images_with_and_without_the_final_gather() {
+    let scene = tour_scene();
+    let accel = SceneAccel::new(&scene).unwrap();
+    let quality = Quality::draft();
+    let views = [
+        ("room B, t = 3.5", Vec3::new(5.5, 1.6, 2.5), 3.5, 1.2, -0.4),
+        (
+            "room A, t = 10.5",
+            Vec3::new(-5.5, 1.6, -2.5),
+            10.5,
+            -2.4,
+            -0.3,
+        ),
+        (
+            "atrium south, t = 7",
+            Vec3::new(0.0, 1.6, 2.5),
+            7.0,
+            3.0,
+            -0.45,
+        ),
+    ];
+    let n = quality.range_image_size;
+    for (name, p, t, yaw, pitch) in views {
+        let field = bake_field(&accel, &quality, t);
+        let placed = accel.at_time(t);
+        let cam = camera(p, yaw, pitch, 80, 48);
+        let half = |seed| {
+            PathTracer::new(PathTracerSettings {
+                samples_per_pixel: 512,
+                max_depth: 32,
+                rr_start_depth: 5,
+                seed,
+                environment_sampling: true,
+            })
+            .render(&placed, &cam)
+            .radiance()
+        };
+        let (a, b) = (half(11), half(12));
+        for final_gather in [0, final_gather_rays(n)] {
+            let renderer = MultiStageRenderer::new(
+                MultiStageSettings {
+                    samples_per_pixel: quality.samples_per_pixel,
+                    shadow_samples: 2,
+                    glossy_samples: 2,
+                    max_specular_depth: quality.max_specular_depth,
+                    seed: 5,
+                    final_gather,
+                },
+                &field,
+            );
+            let start = std::time::Instant::now();
+            let cube = plenoptic_trace::CubeCamera::new(p, n).unwrap();
+            let faces = renderer.render_cube(&placed, &cube);
+            let secs = start.elapsed().as_secs_f64();
+            let passes: &[u32] = if final_gather == 0 {
+                &[0]
+            } else {
+                &[0, 2, 3, 4]
+            };
+            for &k in passes {
+                let mut lighting = LightingCube::from_faces(n, &faces);
+                if k > 0 {
+                    lighting.smooth_ambient(k);
+                }
+                let f = measure(&view_of_cube(&lighting.to_range_image(), &cam, 6), &a, &b);
+                println!(
+                    "{name}: final gather {final_gather}, smoothing {k} passes: {f} \
+                     (faces rendered in {secs:.1} s)"
+                );
+            }
+        }
+    }
 }

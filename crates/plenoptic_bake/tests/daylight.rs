@@ -176,6 +176,7 @@ fn a_bim_style_building_is_lit_inside_by_sun_and_sky() {
                 glossy_samples: 2,
                 max_specular_depth: 4,
                 seed: 3,
+                final_gather: 0,
             },
             &field,
         )

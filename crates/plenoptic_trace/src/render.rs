@@ -42,6 +42,10 @@ pub struct RadianceSample {
     pub sun: Vec3,
     /// The Lambertian lobe's share of `sun` (part of `diffuse`).
     pub sun_diffuse: Vec3,
+    /// The ambient share of `diffuse`: the first hit's indirect diffuse light (the ambient
+    /// field's, or its final gather's), without direct light. It varies slowly over a
+    /// surface, so the bake may smooth it where it would not smooth shadow edges.
+    pub ambient: Vec3,
     /// The part of `radiance` that the first hit emits towards the ray: what pack 4 leaves
     /// out of the non-diffuse radiance for the runtime to take from the material at screen
     /// resolution. Zero for a miss and from the path tracer.
@@ -61,6 +65,7 @@ impl RadianceSample {
         lighting_variance: 0.0,
         sun: Vec3::ZERO,
         sun_diffuse: Vec3::ZERO,
+        ambient: Vec3::ZERO,
         emission: Vec3::ZERO,
     };
 
@@ -80,6 +85,7 @@ impl RadianceSample {
             lighting_variance: 0.0,
             sun: Vec3::ZERO,
             sun_diffuse: Vec3::ZERO,
+            ambient: Vec3::ZERO,
             emission: Vec3::ZERO,
         }
     }
@@ -130,6 +136,7 @@ where
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
         let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
         let (mut sun, mut sun_diffuse, mut emission) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        let mut ambient = Vec3::ZERO;
         let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
@@ -159,6 +166,7 @@ where
             albedo += r.albedo;
             sun += r.sun;
             sun_diffuse += r.sun_diffuse;
+            ambient += r.ambient;
             emission += r.emission;
             let a = luminance(r.albedo);
             // The variance of the lighting the bake stores and filters: without the sun's
@@ -181,6 +189,7 @@ where
             albedo: albedo / n,
             sun: sun / n,
             sun_diffuse: sun_diffuse / n,
+            ambient: ambient / n,
             emission: emission / n,
             lighting_variance: if kept > 1 {
                 // Unbiased sample variance, over n for the variance of the mean.

@@ -43,6 +43,7 @@ fn ms(spp: u32) -> MultiStageSettings {
         glossy_samples: 1,
         max_specular_depth: 4,
         seed: 9,
+        final_gather: 0,
     }
 }
 

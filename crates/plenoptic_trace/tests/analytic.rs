@@ -30,6 +30,7 @@ fn ms(spp: u32) -> MultiStageSettings {
         glossy_samples: 1,
         max_specular_depth: 8,
         seed: 11,
+        final_gather: 0,
     }
 }
 
@@ -130,6 +131,14 @@ fn white_furnace_multi_stage() {
     assert!(field.bounces() > passes && field.bounces() < 64);
     let img = MultiStageRenderer::new(ms(4), &field).render(&placed, &furnace_camera());
     check("furnace MS converged", &img, exact, 0.02);
+    // A final gather reads the converged field one bounce away: the same E/(1−a), with the
+    // gather's own noise in σ.
+    let gathered = MultiStageSettings {
+        final_gather: 1,
+        ..ms(16)
+    };
+    let img = MultiStageRenderer::new(gathered, &field).render(&placed, &furnace_camera());
+    check("furnace MS final gather", &img, exact, 0.02);
 }
 
 /// A diffuse plane of albedo ρ under a point light of intensity I at height h: radiance

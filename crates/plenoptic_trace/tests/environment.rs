@@ -44,6 +44,7 @@ fn ms(spp: u32, shadow: u32) -> MultiStageSettings {
         glossy_samples: 1,
         max_specular_depth: 4,
         seed: 11,
+        final_gather: 0,
     }
 }
 

@@ -46,6 +46,7 @@ fn multi_stage_matches_reference_in_furnished_room() {
             glossy_samples: 2,
             max_specular_depth: 3,
             seed: 3,
+            final_gather: 0,
         },
         &field,
     )

@@ -49,6 +49,9 @@ pub struct MultiStageSettings {
     pub max_specular_depth: u32,
     /// Seed of the random streams.
     pub seed: u64,
+    /// Final-gather rays at the first hit (0: the first hit reads the ambient field
+    /// directly). See [`AmbientField::irradiance_gathered`].
+    pub final_gather: u32,
 }
 
 impl Default for MultiStageSettings {
@@ -59,6 +62,7 @@ impl Default for MultiStageSettings {
             glossy_samples: 2,
             max_specular_depth: 4,
             seed: 0,
+            final_gather: 0,
         }
     }
 }
@@ -159,9 +163,18 @@ impl<'f> MultiStageRenderer<'f> {
             let albedo = bsdf
                 .sample(u_lobe, s.next_2d(), Lobes::Diffuse)
                 .map_or(Vec3::ZERO, |b| b.weight);
-            let ambient = albedo * self.field.irradiance_seen(placed, &hit, wo) / PI;
+            let e = if depth == 0 && self.settings.final_gather > 0 {
+                self.field
+                    .irradiance_gathered(placed, &hit, wo, self.settings.final_gather, s)
+            } else {
+                self.field.irradiance_seen(placed, &hit, wo)
+            };
+            let ambient = albedo * e / PI;
             l += ambient;
             diffuse += ambient;
+            if let Some(out) = first.as_deref_mut() {
+                out.ambient = ambient;
+            }
         }
         if let Some(out) = first {
             out.diffuse = diffuse;

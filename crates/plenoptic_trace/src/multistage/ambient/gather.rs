@@ -81,6 +81,141 @@ pub(super) struct Gathered {
     pub(super) guarded: Vec<bool>,
 }
 
+/// Where a gather point sits and how its rays are traced.
+pub(super) struct Origin<'a> {
+    /// World position of the point.
+    pub(super) p: Vec3,
+    /// Unit world normal of the side the rays leave from.
+    pub(super) n: Vec3,
+    /// Rays traced from the point (their estimates are scaled by it).
+    pub(super) rays: u32,
+    /// Delta bounces a ray follows.
+    pub(super) max_delta_depth: u32,
+    /// Points whose lookups test visibility (`super::visibility`).
+    pub(super) guarded: &'a [bool],
+}
+
+/// Where one gather ray ended.
+enum RayEnd {
+    /// The ray left the scene or was absorbed.
+    Open,
+    /// It met the back face of a single-sided opaque surface leaving the point: the point
+    /// may be inside a solid.
+    BackFace,
+    /// It ended on a non-delta surface whose field points `weights` it sees, times the
+    /// coefficient (throughput × one-sample non-delta albedo / rays).
+    Field(Vec3, [(usize, f32); 3]),
+}
+
+/// What one gather ray found.
+struct Traced {
+    /// The environment sampled by its own distribution from the point.
+    environment: Vec3,
+    /// Light found along the cosine ray (the environment where it leaves the scene,
+    /// emission behind a delta bounce, direct light at its end), in units of the cosine
+    /// rays' sum, to be scaled by π / rays.
+    light: Vec3,
+    end: RayEnd,
+}
+
+/// Traces one cosine-distributed gather ray from `o` (module doc).
+fn trace_ray(
+    placed: &PlacedScene<'_>,
+    layout: &FieldLayout,
+    o: &Origin<'_>,
+    s: &mut Sampler,
+) -> Traced {
+    let (p, n) = (o.p, o.n);
+    let mut out = Traced {
+        environment: Vec3::ZERO,
+        light: Vec3::ZERO,
+        end: RayEnd::Open,
+    };
+    let frame = Frame::from_normal(n);
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    let scene = placed.scene();
+    let env = placed.lights().environment();
+    let sample_env = env.can_sample();
+    let d = frame.to_world(cosine_hemisphere(s.next_2d()));
+    if sample_env {
+        // The environment seen straight from the point, by its own distribution, weighted
+        // against the cosine rays (power heuristic); in units of the cosine rays' sum.
+        if let Some(e) = env.sample(s.next_2d()) {
+            let cos = e.wi.dot(n);
+            if cos > 0.0
+                && e.radiance != Vec3::ZERO
+                && !placed.occluded(&Ray::new(p + n * eps, e.wi))
+            {
+                let w = power_heuristic(e.pdf, cos / std::f32::consts::PI);
+                out.environment = e.radiance * (cos * w / (e.pdf * std::f32::consts::PI));
+            }
+        }
+    }
+    let mut ray = Ray::new(p + n * eps, d);
+    let mut throughput = Vec3::ONE;
+    for depth in 0..=o.max_delta_depth {
+        let Some(hit) = placed.intersect(&ray) else {
+            // The environment: the field holds its light (seen straight or through delta
+            // bounces), which the renderer does not sample for the diffuse lobe. Straight
+            // from the point it competes with the sample above.
+            let w = if depth == 0 && sample_env {
+                power_heuristic(
+                    ray.direction.dot(n) / std::f32::consts::PI,
+                    env.pdf(ray.direction),
+                )
+            } else {
+                1.0
+            };
+            out.light += throughput * env.radiance(ray.direction) * w;
+            return out;
+        };
+        let props = SurfaceProps::at(scene, &hit);
+        // Transmissive surfaces are exempt: light reaches a pane's or a glass case's
+        // inner side through the glass, and the path tracer shades it there.
+        if !hit.front_face && !props.double_sided && props.transmission <= 0.0 {
+            // The inside of a closed solid: no light there. From the point itself it
+            // means the point is embedded in that solid.
+            if depth == 0 {
+                out.end = RayEnd::BackFace;
+            }
+            return out;
+        }
+        if depth > 0 {
+            out.light += throughput * props.emission(&hit);
+        }
+        let bsdf = Bsdf::new(&props, &hit, -ray.direction);
+        if !bsdf.has(Lobes::All) {
+            return out;
+        }
+        if !bsdf.is_delta(Lobes::All) {
+            out.light +=
+                throughput * estimate_direct(placed, &hit, &bsdf, Lobes::All, LIGHTS_ONLY, 1, s);
+        }
+        // One sample of the whole BSDF: a delta lobe carries the ray on; a non-delta lobe
+        // ends it, its weight being a one-sample estimate of the non-delta albedo that
+        // turns the hit's irradiance into radiance (as if it were diffuse).
+        let u_lobe = s.next_f32();
+        let Some(bs) = bsdf.sample(u_lobe, s.next_2d(), Lobes::All) else {
+            return out;
+        };
+        if bs.delta {
+            throughput *= bs.weight;
+            if throughput.max_element() <= 0.0 {
+                return out;
+            }
+            ray = Ray::new(hit.offset_origin(bs.wi), bs.wi);
+            continue;
+        }
+        // E_i = π · mean(L) under cosine sampling, L = albedo · E_hit / π.
+        let c = throughput * bs.weight / o.rays as f32;
+        if let Some(w) = visible_weights(placed, layout, o.guarded, &hit, -ray.direction) {
+            out.end = RayEnd::Field(c, w);
+        }
+        return out;
+    }
+    out
+}
+
 fn gather_point(
     placed: &PlacedScene<'_>,
     layout: &FieldLayout,
@@ -99,102 +234,32 @@ fn gather_point(
         return out;
     };
     let gp = layout.objects[object as usize].points[point];
-    let p = inst.to_world.transform_point3(gp.position);
-    let n = (inst.normal_matrix * gp.normal).normalize_or(Vec3::Y);
-    let frame = Frame::from_normal(n);
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
-    let scene = placed.scene();
-    let rays = settings.rays_per_point.max(1);
+    let o = Origin {
+        p: inst.to_world.transform_point3(gp.position),
+        n: (inst.normal_matrix * gp.normal).normalize_or(Vec3::Y),
+        rays: settings.rays_per_point.max(1),
+        max_delta_depth: settings.max_delta_depth,
+        guarded,
+    };
     let mut back_faces = 0u32;
-    let env = placed.lights().environment();
-    let sample_env = env.can_sample();
-    for _ in 0..rays {
-        let d = frame.to_world(cosine_hemisphere(s.next_2d()));
-        if sample_env {
-            // The environment seen straight from the point, by its own distribution, weighted
-            // against the cosine rays (power heuristic); in units of the cosine rays' sum,
-            // which is scaled by π/rays below.
-            if let Some(e) = env.sample(s.next_2d()) {
-                let cos = e.wi.dot(n);
-                if cos > 0.0
-                    && e.radiance != Vec3::ZERO
-                    && !placed.occluded(&Ray::new(p + n * eps, e.wi))
-                {
-                    let w = power_heuristic(e.pdf, cos / std::f32::consts::PI);
-                    out.direct += e.radiance * (cos * w / (e.pdf * std::f32::consts::PI));
-                }
-            }
-        }
-        let mut ray = Ray::new(p + n * eps, d);
-        let mut throughput = Vec3::ONE;
-        for depth in 0..=settings.max_delta_depth {
-            let Some(hit) = placed.intersect(&ray) else {
-                // The environment: the field holds its light (seen straight or through delta
-                // bounces), which the renderer does not sample for the diffuse lobe. Straight
-                // from the point it competes with the sample above.
-                let w = if depth == 0 && sample_env {
-                    power_heuristic(
-                        ray.direction.dot(n) / std::f32::consts::PI,
-                        env.pdf(ray.direction),
-                    )
-                } else {
-                    1.0
-                };
-                out.direct += throughput * env.radiance(ray.direction) * w;
-                break;
-            };
-            let props = SurfaceProps::at(scene, &hit);
-            // Transmissive surfaces are exempt: light reaches a pane's or a glass case's
-            // inner side through the glass, and the path tracer shades it there.
-            if !hit.front_face && !props.double_sided && props.transmission <= 0.0 {
-                // The inside of a closed solid: no light there. From the point itself it
-                // means the point is embedded in that solid.
-                if depth == 0 {
-                    back_faces += 1;
-                }
-                break;
-            }
-            if depth > 0 {
-                out.direct += throughput * props.emission(&hit);
-            }
-            let bsdf = Bsdf::new(&props, &hit, -ray.direction);
-            if !bsdf.has(Lobes::All) {
-                break;
-            }
-            if !bsdf.is_delta(Lobes::All) {
-                out.direct += throughput
-                    * estimate_direct(placed, &hit, &bsdf, Lobes::All, LIGHTS_ONLY, 1, s);
-            }
-            // One sample of the whole BSDF: a delta lobe carries the ray on; a non-delta lobe
-            // ends it, its weight being a one-sample estimate of the non-delta albedo that
-            // turns the hit's irradiance into radiance (as if it were diffuse).
-            let u_lobe = s.next_f32();
-            let Some(bs) = bsdf.sample(u_lobe, s.next_2d(), Lobes::All) else {
-                break;
-            };
-            if bs.delta {
-                throughput *= bs.weight;
-                if throughput.max_element() <= 0.0 {
-                    break;
-                }
-                ray = Ray::new(hit.offset_origin(bs.wi), bs.wi);
-                continue;
-            }
-            // E_i = π · mean(L) under cosine sampling, L = albedo · E_hit / π.
-            let c = throughput * bs.weight / rays as f32;
-            if let Some(w) = visible_weights(placed, layout, guarded, &hit, -ray.direction) {
+    for _ in 0..o.rays {
+        let t = trace_ray(placed, layout, &o, s);
+        out.direct += t.environment + t.light;
+        match t.end {
+            RayEnd::Open => {}
+            RayEnd::BackFace => back_faces += 1,
+            RayEnd::Field(c, w) => {
                 for (j, wt) in w {
                     if wt > 0.0 {
                         out.row.push((j as u32, c * wt));
                     }
                 }
             }
-            break;
         }
     }
     // E = ∫ L cos dω ≈ π · mean(L) under cosine-weighted sampling.
-    out.direct *= std::f32::consts::PI / rays as f32;
-    out.invalid = back_faces * INSIDE_FRACTION > rays;
+    out.direct *= std::f32::consts::PI / o.rays as f32;
+    out.invalid = back_faces * INSIDE_FRACTION > o.rays;
     if out.invalid {
         out.direct = Vec3::ZERO;
         out.row.clear();
@@ -210,6 +275,28 @@ fn gather_point(
     });
     out.row.shrink_to_fit();
     out
+}
+
+/// A final gather at `o` over the converged field `irradiance`: the module doc's
+/// E = D + K·E for one point that is not in the layout, each of its rays reading the field
+/// where it ends. Rays that meet a back face carry no light.
+pub(super) fn final_gather(
+    placed: &PlacedScene<'_>,
+    layout: &FieldLayout,
+    irradiance: &[Vec3],
+    o: &Origin<'_>,
+    s: &mut Sampler,
+) -> Vec3 {
+    let mut light = Vec3::ZERO;
+    let mut indirect = Vec3::ZERO;
+    for _ in 0..o.rays {
+        let t = trace_ray(placed, layout, o, s);
+        light += t.environment + t.light;
+        if let RayEnd::Field(c, w) = t.end {
+            indirect += c * w.iter().map(|&(j, wt)| irradiance[j] * wt).sum::<Vec3>();
+        }
+    }
+    light * (std::f32::consts::PI / o.rays as f32) + indirect
 }
 
 /// Fill rounds for invalid points: each round lists (point, the neighbours it averages), all
