@@ -124,10 +124,9 @@ fn base_view_frame(
             glossy_samples: 2,
             max_specular_depth: 4,
             seed: 3,
-            final_gather: std::env::var("FG")
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(0),
+            // The bake's rays per sample at 256-px faces: its texels are about the size of
+            // these pixels.
+            final_gather: final_gather_rays(256),
         },
         field,
     )

@@ -9,7 +9,13 @@
 //! + diffuse directional albedo × ambient-field irradiance / π, where the field holds the
 //!   environment's direct light too: a sky seen through a window is a large, smooth source,
 //!   gathered once per field point instead of sampled per pixel (which in a room lit through
-//!   a small window needs hundreds of shadow rays to converge)
+//!   a small window needs hundreds of shadow rays to converge). With
+//!   [`MultiStageSettings::final_gather`] the first hit's irradiance is a final gather over
+//!   the field ([`AmbientField::irradiance_gathered`]: one bounce traced from the hit, the
+//!   field read where its rays end) instead of the field interpolated at the hit, whose grid
+//!   is too coarse for the falloff of light into corners (thesis §5.3.4 augments its
+//!   ambient field with irradiance gradients for the same shortcoming of interpolation;
+//!   tracing one bounce resolves it where gradients only extrapolate)
 //! + specular reflection and refraction traced recursively up to `max_specular_depth`
 //!   (one ray for ideal lobes, `glossy_samples` GGX samples for rough ones at the first hit).
 //!
