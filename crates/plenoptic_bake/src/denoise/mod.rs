@@ -285,12 +285,13 @@ impl LightingCube {
 }
 
 /// À-trous passes of [`LightingCube::smooth_ambient`] in the bake for faces of `n` texels:
-/// 3 at 256 (a footprint of 14 texels' radius, about 5°), one fewer per halving and one more
-/// per doubling, so that the footprint covers about the same angle at every face size
-/// (1 to 5 passes).
+/// 3 at 256 (a footprint of 14 texels' radius, about 5°), one more per doubling (2 to 5
+/// passes), so that the footprint covers about the same angle at large faces; at 128 px and
+/// below 2 passes, where the bake traces more gather rays per sample
+/// (`crate::render::final_gather_rays`).
 pub fn ambient_passes(n: u32) -> u32 {
     let octaves = n.max(1).ilog2() as i32 - 8;
-    (3 + octaves).clamp(1, 5) as u32
+    (3 + octaves).clamp(2, 5) as u32
 }
 
 impl LightingCube {
