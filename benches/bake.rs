@@ -10,6 +10,9 @@
 //!
 //! `denoise`: the range-image denoiser (`plenoptic_bake::denoise`) on one 128-px and one
 //! 256-px cube of the scene with its guides, all cores; the cube's rendering is not timed.
+//! `smooth_ambient_*`: the smoothing of the final gather's ambient light that every bake
+//! runs (`LightingCube::smooth_ambient` at the bake's passes for the size), on the same
+//! cubes.
 //!
 //! `cargo bench --no-default-features --bench bake` (`-- denoise` for the denoiser only)
 
@@ -167,7 +170,9 @@ fn bench(c: &mut Criterion) {
 /// distances of the room, the boxes and the lamp's lighting at 2 spp), per cube size.
 fn bench_denoise(c: &mut Criterion) {
     use plenoptic_bake::denoise::cube::CubeGrid;
-    use plenoptic_bake::denoise::{DenoiseSettings, LightingCube, atrous::denoise_on};
+    use plenoptic_bake::denoise::{
+        DenoiseSettings, LightingCube, ambient_passes, atrous::denoise_on,
+    };
     use plenoptic_trace::{CubeCamera, MultiStageRenderer, MultiStageSettings};
     let scene = scene();
     let recipe = Recipe::from_str_named(RECIPE, "bench.toml", Path::new(".")).unwrap();
@@ -179,6 +184,7 @@ fn bench_denoise(c: &mut Criterion) {
         MultiStageSettings {
             samples_per_pixel: 2,
             max_specular_depth: 1,
+            final_gather: 1,
             ..MultiStageSettings::default()
         },
         &fields[0],
@@ -195,6 +201,16 @@ fn bench_denoise(c: &mut Criterion) {
                 || lighting.clone(),
                 |mut l| {
                     denoise_on(&mut l, &grid, &settings);
+                    black_box(l)
+                },
+                BatchSize::LargeInput,
+            )
+        });
+        g.bench_function(format!("smooth_ambient_{n}"), |b| {
+            b.iter_batched(
+                || lighting.clone(),
+                |mut l| {
+                    l.smooth_ambient(ambient_passes(n));
                     black_box(l)
                 },
                 BatchSize::LargeInput,
