@@ -194,6 +194,7 @@ fn renderers(c: &mut Criterion) {
             glossy_samples: 2,
             max_specular_depth: 3,
             seed: 3,
+            final_gather: 0,
         },
         &field,
     );
