@@ -56,6 +56,26 @@ fn camera(p: Vec3, yaw: f32, pitch: f32, w: u32, h: u32) -> PinholeCamera {
     PinholeCamera::new(p, rotation, 70f32.to_radians(), w, h).unwrap()
 }
 
+/// Two independent path-traced halves of `spp` samples per pixel in all (seeds 11 and 12).
+fn reference_halves(
+    placed: &plenoptic_trace::PlacedScene<'_>,
+    camera: &PinholeCamera,
+    spp: u32,
+) -> (Image<Vec3>, Image<Vec3>) {
+    let half = |seed| {
+        PathTracer::new(PathTracerSettings {
+            samples_per_pixel: spp / 2,
+            max_depth: 32,
+            rr_start_depth: 5,
+            seed,
+            environment_sampling: true,
+        })
+        .render(placed, camera)
+        .radiance()
+    };
+    (half(11), half(12))
+}
+
 fn measure(test: &Image<Vec3>, a: &Image<Vec3>, b: &Image<Vec3>) -> Figures {
     let c = corrected_relative_lrms(test, a, b);
     let (t, a_l, b_l) = (lum(test), lum(a), lum(b));
@@ -134,18 +154,7 @@ fn base_view_frame(
     .render(&placed, camera)
     .radiance();
     let ms_time = start.elapsed().as_secs_f64();
-    let half = |seed| {
-        PathTracer::new(PathTracerSettings {
-            samples_per_pixel: reference_spp / 2,
-            max_depth: 32,
-            rr_start_depth: 5,
-            seed,
-            environment_sampling: true,
-        })
-        .render(&placed, camera)
-        .radiance()
-    };
-    let (a, b) = (half(11), half(12));
+    let (a, b) = reference_halves(&placed, camera, reference_spp);
     // Where the error is: the pixels that contribute most to it.
     {
         let (t, al, bl) = (lum(&ms), lum(&a), lum(&b));
@@ -405,18 +414,7 @@ fn denoise_sweep(which: &[usize], variants: &[(&str, DenoiseSettings)]) {
         ));
         for (w, h, ref_spp) in [(32, 24, 4096), (96, 72, 1024)] {
             let cam = camera(p, yaw, pitch, w, h);
-            let half = |seed| {
-                PathTracer::new(PathTracerSettings {
-                    samples_per_pixel: ref_spp / 2,
-                    max_depth: 32,
-                    rr_start_depth: 5,
-                    seed,
-                    environment_sampling: true,
-                })
-                .render(&placed, &cam)
-                .radiance()
-            };
-            let (a, b) = (half(11), half(12));
+            let (a, b) = reference_halves(&placed, &cam, ref_spp);
             println!("{name}, camera {w} × {h}, reference {ref_spp} spp:");
             for (label, image) in &images {
                 let f = measure(&view_of_cube(image, &cam, 6), &a, &b);
@@ -436,6 +434,42 @@ fn tour_scene() -> Scene {
     plenoptic_scene::load(&path).unwrap()
 }
 
+/// The tour's base views measured, each at one of its time keys: (name, position, time,
+/// yaw, pitch).
+const TOUR_VIEWS: [(&str, Vec3, f32, f32, f32); 5] = [
+    (
+        "atrium centre, t = 0",
+        Vec3::new(0.0, 1.6, 0.0),
+        0.0,
+        0.0,
+        -0.35,
+    ),
+    ("room B, t = 3.5", Vec3::new(5.5, 1.6, 2.5), 3.5, 1.2, -0.4),
+    (
+        "room A, t = 10.5",
+        Vec3::new(-5.5, 1.6, -2.5),
+        10.5,
+        -2.4,
+        -0.3,
+    ),
+    (
+        "atrium south, t = 7",
+        Vec3::new(0.0, 1.6, 2.5),
+        7.0,
+        3.0,
+        -0.45,
+    ),
+    // Base view 12 above lies inside the revolving sculpture; its neighbour on the
+    // lattice towards the north, looking back across the atrium, is in the open.
+    (
+        "atrium north, t = 0",
+        Vec3::new(0.0, 1.6, -2.5),
+        0.0,
+        std::f32::consts::PI,
+        -0.35,
+    ),
+];
+
 /// The tour at five base views of its draft bake (the 5 × 5 lattice over its view space),
 /// each at a time key: prints the figures for the issue note. Slow (minutes in release).
 #[test]
@@ -445,39 +479,7 @@ fn tour_base_views() {
     let accel = SceneAccel::new(&scene).unwrap();
     let quality = Quality::draft();
     let (w, h) = (80, 48);
-    let views = [
-        (
-            "atrium centre, t = 0",
-            Vec3::new(0.0, 1.6, 0.0),
-            0.0,
-            0.0,
-            -0.35,
-        ),
-        ("room B, t = 3.5", Vec3::new(5.5, 1.6, 2.5), 3.5, 1.2, -0.4),
-        (
-            "room A, t = 10.5",
-            Vec3::new(-5.5, 1.6, -2.5),
-            10.5,
-            -2.4,
-            -0.3,
-        ),
-        (
-            "atrium south, t = 7",
-            Vec3::new(0.0, 1.6, 2.5),
-            7.0,
-            3.0,
-            -0.45,
-        ),
-        // Base view 12 above lies inside the revolving sculpture; its neighbour on the
-        // lattice towards the north, looking back across the atrium, is in the open.
-        (
-            "atrium north, t = 0",
-            Vec3::new(0.0, 1.6, -2.5),
-            0.0,
-            std::f32::consts::PI,
-            -0.35,
-        ),
-    ];
+    let views = TOUR_VIEWS;
     for (name, p, t, yaw, pitch) in views {
         let start = std::time::Instant::now();
         let field = bake_field(&accel, &quality, t);
@@ -531,40 +533,14 @@ fn tour_range_images_with_and_without_the_final_gather() {
     let scene = tour_scene();
     let accel = SceneAccel::new(&scene).unwrap();
     let quality = Quality::draft();
-    let views = [
-        ("room B, t = 3.5", Vec3::new(5.5, 1.6, 2.5), 3.5, 1.2, -0.4),
-        (
-            "room A, t = 10.5",
-            Vec3::new(-5.5, 1.6, -2.5),
-            10.5,
-            -2.4,
-            -0.3,
-        ),
-        (
-            "atrium south, t = 7",
-            Vec3::new(0.0, 1.6, 2.5),
-            7.0,
-            3.0,
-            -0.45,
-        ),
-    ];
+    // Room B, room A and the atrium's south.
+    let views = &TOUR_VIEWS[1..4];
     let n = quality.range_image_size;
-    for (name, p, t, yaw, pitch) in views {
+    for &(name, p, t, yaw, pitch) in views {
         let field = bake_field(&accel, &quality, t);
         let placed = accel.at_time(t);
         let cam = camera(p, yaw, pitch, 80, 48);
-        let half = |seed| {
-            PathTracer::new(PathTracerSettings {
-                samples_per_pixel: 512,
-                max_depth: 32,
-                rr_start_depth: 5,
-                seed,
-                environment_sampling: true,
-            })
-            .render(&placed, &cam)
-            .radiance()
-        };
-        let (a, b) = (half(11), half(12));
+        let (a, b) = reference_halves(&placed, &cam, 1024);
         for final_gather in [0, final_gather_rays(n)] {
             let renderer = MultiStageRenderer::new(
                 MultiStageSettings {
