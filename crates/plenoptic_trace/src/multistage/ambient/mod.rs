@@ -239,13 +239,16 @@ impl AmbientField {
                 "the two fields were built on different layouts".into(),
             ));
         }
-        let lerp = |x: &[Vec3], y: &[Vec3]| -> Vec<Vec3> {
-            x.iter().zip(y).map(|(p, q)| p.lerp(*q, s)).collect()
-        };
+        let irradiance = a
+            .irradiance
+            .iter()
+            .zip(&b.irradiance)
+            .map(|(p, q)| p.lerp(*q, s))
+            .collect();
         Ok(Self {
             layout: a.layout.clone(),
             time: a.time + (b.time - a.time) * s,
-            irradiance: lerp(&a.irradiance, &b.irradiance),
+            irradiance,
             bounces: a.bounces.min(b.bounces),
             invalid_points: a.invalid_points.max(b.invalid_points),
             guarded: a
