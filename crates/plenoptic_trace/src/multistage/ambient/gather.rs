@@ -23,6 +23,10 @@
 //! estimated geometrically from the last two increments (r/(1−r)·|ΔE|), falls below
 //! `tolerance` of |E|, or after `max_bounces`.
 //!
+//! A **final gather** ([`final_gather`], `AmbientField::irradiance_gathered`) traces the same
+//! rays from a point that is not in the layout (a pixel's or a texel's first hit) and reads
+//! the converged field where they end: D + K·E for that point alone.
+//!
 //! A ray that meets the back face of a single-sided opaque surface has entered a closed
 //! solid and carries no light (the field is shared by both sides of a triangle, so reading
 //! it there would leak the lit side's light through the wall). Transmissive surfaces are
@@ -109,11 +113,10 @@ enum RayEnd {
 
 /// What one gather ray found.
 struct Traced {
-    /// The environment sampled by its own distribution from the point.
-    environment: Vec3,
-    /// Light found along the cosine ray (the environment where it leaves the scene,
-    /// emission behind a delta bounce, direct light at its end), in units of the cosine
-    /// rays' sum, to be scaled by π / rays.
+    /// Light found: the environment sampled by its own distribution from the point, and
+    /// along the cosine ray the environment where it leaves the scene, emission behind a
+    /// delta bounce and direct light at its end; in units of the cosine rays' sum, to be
+    /// scaled by π / rays.
     light: Vec3,
     end: RayEnd,
 }
@@ -127,7 +130,6 @@ fn trace_ray(
 ) -> Traced {
     let (p, n) = (o.p, o.n);
     let mut out = Traced {
-        environment: Vec3::ZERO,
         light: Vec3::ZERO,
         end: RayEnd::Open,
     };
@@ -147,7 +149,7 @@ fn trace_ray(
                 && !placed.occluded(&Ray::new(p + n * eps, e.wi))
             {
                 let w = power_heuristic(e.pdf, cos / std::f32::consts::PI);
-                out.environment = e.radiance * (cos * w / (e.pdf * std::f32::consts::PI));
+                out.light += e.radiance * (cos * w / (e.pdf * std::f32::consts::PI));
             }
         }
     }
@@ -244,7 +246,7 @@ fn gather_point(
     let mut back_faces = 0u32;
     for _ in 0..o.rays {
         let t = trace_ray(placed, layout, &o, s);
-        out.direct += t.environment + t.light;
+        out.direct += t.light;
         match t.end {
             RayEnd::Open => {}
             RayEnd::BackFace => back_faces += 1,
@@ -291,7 +293,7 @@ pub(super) fn final_gather(
     let mut indirect = Vec3::ZERO;
     for _ in 0..o.rays {
         let t = trace_ray(placed, layout, o, s);
-        light += t.environment + t.light;
+        light += t.light;
         if let RayEnd::Field(c, w) = t.end {
             indirect += c * w.iter().map(|&(j, wt)| irradiance[j] * wt).sum::<Vec3>();
         }
