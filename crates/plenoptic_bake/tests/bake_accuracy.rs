@@ -480,6 +480,7 @@ fn tour_base_views() {
     let quality = Quality::draft();
     let (w, h) = (80, 48);
     let views = TOUR_VIEWS;
+    let mut failures = Vec::new();
     for (name, p, t, yaw, pitch) in views {
         let start = std::time::Instant::now();
         let field = bake_field(&accel, &quality, t);
@@ -498,7 +499,18 @@ fn tour_base_views() {
             (1024, 1024),
         );
         println!("{name}: {f}");
+        // The issue's targets, at every view in the open (base view 12 is inside the
+        // sculpture: its figures are printed, not judged).
+        let inside = p == Vec3::new(0.0, 1.6, 0.0);
+        if !inside
+            && ((f.mean_ratio - 1.0).abs() > 0.03
+                || f.blocks_within < 0.9
+                || f.corrected_lrms > 0.1)
+        {
+            failures.push((name, f));
+        }
     }
+    assert!(failures.is_empty(), "{failures:?}");
 }
 
 /// The tour as its recipe bakes it (the sun study and the sky applied), at base view 13
@@ -562,6 +574,7 @@ fn tour_range_images_with_and_without_the_final_gather() {
             } else {
                 &[0, 2, 3, 4]
             };
+            let mut unsmoothed = None;
             for &k in passes {
                 let mut lighting = LightingCube::from_faces(n, &faces);
                 if k > 0 {
@@ -571,6 +584,16 @@ fn tour_range_images_with_and_without_the_final_gather() {
                 println!(
                     "{name}: final gather {final_gather}, smoothing {k} passes: {f} \
                      (faces rendered in {secs:.1} s)"
+                );
+                // The smoothing is linear in the lighting, so it barely moves the frame's mean
+                // (by up to 1.3 %, room A at 4 passes: texels reweighted by the camera and
+                // multiplied by their own albedo). The denoiser with its luminance weight
+                // moved it by 5–7 %.
+                let m0 = *unsmoothed.get_or_insert(f.mean_ratio);
+                assert!(
+                    (f.mean_ratio / m0 - 1.0).abs() < 0.02,
+                    "{name}: smoothing moved the mean {m0} → {}",
+                    f.mean_ratio
                 );
             }
         }
