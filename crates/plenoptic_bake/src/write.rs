@@ -100,7 +100,10 @@ pub fn volume_chunks(plan: &Plan, bv: u32, samples: &[VolumeSample]) -> Result<V
     let m = bucketing(plan);
     let mut buckets: BTreeMap<u32, Vec<VolumeSample>> = BTreeMap::new();
     for s in samples {
-        buckets.entry(m.bucket_of(s.t)).or_default().push(*s);
+        buckets
+            .entry(m.bucket_of(s.t))
+            .or_default()
+            .push(crate::quantise::coarsen_sample(s));
     }
     let mut out = Vec::new();
     for (b, list) in buckets {
