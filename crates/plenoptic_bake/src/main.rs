@@ -396,11 +396,14 @@ fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> 
     }
     out!("plan of {} (q = {})", p.recipe, p.quality.q);
     out!(
-        "  base views: {} (lattice {} per axis, {} cells tested, {} split)",
+        "  base views: {} (lattice {} per axis, {} cells tested, {} split; {} moved clear of \
+         objects, {} crowded with no clear point near)",
         p.base_views.len(),
         p.space_lattice,
         p.counters.space_cells_tested,
-        p.counters.space_cells_split
+        p.counters.space_cells_split,
+        p.counters.views_moved,
+        p.counters.views_crowded
     );
     out!(
         "  time: {} .. {} s, animated: {}, light keys: {}, time keys: {}",

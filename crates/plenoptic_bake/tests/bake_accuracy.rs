@@ -437,9 +437,11 @@ fn tour_scene() -> Scene {
 /// The tour's base views measured, each at one of its time keys: (name, position, time,
 /// yaw, pitch).
 const TOUR_VIEWS: [(&str, Vec3, f32, f32, f32); 5] = [
+    // Base view 12, which the lattice puts between the slabs of the revolving sculpture at
+    // (0, 1.6, 0), where the plan moves it (plan::clearance).
     (
         "atrium centre, t = 0",
-        Vec3::new(0.0, 1.6, 0.0),
+        Vec3::new(-0.191, 1.6, -0.462),
         0.0,
         0.0,
         -0.35,
@@ -459,8 +461,8 @@ const TOUR_VIEWS: [(&str, Vec3, f32, f32, f32); 5] = [
         3.0,
         -0.45,
     ),
-    // Base view 12 above lies inside the revolving sculpture; its neighbour on the
-    // lattice towards the north, looking back across the atrium, is in the open.
+    // Base view 12's neighbour on the lattice towards the north, looking back across the
+    // atrium.
     (
         "atrium north, t = 0",
         Vec3::new(0.0, 1.6, -2.5),
@@ -499,14 +501,8 @@ fn tour_base_views() {
             (1024, 1024),
         );
         println!("{name}: {f}");
-        // The targets, at every view in the open (base view 12 is inside the
-        // sculpture: its figures are printed, not judged).
-        let inside = p == Vec3::new(0.0, 1.6, 0.0);
-        if !inside
-            && ((f.mean_ratio - 1.0).abs() > 0.03
-                || f.blocks_within < 0.9
-                || f.corrected_lrms > 0.1)
-        {
+        // The targets, at every view.
+        if (f.mean_ratio - 1.0).abs() > 0.03 || f.blocks_within < 0.9 || f.corrected_lrms > 0.1 {
             failures.push((name, f));
         }
     }

@@ -115,3 +115,83 @@ fn trace_cube_faces_match_the_pack_texel_order() {
         }
     }
 }
+
+/// Base views clear of objects (`plan::clearance`): room A's rectangle has a pillar standing
+/// on one corner and a box sliding through another halfway through the bake's range. Both
+/// views move to a clear point nearby (not farther than 0.45 of the way to the next view);
+/// the other two stay on their lattice points.
+#[test]
+fn base_views_move_out_of_objects_and_out_of_the_way_of_moving_ones() {
+    use glam::Vec3;
+    use plenoptic_bake::plan::clearance;
+    use plenoptic_scene::Track;
+    use plenoptic_scene::builder::{MaterialDesc, NodeDesc};
+
+    // In lattice order (x, then z).
+    let lattice = [
+        Vec3::new(-6.0, 0.3, -1.0),
+        Vec3::new(-6.0, 0.3, 1.0),
+        Vec3::new(-4.0, 0.3, -1.0),
+        Vec3::new(-4.0, 0.3, 1.0),
+    ];
+    let rooms = two_rooms();
+    let quality = "q = 0.0\nmax_space_depth = 3";
+    let before = plan_of(ROOM_A_RECT, &rooms, quality);
+    assert_eq!(before.counters.views_moved, 0);
+    let mut scene = two_rooms();
+    let grey = scene.add_material(MaterialDesc::diffuse(Vec3::splat(0.5)));
+    let pillar = scene.add_box("pillar", Vec3::new(0.4, 3.9, 0.4), grey);
+    scene.add_node(NodeDesc::new("pillar").mesh(pillar).translation(lattice[0]));
+    let slider = scene.add_box("slider", Vec3::splat(0.3), grey);
+    let node = scene.add_node(
+        NodeDesc::new("slider")
+            .mesh(slider)
+            .translation(Vec3::new(-4.0, 0.3, 0.2)),
+    );
+    scene.animate_translation(
+        node,
+        Track::linear([
+            (0.0, Vec3::new(-4.0, 0.3, 0.2)),
+            (1.0, Vec3::new(-4.0, 0.3, 1.8)),
+        ]),
+    );
+    let after = plan_of(ROOM_A_RECT, &scene, quality);
+    assert_eq!(after.base_views.len(), 4);
+    assert_eq!(
+        (after.counters.views_moved, after.counters.views_crowded),
+        (2, 0)
+    );
+    // The same lattice points in the same order; only the positions moved.
+    for (a, b) in before.base_views.iter().zip(&after.base_views) {
+        assert_eq!(a.lattice, b.lattice);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_recipe(dir.path(), &scene, ROOM_A_RECT, quality);
+    let (_, loaded) = load_recipe(&path).unwrap();
+    let accel = SceneAccel::new(&loaded).unwrap();
+    let scenes: Vec<_> = clearance::times(0.0, 1.0, clearance::TIMES)
+        .into_iter()
+        .map(|t| accel.at_time(t))
+        .collect();
+    for (v, &l) in after.base_views.iter().zip(&lattice) {
+        let moved = v.position.distance(l);
+        let crowded_there = clearance::crowding(&scenes, l);
+        if l == lattice[0] || l == lattice[3] {
+            // In the pillar (every direction meets a back face), and in the slider's way.
+            assert!(crowded_there > 0.5, "{l}: {crowded_there}");
+            assert!(
+                moved > 0.0 && moved <= 0.45 * 2.0 + 1e-4,
+                "{l} -> {}",
+                v.position
+            );
+            assert!(clearance::crowding(&scenes, v.position) <= clearance::CROWDED);
+            assert_eq!(v.position.y, 0.3);
+        } else {
+            assert!(crowded_there <= clearance::CROWDED, "{l}: {crowded_there}");
+            assert_eq!(v.position, l);
+        }
+    }
+    // At the start and the end alone the slider is 0.8 m from its corner: clear.
+    let ends: Vec<_> = [0.0, 1.0].map(|t| accel.at_time(t)).into_iter().collect();
+    assert!(clearance::crowding(&ends, lattice[3]) <= clearance::CROWDED);
+}

@@ -8,6 +8,7 @@
 //! copy to check that a resumed bake or a merge still has the same inputs.
 
 pub mod ambient;
+pub mod clearance;
 pub mod ids;
 pub mod space;
 pub mod sunlit;
@@ -98,6 +99,13 @@ pub struct PlanCounters {
     pub time_intervals_tested: u64,
     /// Ambient intervals tested.
     pub ambient_intervals_tested: u64,
+    /// Base views moved off their lattice point, out of or away from an object
+    /// ([`clearance`]).
+    #[serde(default)]
+    pub views_moved: u64,
+    /// Base views left where they were, crowded, with no clear point around them.
+    #[serde(default)]
+    pub views_crowded: u64,
 }
 
 /// The bake plan. See the module doc.
@@ -245,13 +253,35 @@ pub fn decompose(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> 
 
     // Space.
     let placed = accel.at_time(start);
-    let space = space::decompose(&placed, &recipe.view_space, q.q, id_size, q.max_space_depth);
+    let mut space = space::decompose(&placed, &recipe.view_space, q.q, id_size, q.max_space_depth);
     rays += space.views.len() as u64 * cube_rays;
     let mut counters = PlanCounters {
         space_cells_tested: space.cells_tested,
         space_cells_split: space.cells_split,
         ..Default::default()
     };
+    // Views inside or wedged in objects move to a clear point nearby.
+    let scenes: Vec<_> =
+        clearance::times(start, if animated { end } else { start }, clearance::TIMES)
+            .into_iter()
+            .map(|t| accel.at_time(t))
+            .collect();
+    let lattice_points: Vec<Vec3> = space.views.iter().map(|v| v.1).collect();
+    for (_, position) in &mut space.views {
+        let reach = clearance::reach(
+            &recipe.view_space,
+            lattice_points.iter().copied(),
+            *position,
+        );
+        match clearance::clear_position(&scenes, &recipe.view_space, reach, *position) {
+            Some(p) if p != *position => {
+                *position = p;
+                counters.views_moved += 1;
+            }
+            Some(_) => {}
+            None => counters.views_crowded += 1,
+        }
+    }
 
     // Time: lights, then each base view.
     let time_lattice = 1u32 << q.max_time_depth.min(16);
