@@ -97,8 +97,10 @@ impl PutLe for Vec<u8> {
     }
 }
 
-/// The zstd level the writer uses for every compressed payload.
-pub(crate) const ZSTD_LEVEL: i32 = 9;
+/// The zstd level the writer uses for every compressed payload. On the tour's cubes (RGB9E5
+/// and f32 texels), level 15 stores 9 % less than 9 at 10 MB/s against 48 (level 12: 0.6 %
+/// less; 19: 10 % less at 3 MB/s); decoding is as fast at any level.
+pub(crate) const ZSTD_LEVEL: i32 = 15;
 
 /// Compresses `data` as one zstd frame (content size recorded, no dictionary).
 pub(crate) fn zstd_compress(data: &[u8]) -> Result<Vec<u8>> {
