@@ -1,7 +1,9 @@
 //! The bake plan: the thesis's "recipe" (Nimeroff 1997, ch. 6): where the base views are
-//! ([`space`]), which times each one stores ([`time`]), when the ambient field is gathered
+//! ([`space`], then moved out of the objects a lattice point falls in by [`clearance`]),
+//! which times each one stores ([`time`]), when the ambient field is gathered
 //! ([`ambient`]), and how many temporal-volume samples each base view gets. Computed from
-//! id-images (and, for the ambient keys, irradiance) only: no radiance of the range images.
+//! id-images, first hits (clearance) and, for the ambient keys, irradiance only: no radiance
+//! of the range images.
 //!
 //! A [`Plan`] is plain data (serde JSON). It is a pure function of the recipe and the scene,
 //! so every process of a sharded bake computes the same plan, and the work directory keeps a
