@@ -16,8 +16,9 @@
 //! - **Moved:** candidates lie on rings around the lattice point, [`RING_STEP`] apart, in the
 //!   view space's plane (rectangle), along its line (segment) or in all directions (box), up
 //!   to 0.45 of the distance to the nearest other base view (so that views keep their order
-//!   and cells), inside the view space. The first ring with a clear candidate gives the least crowded of
-//!   them (the first in ring order on ties). No clear candidate: the view stays and is counted.
+//!   and cells), inside the view space. The first ring with a clear candidate gives the
+//!   least crowded of them (the first in ring order on ties). No clear candidate: the view
+//!   stays and is counted.
 //!
 //! Pure function of the scene and the recipe, as the whole plan is.
 
