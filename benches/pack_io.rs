@@ -3,6 +3,13 @@
 //! smooth light falloff) seen from 4 base views × 3 time keys at face size 128, plus 4 temporal
 //! volume blocks of 20 000 samples with connectivity. Prints the compression ratio once.
 //!
+//! `pack_io/zstd_decode_level_{9,15}`: zstd alone decoding the fixture's radiance, lighting
+//! and distance texels with 5 % noise, rounded as the baker stores them
+//! (`plenoptic_bake::quantise`), compressed at the writer's level (15) and at its former
+//! one (9), measured in the same run; prints the sizes' ratio. With `PLENOPTIC_BENCH_PACK`
+//! naming a baked pack, every fifth of its radiance, lighting, non-diffuse and distance cubes
+//! instead (the texels as that bake stored them).
+//!
 //! `cargo bench --no-default-features --bench pack_io`
 
 use std::hint::black_box;
@@ -204,6 +211,100 @@ fn pack_io(c: &mut Criterion) {
     let out = dir.path().join("bench-write.pack");
     g.bench_function("write", |b| b.iter(|| black_box(write(&f, &out))));
     g.bench_function("read_decode", |b| b.iter(|| black_box(read_all(&path))));
+    g.finish();
+    zstd_levels(c, &f);
+}
+
+/// The texel bytes of every cube of the fixture with a bake's noise, as the baker stores them.
+fn noisy_texels(f: &Fixture) -> Vec<Vec<u8>> {
+    use plenoptic_bake::quantise::{coarse_distance, coarsen_colour};
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut noise = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        1.0 + 0.1 * ((state >> 40) as f32 / (1u64 << 24) as f32 - 0.5)
+    };
+    let mut out = Vec::new();
+    for (_, _, img) in &f.images {
+        for cube in [&img.radiance, &img.lighting] {
+            let bytes = cube
+                .texels
+                .iter()
+                .flat_map(|&c| cube::rgb9e5_pack(coarsen_colour(c * noise())).to_le_bytes());
+            out.push(bytes.collect());
+        }
+        let d = img.distance.texels.iter();
+        out.push(d.flat_map(|&d| coarse_distance(d).to_le_bytes()).collect());
+    }
+    out
+}
+
+/// Every fifth radiance, lighting, non-diffuse and distance cube of the pack at `path`, as
+/// texel bytes.
+fn pack_texels(path: &str) -> Vec<Vec<u8>> {
+    let r = PackReader::open(path).unwrap();
+    let colour = |c: RadianceCube| -> Vec<u8> {
+        c.texels
+            .iter()
+            .flat_map(|&c| cube::rgb9e5_pack(c).to_le_bytes())
+            .collect()
+    };
+    r.entries()
+        .iter()
+        .filter(|e| {
+            matches!(
+                e.kind,
+                ChunkKind::RadianceCube
+                    | ChunkKind::LightingCube
+                    | ChunkKind::NonDiffuseCube
+                    | ChunkKind::DistanceCube
+            )
+        })
+        .step_by(5)
+        .map(|e| {
+            let (v, k) = (e.base_view, e.key);
+            match e.kind {
+                ChunkKind::DistanceCube => (r.distance(v, k).unwrap().texels.iter())
+                    .flat_map(|d| d.to_le_bytes())
+                    .collect(),
+                ChunkKind::RadianceCube => colour(r.radiance(v, k).unwrap()),
+                ChunkKind::LightingCube => colour(r.lighting(v, k).unwrap()),
+                _ => colour(r.non_diffuse(v, k).unwrap()),
+            }
+        })
+        .collect()
+}
+
+/// zstd decoding at the writer's level against its former one (see the module doc).
+fn zstd_levels(c: &mut Criterion, f: &Fixture) {
+    let raw = match std::env::var("PLENOPTIC_BENCH_PACK") {
+        Ok(path) => pack_texels(&path),
+        Err(_) => noisy_texels(f),
+    };
+    let total: usize = raw.iter().map(Vec::len).sum();
+    let at = |level| -> Vec<Vec<u8>> {
+        raw.iter()
+            .map(|b| zstd::bulk::compress(b, level).unwrap())
+            .collect()
+    };
+    let levels = [(9, at(9)), (15, at(15))];
+    let size = |frames: &[Vec<u8>]| frames.iter().map(Vec::len).sum::<usize>() as f64;
+    println!(
+        "pack_io: zstd level 15 stores {:.3} of level 9's bytes of these texels",
+        size(&levels[1].1) / size(&levels[0].1)
+    );
+    let mut g = c.benchmark_group("pack_io");
+    g.throughput(Throughput::Bytes(total as u64));
+    for (level, frames) in &levels {
+        g.bench_function(format!("zstd_decode_level_{level}"), |b| {
+            b.iter(|| {
+                for (frame, bytes) in frames.iter().zip(&raw) {
+                    black_box(zstd::bulk::decompress(frame, bytes.len()).unwrap());
+                }
+            })
+        });
+    }
     g.finish();
 }
 

@@ -99,10 +99,9 @@ impl PutLe for Vec<u8> {
 
 /// The zstd level the writer uses for every compressed payload. On the tour's cubes (RGB9E5
 /// and f32 texels), level 15 stores 9 % less than 9 at 10 MB/s against 48 (level 12: 0.6 %
-/// less; 19: 10 % less at 3 MB/s). Its frames decode at about 0.65 of level 9's speed
-/// (580 against 900 MB/s of texels on the 2-core development machine); the plugin's
-/// `plugin/decode_key` benchmark, which also converts the texels, measured 692 MiB/s at
-/// face 64 against 795 before.
+/// less; 19: 10 % less at 3 MB/s). Its frames decode at 0.62 of level 9's speed (512 against
+/// 821 MiB/s of texels; `PLENOPTIC_BENCH_PACK=tour.pack cargo bench --no-default-features
+/// --bench pack_io -- zstd_decode`); on that bench's synthetic fixture, at 0.93.
 pub(crate) const ZSTD_LEVEL: i32 = 15;
 
 /// Compresses `data` as one zstd frame (content size recorded, no dictionary).
