@@ -149,13 +149,11 @@ pub fn clear_position(
             .filter(|&q| inside(view, q))
             .map(|q| (crowding(scenes, q), q))
             .collect();
-        let best = tested.into_iter().filter(|&(c, _)| c <= CROWDED).fold(
-            None,
-            |best: Option<(f32, Vec3)>, c| match best {
-                Some(b) if b.0 <= c.0 => Some(b),
-                _ => Some(c),
-            },
-        );
+        // The least crowded clear candidate, the first on ties.
+        let best = tested
+            .into_iter()
+            .filter(|&(c, _)| c <= CROWDED)
+            .min_by(|a, b| a.0.total_cmp(&b.0));
         if let Some((_, q)) = best {
             return Some(q);
         }
