@@ -1,9 +1,9 @@
 //! A sun-shadow edge on a floor (issue: pack v2, "Sun shadows"): the error of the
 //! geometry-assisted frame against the path tracer in a 4-pixel band along the edge, against
 //! the error elsewhere on the floor. Pack 3 leaves the sun's direct light to the runtime
-//! (shadow rays against the proxies, spread over each pixel's footprint, more of them where
-//! the first disagree), so the edge is at screen resolution; pack 2.0 had it in the stored
-//! lighting, at cube resolution (25× at 1280 × 720).
+//! (shadow rays against the proxies; for this sun without a disc, the lit fraction of each
+//! pixel an edge crosses is measured along the edge, `plenoptic_recon`'s `sun_edge`), so the
+//! edge is at screen resolution; pack 2.0 had it in the stored lighting, at cube resolution.
 //!
 //! The errors are variance-corrected RMS errors, as every comparison of the issue: from two
 //! reference halves, the reference's own variance is estimated and subtracted per region
@@ -123,22 +123,25 @@ fn errors(
             })
         })
         .collect();
-    // The band: floor pixels within 2 pixels of one whose sunlight differs.
-    let near_edge = |j: usize| {
+    // The pixels within 2 of pixel j, itself included (fewer at the frame's border).
+    let window = |j: usize| {
         let (x, y) = ((j % w) as i64, (j / w) as i64);
-        let here = lit[j];
-        (-2..=2i64).any(|dy| {
-            (-2..=2i64).any(|dx| {
-                let (nx, ny) = (x + dx, y + dy);
-                nx >= 0
-                    && ny >= 0
-                    && (nx as usize) < w
-                    && (ny as usize) < h
-                    && lit[ny as usize * w + nx as usize].is_some_and(|l| Some(l) != here)
-            })
-        })
+        (-2..=2i64)
+            .flat_map(move |dy| (-2..=2i64).map(move |dx| (x + dx, y + dy)))
+            .filter(|&(nx, ny)| nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h)
+            .map(|(nx, ny)| ny as usize * w + nx as usize)
     };
-    let floor_px: Vec<usize> = (0..w * h).filter(|&j| lit[j].is_some()).collect();
+    // The band: floor pixels within 2 pixels of one whose sunlight differs.
+    let near_edge = |j: usize| window(j).any(|k| lit[k].is_some_and(|l| Some(l) != lit[j]));
+    // Compared: floor pixels at least 3 pixels inside the floor's outline in the frame. At
+    // the outline the path tracer's pixels mix the floor with what lies behind it, and this
+    // reconstruction shows one surface per pixel (it does not antialias geometry): that
+    // error is the same whether the sun is there or not, and kept in, it dominated both
+    // regions (the
+    // floor's far edge runs through the band where the shadow meets it, and measured the
+    // rest of the floor at 0.018 instead of 0.002).
+    let inside = |j: usize| window(j).count() == 25 && window(j).all(|k| lit[k].is_some());
+    let floor_px: Vec<usize> = (0..w * h).filter(|&j| inside(j)).collect();
     // Squared errors against the reference's halves, per region, with the reference's
     // variance estimated and removed (plenoptic_eval::metrics); and mean absolute errors,
     // which keep the reference's noise in.
@@ -209,8 +212,12 @@ fn errors(
     (eb, er)
 }
 
-/// The issue's size (release, half a minute): 64-px cubes at 1280 × 720, at the default 4
-/// shadow rays per pixel and at 16.
+/// The issue's size (release, about 2.5 minutes): 64-px cubes at 1280 × 720, the default
+/// settings within 2× of the rest of the floor; beside them, 4 and 16 rays per pixel
+/// without the edges measured, and the radiance at cube resolution. The reference takes
+/// 512 samples per pixel: at 64, the uncertainty of its own variance in the band's few
+/// hundred edge pixels was as large as the error measured (the band read 2.3× where it
+/// reads 1.6× at 512).
 #[test]
 #[ignore]
 fn sun_shadow_edge_at_1280x720() {
@@ -218,17 +225,19 @@ fn sun_shadow_edge_at_1280x720() {
         (Shading::Materials, 4, 32),
         (Shading::Materials, 4, 0),
         (Shading::Materials, 16, 0),
-        (Shading::Materials, 4, 64),
         (Shading::Radiance, 4, 32),
     ];
-    measure(64, 1280, 720, 64, &configs);
+    let e = measure(64, 1280, 720, 512, &configs);
+    let (band, rest) = e[0];
+    assert!(band <= 2.0 * rest, "edge band {band:.4} against {rest:.4}");
 }
 
 /// CI's size: 16-px cubes at 320 × 180. The edge comes from the shadow rays, not the cubes,
 /// so a tiny bake still gives a sharp one. Beside it, the same pack's radiance (which keeps
 /// the sun, at cube resolution, as pack 2.0's lighting did): the runtime sun's edge must be
-/// far better, and within a bound of the rest of the floor. And the same frame without the
-/// refinement of edge pixels: refining must lower the band's error.
+/// far better, and within a bound of the rest of the floor (4×: at 32 samples per pixel the
+/// reference cannot measure finer; 2.8× today). And the same frame without the edge pixels
+/// measured: measuring them must at least halve the band's error (a third of it today).
 #[test]
 fn sun_shadow_edge_is_at_screen_resolution() {
     let e = measure(
@@ -247,9 +256,9 @@ fn sun_shadow_edge_is_at_screen_resolution() {
         eb < 0.25 * cube_band,
         "edge band {eb:.3}, at cube resolution {cube_band:.3}"
     );
-    assert!(eb < 6.0 * er.max(0.01), "edge band {eb:.3} against {er:.3}");
+    assert!(eb < 4.0 * er.max(0.01), "edge band {eb:.3} against {er:.3}");
     assert!(
-        eb < 0.9 * unrefined,
+        eb < 0.5 * unrefined,
         "edge band {eb:.3}, without refining edge pixels {unrefined:.3}"
     );
 }

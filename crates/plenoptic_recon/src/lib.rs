@@ -107,6 +107,7 @@ pub mod shadow;
 pub mod specular;
 pub mod streamed;
 pub mod sun;
+mod sun_edge;
 mod surface;
 pub mod temporal;
 pub mod viewspace;

@@ -56,6 +56,9 @@ pub struct ReconSettings {
     /// made again with this many, so edges are antialiased as finely as the path tracer's
     /// while lit and shadowed pixels cost only the first rays. At most
     /// [`crate::sun::MAX_SUN_RAYS`]; not above `sun_shadow_rays` turns the refinement off.
+    /// For a sun without a disc (hard shadows), refinement finds edge pixels with 5 rays
+    /// from the pixel's corners and centre instead, measures their lit fraction along the
+    /// edge ([`crate::sun`]), and uses these rays only where no single edge crosses a pixel.
     pub sun_edge_rays: u32,
     /// How the geometry-assisted mode shows the specular part of surfaces with a material:
     /// as the base views saw it, or for the actual camera by marching the reflected ray
