@@ -172,8 +172,8 @@ fn errors(
     }
     .save_png(
         out.join(format!(
-            "{width}_recon_{face}_{:?}_{rays}.png",
-            rec.settings.shading
+            "{width}_recon_{face}_{:?}_{rays}_{}.png",
+            rec.settings.shading, rec.settings.sun_edge_rays
         )),
         exposure,
     )
