@@ -155,6 +155,10 @@ fn measure(
             .id
     };
     let (mirror, steel) = (id("mirror"), id("steel"));
+    assert!(
+        plenoptic_recon::specular::glossy_allowed(&rec),
+        "every light's highlight is evaluated at runtime (the lamp is placed)"
+    );
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("specular");
     std::fs::create_dir_all(&out).unwrap();
     let exposure = 0.5 / a.mean_luminance() as f32;
@@ -239,18 +243,23 @@ fn measure(
     results
 }
 
-/// Under the sun (left to the runtime) both panels are marched; with a point lamp (whose
-/// highlight exists only in the baked radiance) only the mirror is. Measured at 160 × 90,
-/// 64-px cubes, 2 × 64 spp (dev profile and release alike):
+/// Both panels are marched in both scenes: under the sun (left to the runtime), and under
+/// a point lamp, which pack 4.1 places so that the steel adds its highlight at runtime
+/// (until then the steel kept its baked highlight, frozen where the base views saw it).
+/// Measured at 160 × 90, 64-px cubes, 2 × 64 spp, one sample per pixel (dev profile and
+/// release alike):
 ///
 /// | scene | mirror baked → marched | steel baked → marched | diffuse |
 /// |---|---|---|---|
-/// | sun | 0.594 → 0.244 | 0.213 → 0.181 | 0.096 |
-/// | lamp | 0.187 → 0.088 | 0.203 (not marched) | 0.036 |
+/// | sun | 0.594 → 0.244 | 0.213 → 0.181 | 0.094 |
+/// | lamp | 0.187 → 0.088 | 0.203 → 0.104 | 0.036 |
 ///
-/// (Before the bake's final gather the diffuse pixels' errors were 0.097 and 0.052.)
-/// (Baked steel was 0.256 before the range images' texels kept only the samples of their
-/// centre's object, `plenoptic_trace::PixelFilter::SameObject`.)
+/// (The steel's 8 rays per pixel are each weighted by the lobe's `F·G·(ω_o·h)/((n·ω_o)
+/// (n·h))`; with their plain mean times Karis's split-sum fit the steel came out at 0.92
+/// and 0.87 of the path tracer's mean, 0.124 and 0.140 at 320 × 180 against 0.080 and
+/// 0.060.) (Before the bake's final gather the diffuse pixels' errors were 0.097 and
+/// 0.052.) (Baked steel was 0.256 before the range images' texels kept only the samples of
+/// their centre's object, `plenoptic_trace::PixelFilter::SameObject`.)
 #[test]
 fn mirror_and_steel_reflect_for_the_camera() {
     let sun: Vec<_> = measure(false, 64, (160, 90), 128, 1)
@@ -290,17 +299,20 @@ fn mirror_and_steel_reflect_for_the_camera() {
         mirror_m < 3.0 * diffuse,
         "lamp: mirror {mirror_m}, diffuse {diffuse}"
     );
-    assert_eq!(
-        steel_b, steel_m,
-        "a glossy surface under a baked lamp keeps its baked part"
+    // Pack 4.1 places the lamp: the steel reflects for the camera and adds the lamp's
+    // highlight at runtime (plenoptic_recon::lamps) instead of keeping the baked one.
+    assert!(
+        steel_m < 0.6 * steel_b,
+        "lamp: steel {steel_b} -> {steel_m}"
     );
 }
 
 /// The comparison with antialiased frames, as the tour's are compared (release,
-/// about a minute): 320 × 180, 4 × 4 samples per pixel, 2 × 64 spp. Under the sun both
-/// panels reflect for the camera: 2.17× and 1.99× the diffuse pixels' error (the issue's
-/// bound is 2×). Under the lamp the steel keeps its baked highlight (4.65×). Held here: the
-/// march halves the mirror's error, and the sun's panels stay within 2.5×.
+/// about a minute): 320 × 180, 4 × 4 samples per pixel, 2 × 64 spp. Both panels reflect
+/// for the camera in both scenes; under the lamp the steel adds the placed lamp's highlight
+/// at runtime. Measured: sun: mirror 2.18×, steel 1.29× the diffuse pixels' error; lamp:
+/// mirror 2.08×, steel 1.49× (the bound is 2×). Held here: the march halves the
+/// mirror's error, the steel within 2×, the mirror within 2.5×.
 #[test]
 #[ignore]
 fn mirror_and_steel_antialiased() {
@@ -308,12 +320,11 @@ fn mirror_and_steel_antialiased() {
     let lamp = measure(true, 64, (320, 180), 128, 4);
     for r in [&sun, &lamp] {
         let ([mirror_b, ..], _) = r[0];
-        let ([mirror_m, ..], _) = r[1];
-        assert!(mirror_m < 0.5 * mirror_b, "mirror {mirror_b} -> {mirror_m}");
+        let ([mirror, steel, diffuse], _) = r[1];
+        assert!(mirror < 0.5 * mirror_b, "mirror {mirror_b} -> {mirror}");
+        assert!(
+            mirror <= 2.5 * diffuse && steel <= 2.0 * diffuse,
+            "mirror {mirror}, steel {steel}, diffuse {diffuse}"
+        );
     }
-    let ([mirror, steel, diffuse], _) = sun[1];
-    assert!(
-        mirror <= 2.5 * diffuse && steel <= 2.5 * diffuse,
-        "sun: mirror {mirror}, steel {steel}, diffuse {diffuse}"
-    );
 }

@@ -80,8 +80,8 @@ pub use environment::{
 pub use error::{ChunkRef, PackError, Result, Section};
 pub use header::{HEADER_LEN, Header, MAGIC, OLDEST_MAJOR, VERSION_MAJOR, VERSION_MINOR};
 pub use manifest::{
-    Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, Manifest, Motion, ObjectEntry,
-    TimeRange, Units, ViewSpace,
+    Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, LightPlacement, Manifest,
+    Motion, ObjectEntry, TimeRange, Units, ViewSpace,
 };
 pub use material::{
     AlphaMode, MaterialEntry, TextureBinding, TextureEntry, UvTransform, WrapMode,

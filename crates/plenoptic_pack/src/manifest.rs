@@ -145,6 +145,22 @@ impl Manifest {
                 ));
             }
         }
+        for (i, l) in self.lights.iter().enumerate() {
+            if let Some(p) = &l.placed {
+                let unit = (p.direction.length() - 1.0).abs() < 1e-3;
+                let range = p.range.is_none_or(|r| r.is_finite() && r > 0.0);
+                if !(p.position.is_finite() && p.direction.is_finite() && unit && range) {
+                    return bad(format!(
+                        "light {i} is placed at {} along {} with range {:?}: not a finite \
+                         position, a unit direction and a positive range",
+                        p.position, p.direction, p.range
+                    ));
+                }
+            }
+            if !(l.colour.is_finite() && l.intensity.is_finite()) {
+                return bad(format!("light {i} has a non-finite colour or intensity"));
+            }
+        }
         Ok(())
     }
 }
@@ -297,6 +313,24 @@ pub struct Light {
     pub follows_object: Option<u32>,
     /// The glTF node the light is attached to, if any.
     pub node_path: Option<String>,
+    /// Where a point or spot light that never moves shines from (4.1): the runtime evaluates
+    /// its highlight on the glossy surfaces whose reflections it marches for the camera.
+    /// `None` (absent, as in every older pack): directional lights, area lights, lights that
+    /// move, whose highlights stay in the baked non-diffuse radiance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placed: Option<LightPlacement>,
+}
+
+/// Where a punctual light is, in the world.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LightPlacement {
+    /// Position, metres.
+    pub position: Vec3,
+    /// Unit direction the light shines along (a spot light's axis, the node's −Z).
+    pub direction: Vec3,
+    /// Distance beyond which it gives no light, metres; `None`: unlimited.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<f32>,
 }
 
 /// The settings a pack was baked with.

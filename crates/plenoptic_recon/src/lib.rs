@@ -92,6 +92,7 @@ mod geometry;
 #[path = "geometry_tests.rs"]
 mod geometry_tests;
 mod glazing;
+pub mod lamps;
 mod lookup;
 mod material;
 pub mod motion;

@@ -211,23 +211,31 @@ pub(crate) fn render(
             let cos_o = -px.view.dot(n);
             let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
             let alpha = px.material.roughness * px.material.roughness;
-            let incoming = if px.material.roughness < DELTA_ROUGHNESS {
-                r.incoming(px.position, dir, 0.0)
-            } else {
-                // A per-pixel turn of the lobe's directions (golden-ratio sequence).
-                let turn = (j as f32 * 0.618_034).fract();
-                r.lobe(px.position, n, -px.view, alpha, turn)
-            };
-            marched_pixels.fetch_add(1, Ordering::Relaxed);
-            if incoming.is_none() {
-                unanswered.fetch_add(1, Ordering::Relaxed);
-            }
             let eta = if front {
                 px.material.ior
             } else {
                 1.0 / px.material.ior
             };
-            Some(px.emission + specular::reflectance(&px.material, cos_o, eta) * incoming?)
+            let delta = px.material.roughness < DELTA_ROUGHNESS;
+            let incoming = if delta {
+                r.incoming(px.position, dir, 0.0)
+                    .map(|l| specular::reflectance(&px.material, cos_o, eta) * l)
+            } else {
+                // A per-pixel turn of the lobe's directions (golden-ratio sequence).
+                let turn = (j as f32 * 0.618_034).fract();
+                r.lobe(px.position, bsdf, alpha, turn)
+            };
+            marched_pixels.fetch_add(1, Ordering::Relaxed);
+            if incoming.is_none() {
+                unanswered.fetch_add(1, Ordering::Relaxed);
+            }
+            // A glossy surface's lamps' highlights, which the march cannot see.
+            let highlights = if delta {
+                Vec3::ZERO
+            } else {
+                r.highlights(px.position, px.ng, bsdf)
+            };
+            Some(px.emission + incoming? + highlights)
         });
         // Glass in the see-through layer that no view answers shows no reflection (its
         // baked radiance holds what it lets through, which is composited apart).

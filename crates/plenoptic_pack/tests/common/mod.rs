@@ -91,6 +91,19 @@ pub fn manifest(base_views: usize) -> Manifest {
             intensity: 800.0,
             follows_object: Some(2),
             node_path: Some("/Scene/Lamp".into()),
+            placed: None,
+        },
+        Light {
+            kind: LightKind::Point,
+            colour: Vec3::new(1.0, 0.8, 0.6),
+            intensity: 20.0,
+            follows_object: None,
+            node_path: Some("/Scene/Bulb".into()),
+            placed: Some(plenoptic_pack::LightPlacement {
+                position: Vec3::new(0.5, 2.2, -1.0),
+                direction: Vec3::NEG_Y,
+                range: Some(8.0),
+            }),
         },
         Light {
             kind: LightKind::Area {
@@ -101,6 +114,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             intensity: 12.5,
             follows_object: None,
             node_path: None,
+            placed: None,
         },
         Light {
             kind: LightKind::Directional,
@@ -108,6 +122,7 @@ pub fn manifest(base_views: usize) -> Manifest {
             intensity: 3.0,
             follows_object: None,
             node_path: Some("/Scene/Sun".into()),
+            placed: None,
         },
     ];
     m.bake = BakeSettings {

@@ -537,6 +537,24 @@ pub fn write_pack_with(
         },
         spec.bucket,
     );
+    if spec.materials == Materials::Mirror {
+        // The shading function's light, placed (pack 4.1): the glossy wall's highlight of it
+        // is evaluated at runtime (plenoptic_recon::lamps). The stored non-diffuse texels are
+        // not changed, so this tests that both backends add the same highlight, not the
+        // physics.
+        manifest.lights.push(plenoptic_pack::Light {
+            kind: plenoptic_pack::LightKind::Point,
+            colour: Vec3::ONE,
+            intensity: 3.0,
+            follows_object: None,
+            node_path: None,
+            placed: Some(plenoptic_pack::LightPlacement {
+                position: LIGHT,
+                direction: Vec3::NEG_Y,
+                range: None,
+            }),
+        });
+    }
     if spec.volume_samples > 0 {
         let mut rng = Lcg(7);
         for (v, &pos) in spec.views.iter().enumerate() {

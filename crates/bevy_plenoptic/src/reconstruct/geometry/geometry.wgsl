@@ -41,7 +41,8 @@ struct ViewParams {
     // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
     // frame.
     fill: vec4<f32>,
-    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter).
+    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
+    // y: how many lamps are in use.
     flags: vec4<f32>,
     // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
     sun: vec4<f32>,
@@ -51,6 +52,10 @@ struct ViewParams {
     // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
     // pixel (plenoptic_recon's GLOSSY_RAYS).
     specular: vec4<f32>,
+    // The placed lamps (plenoptic_recon's lamps module), 3 per lamp: position (xyz), range
+    // (w, −1: none); spot axis (xyz), cos outer cone (w, −2: a point light); colour ×
+    // intensity (xyz), 1 / (cos inner − cos outer) (w).
+    lamps: array<vec4<f32>, 12>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y).
@@ -904,9 +909,11 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     return vec4<f32>(0.0);
 }
 
-// The mean radiance over cam.specular.w directions reflected about GGX half-vectors
-// (roughness `alpha`) around `n` seen from `wo`, a Hammersley set turned by `turn`.
-fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -> vec4<f32> {
+// The radiance the glossy lobe (roughness `alpha`, the fragment's material) reflects
+// towards `wo` around `n` (geometric normal `ng`, relative IOR `eta`): cam.specular.w
+// directions reflected about GGX half-vectors, a Hammersley set turned by `turn`, each
+// weighted by F · G · (ω_o·h) / ((n·ω_o)(n·h)) (plenoptic_recon's Bsdf::glossy_weight).
+fn lobe(origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f32, eta: f32, turn: f32) -> vec4<f32> {
     let pair = orthonormal_pair(n);
     var sum = vec3<f32>(0.0);
     var count = 0.0;
@@ -920,12 +927,15 @@ fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -
         let phi = 6.28318530717959 * u2;
         let h = n * cos_h + (pair[0] * cos(phi) + pair[1] * sin(phi)) * sin_h;
         let wi = h * (2.0 * dot(wo, h)) - wo;
-        if dot(wi, n) <= 0.0 {
+        let w = glossy_weight(h, wi, wo, n, ng, alpha, eta);
+        if all(w == vec3<f32>(0.0)) {
+            // Below the surface: no light, but the lobe's share all the same.
+            count += 1.0;
             continue;
         }
         let l = incoming(origin, wi, 0.7 * alpha);
         if l.w > 0.0 {
-            sum += l.rgb;
+            sum += l.rgb * w;
             count += 1.0;
         }
     }
@@ -935,22 +945,81 @@ fn lobe(origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, alpha: f32, turn: f32) -
     return vec4<f32>(0.0);
 }
 
-// The specular lobe's directional albedo at n·ω_o = `cos_in`: the exact Fresnel on ideal
-// mirrors, Karis's split-sum fit on glossy surfaces.
+// plenoptic_recon's Bsdf::glossy_weight for the fragment's material.
+fn glossy_weight(h: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, alpha: f32, eta: f32) -> vec3<f32> {
+    let cos_o = dot(wo, n);
+    let cos_i = dot(wi, n);
+    let cos_h = dot(h, n);
+    if cos_i <= 0.0 || cos_h <= 0.0 || dot(wi, ng) <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let voh = clamp(dot(wo, h), 0.0, 1.0);
+    let m = pixel_metallic;
+    let fr = vec3<f32>((1.0 - m) * fresnel_dielectric(voh, eta)) + fresnel_schlick(pixel_base, voh) * m;
+    let g = smith_g1(alpha, cos_o) * smith_g1(alpha, cos_i);
+    return fr * (g * voh / max(cos_o * cos_h, 1e-8));
+}
+
+// plenoptic_recon's Bsdf::eval_glossy: the GGX reflection lobe alone.
+fn glossy_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, alpha: f32, eta: f32) -> vec3<f32> {
+    let cos_i = dot(wi, n);
+    if cos_i <= 0.0 || dot(wi, ng) <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let h = normalize(wo + wi);
+    let voh = clamp(dot(wo, h), 0.0, 1.0);
+    let m = pixel_metallic;
+    let fr = vec3<f32>((1.0 - m) * fresnel_dielectric(voh, eta)) + fresnel_schlick(pixel_base, voh) * m;
+    let d = ggx_d(alpha, dot(h, n));
+    let g = smith_g1(alpha, dot(wo, n)) * smith_g1(alpha, cos_i);
+    return fr * (d * g / max(4.0 * dot(wo, n) * cos_i, 1e-8));
+}
+
+// The placed lamps' highlights at `p` (plenoptic_recon's lamps::highlights): the glossy lobe
+// × the lamp's irradiance (glTF's spot falloff, nothing beyond its range) × the cosine, each
+// shadowed by a ray against the proxies.
+fn highlights(p: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f32, eta: f32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
+    for (var k = 0u; k < u32(cam.flags.y); k++) {
+        let a = cam.lamps[3u * k];
+        let b = cam.lamps[3u * k + 1u];
+        let c = cam.lamps[3u * k + 2u];
+        let d = a.xyz - p;
+        let dist2 = dot(d, d);
+        let dist = sqrt(dist2);
+        if dist <= 0.0 || (a.w > 0.0 && dist > a.w) {
+            continue;
+        }
+        let wi = d / dist;
+        var value = c.xyz / dist2;
+        if b.w > -1.5 {
+            let att = clamp((dot(b.xyz, -wi) - b.w) * c.w, 0.0, 1.0);
+            value *= att * att;
+        }
+        if all(value == vec3<f32>(0.0)) {
+            continue;
+        }
+        let f = glossy_bsdf(wi, wo, n, ng, alpha, eta);
+        if all(f == vec3<f32>(0.0)) {
+            continue;
+        }
+        let origin = p + select(-ng, ng, dot(wi, ng) >= 0.0) * eps;
+        if has_rays() && occluded(origin, wi, dist - 2.0 * eps) {
+            continue;
+        }
+        sum += f * value * abs(dot(wi, n));
+    }
+    return sum;
+}
+
+// An ideal mirror's reflectance at n·ω_o = `cos_in` (plenoptic_recon's specular::reflectance):
+// the exact Fresnel.
 fn reflectance(cos_in: f32, eta: f32) -> vec3<f32> {
     let cos_o = clamp(cos_in, 1e-4, 1.0);
     let m = pixel_metallic;
-    if pixel_roughness < 0.02 {
-        return vec3<f32>((1.0 - m) * fresnel_dielectric(cos_o, eta))
-            + fresnel_schlick(pixel_base, cos_o) * m;
-    }
-    let f0 = vec3<f32>(pow((eta - 1.0) / (eta + 1.0), 2.0) * (1.0 - m)) + pixel_base * m;
-    let r = pixel_roughness * vec4<f32>(-1.0, -0.0275, -0.572, 0.022)
-        + vec4<f32>(1.0, 0.0425, 1.04, -0.04);
-    let a004 = min(r.x * r.x, exp2(-9.28 * cos_o)) * r.x + r.y;
-    let scale = -1.04 * a004 + r.z;
-    let bias = 1.04 * a004 + r.w;
-    return max(f0 * scale + vec3<f32>(bias), vec3<f32>(0.0));
+    return vec3<f32>((1.0 - m) * fresnel_dielectric(cos_o, eta))
+        + fresnel_schlick(pixel_base, cos_o) * m;
 }
 
 // The reflection at this fragment for the camera: (emission-free specular radiance, 1), or
@@ -968,7 +1037,12 @@ fn reflection(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         let px = vec2<u32>(in.position.xy - view.viewport.xy);
         let j = px.y * u32(view.viewport.z) + px.x;
         let turn = fract(f32(j) * 0.618034);
-        l = lobe(origin, v.n, v.wo, pixel_roughness * pixel_roughness, turn);
+        let alpha = max(pixel_roughness * pixel_roughness, 1e-4);
+        l = lobe(origin, v.n, v.ng, v.wo, alpha, v.eta, turn);
+        if l.w == 0.0 {
+            return l;
+        }
+        return vec4<f32>(l.rgb + highlights(origin, v.n, v.ng, v.wo, alpha, v.eta), 1.0);
     }
     if l.w == 0.0 {
         return l;

@@ -9,13 +9,16 @@
 //!
 //! instead of the baked non-diffuse radiance (`geometry.wgsl`). Glossy lobes march 8 rays
 //! reflected about GGX half-vectors from the same Hammersley set, turned per pixel by the
-//! same golden-ratio sequence; rays that leave the scene see the pack's environment at the
-//! camera's time. Where no lookup answers, the baked non-diffuse radiance stays.
+//! same golden-ratio sequence, each weighted by `F · G · (ω_o·h) / ((n·ω_o)(n·h))`, and add
+//! the highlights of the pack's placed lamps (pack 4.1, `plenoptic_recon::lamps`) with a
+//! shadow ray against the proxies; rays that leave the scene see the pack's environment at
+//! the camera's time. Where no lookup answers, the baked non-diffuse radiance stays.
 //!
 //! The emission is the material's at the fragment's UV (`pixel_emission`), as on the CPU.
 
 use bevy::prelude::*;
 use plenoptic_recon::Specular;
+use plenoptic_recon::lamps::runtime_lamps;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
 use super::view::ViewParams;
@@ -25,6 +28,19 @@ use crate::camera::ReconSettings;
 /// The view buffer's reflection fields on `pack`, as the camera's `settings` ask.
 pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &ReconSettings) {
     let manifest = pack.reader.manifest();
+    let lamps = runtime_lamps(manifest).unwrap_or_default();
+    params.flags.y = lamps.len() as f32;
+    for (k, lamp) in lamps.iter().enumerate() {
+        let (cos_outer, scale) = lamp.cone.unwrap_or((-2.0, 0.0));
+        let range = if lamp.range.is_finite() {
+            lamp.range
+        } else {
+            -1.0
+        };
+        params.lamps[3 * k] = lamp.position.extend(range);
+        params.lamps[3 * k + 1] = lamp.direction.extend(cos_outer);
+        params.lamps[3 * k + 2] = lamp.radiant.extend(scale);
+    }
     params.specular = match settings.specular {
         Specular::Baked => Vec4::ZERO,
         Specular::Marched { max_roughness } => {
@@ -71,6 +87,11 @@ mod tests {
         ] {
             assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
         }
+        let line = format!(
+            "lamps: array<vec4<f32>, {}>,",
+            3 * plenoptic_recon::lamps::MAX_RUNTIME_LAMPS
+        );
+        assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
         let rays = include_str!("rays.wgsl");
         let line = format!("const NO_TRIANGLES: u32 = {NO_TRIANGLES:#x}u;");
         assert!(rays.contains(&line), "rays.wgsl lacks `{line}`");

@@ -34,6 +34,7 @@ use crate::camera::PlenopticCamera;
 use crate::camera::ReconSettings;
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS, background, image};
 use crate::streaming::StreamCache;
+use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 
 /// One camera's lookups and settings, as `geometry.wgsl` reads them (`ViewParams` there).
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
@@ -47,7 +48,7 @@ pub struct ViewParams {
     /// image-mode passes' frame instead (image and volume modes).
     pub fill: Vec4,
     /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
-    /// `CubeFilter::Bilinear` (0: the nearest texel).
+    /// `CubeFilter::Bilinear` (0: the nearest texel); y: how many of `lamps` are in use.
     pub flags: Vec4,
     /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
     pub sun: Vec4,
@@ -57,6 +58,11 @@ pub struct ViewParams {
     /// roughest glossy surface marched (−1: ideal mirrors only), z: how far rays are marched,
     /// w: rays per glossy pixel.
     pub specular: Vec4,
+    /// The lamps whose highlights glossy surfaces add ([`super::reflect`],
+    /// `plenoptic_recon::lamps`), 3 per lamp: position (xyz) and range (w, −1: none);
+    /// spot axis (xyz) and the cosine of its outer cone (w, −2: a point light); colour ×
+    /// intensity (xyz) and `1 / (cos inner − cos outer)` (w). `flags.y` counts them.
+    pub lamps: [Vec4; 3 * MAX_RUNTIME_LAMPS],
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
