@@ -5,6 +5,7 @@ mod common;
 use std::io::Cursor;
 
 use common::*;
+use glam::Vec3;
 use plenoptic_pack::*;
 
 fn small_pack() -> Vec<u8> {
@@ -384,6 +385,50 @@ fn glazing_coverage_outside_zero_to_one_is_refused_and_named() {
     let back = Manifest::from_json(&m.to_json().unwrap()).unwrap();
     assert_eq!(back.objects[0].coverage, Some(0.12));
     assert_eq!(back.objects[1].coverage, None);
+}
+
+#[test]
+fn a_lamp_placed_nowhere_is_refused_and_named() {
+    let placed = |position: Vec3, direction: Vec3, range: Option<f32>| {
+        let mut m = manifest(1);
+        let i = m
+            .lights
+            .iter()
+            .position(|l| l.placed.is_some())
+            .expect("the test manifest places a lamp");
+        m.lights[i].placed = Some(plenoptic_pack::LightPlacement {
+            position,
+            direction,
+            range,
+        });
+        (i, m)
+    };
+    let nan = f32::NAN;
+    for (position, direction, range) in [
+        (Vec3::new(nan, 0.0, 0.0), Vec3::NEG_Y, None),
+        (Vec3::ZERO, Vec3::new(0.0, -3.0, 0.0), None),
+        (Vec3::ZERO, Vec3::ZERO, None),
+        (Vec3::ZERO, Vec3::NEG_Y, Some(0.0)),
+        (Vec3::ZERO, Vec3::NEG_Y, Some(f32::INFINITY)),
+    ] {
+        let (i, m) = placed(position, direction, range);
+        let err = m.validate().unwrap_err().to_string();
+        assert!(err.contains(&format!("light {i}")), "{err}");
+        // A writer refuses it too.
+        let dir = tempfile::tempdir().unwrap();
+        assert!(
+            PackWriter::create(dir.path().join("l.pack"))
+                .unwrap()
+                .finish(&m)
+                .is_err()
+        );
+    }
+    // A good placement survives the JSON round trip; absent reads as not placed.
+    let (i, m) = placed(Vec3::new(1.0, 2.0, 3.0), Vec3::NEG_Y, Some(4.0));
+    m.validate().unwrap();
+    let back = Manifest::from_json(&m.to_json().unwrap()).unwrap();
+    assert_eq!(back.lights[i].placed, m.lights[i].placed);
+    assert!(back.lights.iter().filter(|l| l.placed.is_none()).count() >= 2);
 }
 
 #[test]
