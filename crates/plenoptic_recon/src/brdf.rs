@@ -109,7 +109,7 @@ impl Bsdf {
     /// Lambertian and transmission lobes) for incident direction `wi`: what a lamp's
     /// highlight is ([`crate::lamps`]); zero on ideal surfaces.
     pub fn eval_glossy(&self, wi: Vec3) -> Vec3 {
-        let (wo, n, m) = (self.wo, self.n, &self.m);
+        let (wo, n) = (self.wo, self.n);
         let cos_i = wi.dot(n);
         if self.delta || cos_i <= 0.0 || wi.dot(self.ng) <= 0.0 {
             return Vec3::ZERO;
@@ -118,12 +118,17 @@ impl Bsdf {
         if h == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        let voh = wo.dot(h).clamp(0.0, 1.0);
-        let fd = fresnel_dielectric(voh, self.eta);
         let d = ggx_d(self.alpha, h.dot(n));
         let g = smith_g1(self.alpha, wo.dot(n)) * smith_g1(self.alpha, cos_i);
-        let fr = Vec3::splat((1.0 - m.metallic) * fd) + fresnel_schlick(m.base, voh) * m.metallic;
-        fr * (d * g / (4.0 * wo.dot(n) * cos_i).max(1e-8))
+        self.glossy_fresnel(wo.dot(h)) * (d * g / (4.0 * wo.dot(n) * cos_i).max(1e-8))
+    }
+
+    /// The glossy lobe's Fresnel term at `ω_o·h`: the exact dielectric one for the
+    /// non-metallic part, Schlick's with the base colour for the metallic part.
+    fn glossy_fresnel(&self, voh: f32) -> Vec3 {
+        let (m, voh) = (&self.m, voh.clamp(0.0, 1.0));
+        Vec3::splat((1.0 - m.metallic) * fresnel_dielectric(voh, self.eta))
+            + fresnel_schlick(m.base, voh) * m.metallic
     }
 
     /// The glossy lobe's weight `f · cos θ_i / pdf` for a direction `wi` reflected about the
@@ -131,16 +136,14 @@ impl Bsdf {
     /// ((n·ω_o)(n·h))`. The mean of these weights times the radiance from `wi` estimates the
     /// lobe's reflected radiance without bias ([`crate::specular`]).
     pub fn glossy_weight(&self, h: Vec3, wi: Vec3) -> Vec3 {
-        let (wo, n, m) = (self.wo, self.n, &self.m);
+        let (wo, n) = (self.wo, self.n);
         let (cos_o, cos_i, cos_h) = (wo.dot(n), wi.dot(n), h.dot(n));
         if cos_i <= 0.0 || cos_h <= 0.0 || wi.dot(self.ng) <= 0.0 {
             return Vec3::ZERO;
         }
         let voh = wo.dot(h).clamp(0.0, 1.0);
-        let fd = fresnel_dielectric(voh, self.eta);
-        let fr = Vec3::splat((1.0 - m.metallic) * fd) + fresnel_schlick(m.base, voh) * m.metallic;
         let g = smith_g1(self.alpha, cos_o) * smith_g1(self.alpha, cos_i);
-        fr * (g * voh / (cos_o * cos_h).max(1e-8))
+        self.glossy_fresnel(voh) * (g * voh / (cos_o * cos_h).max(1e-8))
     }
 
     /// The BSDF's value for incident direction `wi` (unit, away from the surface).
@@ -160,14 +163,7 @@ impl Bsdf {
             }
             let voh = wo.dot(h).clamp(0.0, 1.0);
             let fd = fresnel_dielectric(voh, self.eta);
-            let mut f = m.base * ((1.0 - metal) * (1.0 - tr) * (1.0 - fd) / PI);
-            if !self.delta {
-                let d = ggx_d(self.alpha, h.dot(n));
-                let g = smith_g1(self.alpha, cos_o) * smith_g1(self.alpha, cos_i);
-                let fr = Vec3::splat((1.0 - metal) * fd) + fresnel_schlick(m.base, voh) * metal;
-                f += fr * (d * g / (4.0 * cos_o * cos_i).max(1e-8));
-            }
-            f
+            m.base * ((1.0 - metal) * (1.0 - tr) * (1.0 - fd) / PI) + self.eval_glossy(wi)
         } else if m.thin_walled && !self.delta && tr > 0.0 && metal < 1.0 {
             // The microfacet reflection mirrored through the wall's plane.
             let wr = wi - n * (2.0 * cos_i);

@@ -70,8 +70,9 @@ pub enum Specular {
     Baked,
     /// Surfaces without transmission reflect for the actual camera, marched through the
     /// distance cubes ([`crate::specular`]): ideal mirrors always, glossy surfaces whose
-    /// perceptual roughness is at most `max_roughness` when no punctual light's highlight is
-    /// baked ([`glossy_allowed`]); the others keep [`Specular::Baked`]. Costs a march per
+    /// perceptual roughness is at most `max_roughness` when every punctual light's highlight
+    /// is evaluated at runtime ([`glossy_allowed`]: the runtime sun's, placed lamps'); the
+    /// others keep [`Specular::Baked`]. Costs a march per
     /// (view, key) and ray (up to [`MAX_STEPS`] cube lookups each; [`GLOSSY_RAYS`] rays on
     /// glossy surfaces).
     Marched {
