@@ -248,7 +248,8 @@ fn run(options: &Options) -> Result<(), BoxError> {
     }
     let mut pack = options.pack.clone().unwrap_or(recipe.output.clone());
     // A pack of an older format is baked again (version 1 cannot be read; version 2 keeps
-    // the sun in its lighting, which version 3 evaluates at runtime); the new pack replaces it
+    // the sun in its lighting, which version 3 evaluates at runtime; 4.0 does not place its
+    // lamps, so its glossy surfaces keep their baked highlights); the new pack replaces it
     // only once it is complete.
     let outdated = pack.exists() && plenoptic_pack::is_outdated(&pack);
     if outdated {

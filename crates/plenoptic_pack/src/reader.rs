@@ -592,13 +592,17 @@ fn validate_entries(
     Ok(index)
 }
 
-/// Whether the pack at `path` is of an older major format than this crate writes: one it
-/// refuses (version 1, [`PackError::NeedsRebake`]) or one it reads but a bake would improve
-/// (version 2 keeps the sun's direct light in its lighting). A file that cannot be opened for
-/// another reason is not outdated (opening it reports that).
+/// Whether the pack at `path` is of an older format than this crate writes: one it refuses
+/// (version 1, [`PackError::NeedsRebake`]) or one it reads but a bake would improve (version
+/// 2 keeps the sun's direct light in its lighting; 4.0 does not place its lamps, so glossy
+/// surfaces keep the highlights the base views saw). A newer minor is not outdated. A file
+/// that cannot be opened for another reason is not outdated (opening it reports that).
 pub fn is_outdated(path: impl AsRef<Path>) -> bool {
     match PackReader::open(path) {
-        Ok(r) => r.header().version_major < crate::VERSION_MAJOR,
+        Ok(r) => {
+            let h = r.header();
+            (h.version_major, h.version_minor) < (crate::VERSION_MAJOR, crate::VERSION_MINOR)
+        }
         Err(e) => matches!(e, PackError::NeedsRebake { .. }),
     }
 }

@@ -432,17 +432,27 @@ fn a_lamp_placed_nowhere_is_refused_and_named() {
 }
 
 #[test]
-fn older_majors_are_outdated() {
+fn older_formats_are_outdated() {
     let dir = tempfile::tempdir().unwrap();
-    for (major, outdated) in [(1, true), (2, true), (3, true), (4, false)] {
+    for (major, minor, outdated) in [
+        (1, 0, true),
+        (2, 0, true),
+        (3, 2, true),
+        (4, 0, true),
+        (4, 1, false),
+        (4, 7, false),
+    ] {
         let mut b = small_pack();
-        rewrite_header(&mut b, |h| h.version_major = major);
-        let path = dir.path().join(format!("v{major}.pack"));
+        rewrite_header(&mut b, |h| {
+            h.version_major = major;
+            h.version_minor = minor;
+        });
+        let path = dir.path().join(format!("v{major}.{minor}.pack"));
         std::fs::write(&path, &b).unwrap();
         assert_eq!(
             plenoptic_pack::is_outdated(&path),
             outdated,
-            "major {major}"
+            "version {major}.{minor}"
         );
     }
     assert!(!plenoptic_pack::is_outdated(
