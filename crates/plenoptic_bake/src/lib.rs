@@ -16,7 +16,8 @@
 //!   validity radii; [`denoise`]: the edge-aware à-trous filter of the range images' diffuse
 //!   lighting (demodulated by albedo, seam-aware, guided by id, normal and distance).
 //! - [`write`](mod@write): chunks, proxy geometry, animation tracks, manifest and statistics; the pack is
-//!   assembled in a canonical order.
+//!   assembled in a canonical order. [`lights`]: the manifest's lights, with the place of
+//!   each lamp that never moves (pack 4.1).
 //! - [`work`]: the work directory that makes bakes resumable and shardable, and merging.
 //! - [`bake`](mod@bake): the whole pipeline; [`progress`]: progress bars with ETA;
 //!   [`reference`](mod@reference): path-traced reference frames along a camera path.
@@ -86,6 +87,7 @@ pub mod daylight;
 pub mod denoise;
 pub mod error;
 pub mod input;
+pub mod lights;
 pub mod materials;
 pub mod plan;
 pub mod progress;

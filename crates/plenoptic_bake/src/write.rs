@@ -24,10 +24,10 @@ use std::path::{Path, PathBuf};
 
 use plenoptic_pack::{
     Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, DirectSun,
-    EnvironmentEntry, Interpolation, Light, LightKind, LightPlacement, Manifest, Motion,
-    ObjectEntry, ObjectTracks, PackWriter, ProxyMesh, RangeImage, TimeRange, Track, ViewSpace,
-    VolumeSample, decode_volume_block, encode_connectivity, encode_distance, encode_normal,
-    encode_object_id, encode_radiance, encode_volume_block,
+    EnvironmentEntry, Interpolation, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter,
+    ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block,
+    encode_connectivity, encode_distance, encode_normal, encode_object_id, encode_radiance,
+    encode_volume_block,
 };
 use plenoptic_scene::Scene;
 use plenoptic_trace::SceneAccel;
@@ -337,29 +337,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
             }
         })
         .collect();
-    m.lights = scene
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| Light {
-            kind: match l.kind {
-                plenoptic_scene::LightKind::Point => LightKind::Point,
-                plenoptic_scene::LightKind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                } => LightKind::Spot {
-                    inner_cone: inner_cone_angle,
-                    outer_cone: outer_cone_angle,
-                },
-                plenoptic_scene::LightKind::Directional => LightKind::Directional,
-            },
-            colour: l.color,
-            intensity: l.intensity,
-            follows_object: None,
-            node_path: scene.nodes.get(l.node).map(|n| n.name.clone()),
-            placed: light_placement(scene, i),
-        })
-        .collect();
+    m.lights = crate::lights::manifest_lights(scene);
     let mut extra = BTreeMap::new();
     extra.insert("recipe".into(), plan.recipe.clone());
     extra.insert(
@@ -554,25 +532,6 @@ pub fn timings_path(output: &Path) -> PathBuf {
     let mut name = output.as_os_str().to_owned();
     name.push(".timings.json");
     PathBuf::from(name)
-}
-
-/// Where scene light `i` shines from, for the runtime's highlights (pack 4.1): point and spot
-/// lights whose node never moves; `None` for the others.
-fn light_placement(scene: &plenoptic_scene::Scene, i: usize) -> Option<LightPlacement> {
-    let l = &scene.lights[i];
-    let punctual = matches!(
-        l.kind,
-        plenoptic_scene::LightKind::Point | plenoptic_scene::LightKind::Spot { .. }
-    );
-    if !punctual || scene.node_is_animated(l.node) {
-        return None;
-    }
-    let placed = scene.placed_light(i, 0.0);
-    Some(LightPlacement {
-        position: placed.position,
-        direction: placed.direction,
-        range: l.range.filter(|r| r.is_finite() && *r > 0.0),
-    })
 }
 
 #[cfg(test)]
