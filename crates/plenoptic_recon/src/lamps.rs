@@ -24,7 +24,7 @@ use glam::Vec3;
 use plenoptic_pack::{LightKind, Manifest};
 
 use crate::brdf::Bsdf;
-use crate::shadow::PlacedShadows;
+use crate::shadow::{PlacedShadows, shadow_lift};
 
 /// Most lamps whose highlights are evaluated per pixel (the GPU's view buffer holds this
 /// many). A pack with more keeps its glossy surfaces baked.
@@ -108,7 +108,6 @@ pub fn highlights(
     shadows: Option<&PlacedShadows>,
 ) -> Vec3 {
     let n = bsdf.normal();
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
     let mut sum = Vec3::ZERO;
     for lamp in lamps {
         let Some((wi, dist, irradiance)) = lamp.towards(p) else {
@@ -118,12 +117,8 @@ pub fn highlights(
         if f == Vec3::ZERO {
             continue;
         }
-        let origin = if wi.dot(ng) >= 0.0 {
-            p + ng * eps
-        } else {
-            p - ng * eps
-        };
-        if shadows.is_some_and(|s| s.occluded(origin, wi, dist - 2.0 * eps)) {
+        let lift = shadow_lift(p, ng, wi);
+        if shadows.is_some_and(|s| s.occluded(p + lift, wi, dist - 2.0 * lift.length())) {
             continue;
         }
         sum += f * irradiance * wi.dot(n).abs();

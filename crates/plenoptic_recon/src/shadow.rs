@@ -138,6 +138,18 @@ impl ShadowScene {
     }
 }
 
+/// How far off a surface point `p` (geometric normal `ng`, either side) a shadow ray towards
+/// `wi` starts: 10⁻⁴ · (1 + |p|∞) along the normal, on `wi`'s side, as the path tracer's
+/// `Hit::offset_origin` offsets it (the runtime sun's and the lamps' rays).
+pub fn shadow_lift(p: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    if wi.dot(ng) >= 0.0 {
+        ng * eps
+    } else {
+        -ng * eps
+    }
+}
+
 impl PlacedShadows<'_> {
     /// Whether anything lies along the ray from `origin` along unit `dir` closer than
     /// `tmax`.

@@ -42,7 +42,7 @@ use plenoptic_pack::plenoptic_sky::SunTrack;
 
 use crate::brdf::Bsdf;
 use crate::proxy::ProxyGeometry;
-use crate::shadow::{PlacedShadows, ShadowScene};
+use crate::shadow::{PlacedShadows, ShadowScene, shadow_lift};
 
 /// Largest number of shadow rays per pixel a setting may ask for.
 pub const MAX_SUN_RAYS: u32 = 64;
@@ -165,12 +165,7 @@ impl PlacedSun<'_> {
         if f == Vec3::ZERO {
             return Some(Vec3::ZERO);
         }
-        let eps = 1e-4 * (1.0 + p.abs().max_element());
-        let lift = if wi.dot(ng) >= 0.0 {
-            ng * eps
-        } else {
-            -ng * eps
-        };
+        let lift = shadow_lift(p, ng, wi);
         let open = |uv: Vec2| {
             let q = p + footprint.0 * uv.x + footprint.1 * uv.y;
             !self.shadows.occluded(q + lift, wi, 1e9)
@@ -203,7 +198,6 @@ impl PlacedSun<'_> {
             turn,
             shift,
         } = *rays;
-        let eps = 1e-4 * (1.0 + p.abs().max_element());
         let mut out = Estimate {
             sum: Vec3::ZERO,
             blocked: 0,
@@ -223,12 +217,7 @@ impl PlacedSun<'_> {
                 let v = (shift + k as f32 * 0.569_840_3).fract() - 0.5;
                 p + footprint.0 * u + footprint.1 * v
             };
-            let origin = if wi.dot(ng) >= 0.0 {
-                q + ng * eps
-            } else {
-                q - ng * eps
-            };
-            if self.shadows.occluded(origin, wi, 1e9) {
+            if self.shadows.occluded(q + shadow_lift(p, ng, wi), wi, 1e9) {
                 out.blocked += 1;
                 continue;
             }

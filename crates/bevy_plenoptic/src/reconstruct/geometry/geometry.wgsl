@@ -751,14 +751,11 @@ fn sun_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32)
         let h = normalize(wo + wi);
         let voh = clamp(dot(wo, h), 0.0, 1.0);
         let fd = fresnel_dielectric(voh, eta);
-        var f = pixel_base * ((1.0 - m) * (1.0 - tr) * (1.0 - fd) / PI);
-        if !delta {
-            let d = ggx_d(alpha, dot(h, n));
-            let g = smith_g1(alpha, cos_o) * smith_g1(alpha, cos_i);
-            let fr = vec3<f32>((1.0 - m) * fd) + fresnel_schlick(pixel_base, voh) * m;
-            f += fr * (d * g / max(4.0 * cos_o * cos_i, 1e-8));
+        let f = pixel_base * ((1.0 - m) * (1.0 - tr) * (1.0 - fd) / PI);
+        if delta {
+            return f;
         }
-        return f;
+        return f + glossy_bsdf(wi, wo, n, ng, alpha, eta);
     }
     if delta || tr <= 0.0 || m >= 1.0 {
         return vec3<f32>(0.0);
@@ -954,10 +951,15 @@ fn glossy_weight(h: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: v
         return vec3<f32>(0.0);
     }
     let voh = clamp(dot(wo, h), 0.0, 1.0);
-    let m = pixel_metallic;
-    let fr = vec3<f32>((1.0 - m) * fresnel_dielectric(voh, eta)) + fresnel_schlick(pixel_base, voh) * m;
     let g = smith_g1(alpha, cos_o) * smith_g1(alpha, cos_i);
-    return fr * (g * voh / max(cos_o * cos_h, 1e-8));
+    return glossy_fresnel(voh, eta) * (g * voh / max(cos_o * cos_h, 1e-8));
+}
+
+// The glossy lobe's Fresnel term at ω_o·h (plenoptic_recon's Bsdf::glossy_fresnel): the exact
+// dielectric one for the non-metallic part, Schlick's with the base colour for the metallic.
+fn glossy_fresnel(voh: f32, eta: f32) -> vec3<f32> {
+    let m = pixel_metallic;
+    return vec3<f32>((1.0 - m) * fresnel_dielectric(voh, eta)) + fresnel_schlick(pixel_base, voh) * m;
 }
 
 // plenoptic_recon's Bsdf::eval_glossy: the GGX reflection lobe alone.
@@ -968,11 +970,9 @@ fn glossy_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, alpha:
     }
     let h = normalize(wo + wi);
     let voh = clamp(dot(wo, h), 0.0, 1.0);
-    let m = pixel_metallic;
-    let fr = vec3<f32>((1.0 - m) * fresnel_dielectric(voh, eta)) + fresnel_schlick(pixel_base, voh) * m;
     let d = ggx_d(alpha, dot(h, n));
     let g = smith_g1(alpha, dot(wo, n)) * smith_g1(alpha, cos_i);
-    return fr * (d * g / max(4.0 * dot(wo, n) * cos_i, 1e-8));
+    return glossy_fresnel(voh, eta) * (d * g / max(4.0 * dot(wo, n) * cos_i, 1e-8));
 }
 
 // The placed lamps' highlights at `p` (plenoptic_recon's lamps::highlights): the glossy lobe
