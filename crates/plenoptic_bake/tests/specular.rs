@@ -115,7 +115,7 @@ fn region_error(
 }
 
 /// Per specular mode: (mirror, steel, diffuse) corrected relative LRMS over all their
-/// pixels, and over those at least 2 px inside their object's outline; the reconstruction
+/// pixels, and over those whose 8 neighbours show the same object; the reconstruction
 /// at `supersampling`² samples per pixel.
 fn measure(
     lamp: bool,
@@ -179,7 +179,8 @@ fn measure(
         // The pixels whose 3 × 3 neighbourhood shows their object alone. At an outline the
         // path tracer's pixel mixes two surfaces and, below 2 × 2 supersampling, this one
         // shows the centre's: an error of every object's outline, whatever its material
-        // (it more than doubled the diffuse pixels' error at 160 × 90).
+        // (at 160 × 90 it raised the diffuse pixels' error by about 40 %, 0.066 → 0.094 under
+        // the sun: their squared error doubled).
         let (w, h) = (width as usize, height as usize);
         let inside = |j: usize| {
             let (x, y) = (j % w, j / w);

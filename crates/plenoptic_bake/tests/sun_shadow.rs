@@ -137,9 +137,8 @@ fn errors(
     // the outline the path tracer's pixels mix the floor with what lies behind it, and this
     // reconstruction shows one surface per pixel (it does not antialias geometry): that
     // error is the same whether the sun is there or not, and kept in, it dominated both
-    // regions (the
-    // floor's far edge runs through the band where the shadow meets it, and measured the
-    // rest of the floor at 0.018 instead of 0.002).
+    // regions (the floor's far edge runs through the band where the shadow meets it, and
+    // it measured the rest of the floor at 0.018 instead of 0.002).
     let inside = |j: usize| window(j).count() == 25 && window(j).all(|k| lit[k].is_some());
     let floor_px: Vec<usize> = (0..w * h).filter(|&j| inside(j)).collect();
     // Squared errors against the reference's halves, per region, with the reference's
