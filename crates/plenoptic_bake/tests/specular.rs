@@ -287,7 +287,13 @@ fn mirror_and_steel_reflect_for_the_camera() {
         mirror_m < 3.0 * diffuse,
         "sun: mirror {mirror_m}, diffuse {diffuse}"
     );
-    assert!(steel_m < 0.9 * steel_b, "sun: steel {steel_b} -> {steel_m}");
+    // 0.213 -> 0.181 while the baked specular was looked up at every pixel; interpolated
+    // between the lighting pass's anchors (geometry/sparse.rs) the baked highlight's texels
+    // blur a little and its error fell to 0.194. The marched 0.181 did not change.
+    assert!(
+        steel_m < 0.95 * steel_b,
+        "sun: steel {steel_b} -> {steel_m}"
+    );
     let ([mirror_b, steel_b, _], [mirror_m, steel_m, diffuse]) = (lamp[0], lamp[1]);
     assert!(
         mirror_m < 0.6 * mirror_b,

@@ -42,9 +42,13 @@ use crate::reconstructor::{CubeFilter, KeyCubes, Reconstructor};
 use crate::shading::Channel;
 use crate::temporal::bracketing;
 use crate::volume::VolumeIndex;
-use crate::{Error, Result, sample};
+use crate::{Error, Result};
 
 mod fill;
+mod rows;
+mod sparse;
+
+use rows::{Rows, lookup_some};
 
 struct ViewKey {
     /// Base view and time key indices.
@@ -95,6 +99,9 @@ pub(crate) struct Pass<'a> {
     /// Where no proxy is, the environment: the heaviest key's cube of this channel read with
     /// this filter (`None`: the pass's own channel and filter).
     pub environment: Option<(Channel, CubeFilter)>,
+    /// Look up a quarter of the pixels and interpolate between them where that stands for the
+    /// others' lookups (sparse.rs): for a channel smooth at cube resolution (the lighting).
+    pub sparse: bool,
 }
 
 /// What [`render_pair`] renders.
@@ -107,6 +114,10 @@ pub(crate) struct PairFrame {
     /// Whether the environment's cube could be read (pixels where nothing is are black
     /// otherwise).
     pub environment: bool,
+    /// Where the pass rasterized the proxies with their triangles (a sparse pass): the
+    /// projected triangles and each pixel's triangle (index into their sources; `u32::MAX`:
+    /// none), for the surfaces of the same pixels ([`crate::surface`]).
+    pub triangles: Option<(crate::raster::Projected, Vec<u32>)>,
 }
 
 impl<'a> Pass<'a> {
@@ -119,6 +130,7 @@ impl<'a> Pass<'a> {
             filter,
             second: None,
             environment: None,
+            sparse: false,
         }
     }
 }
@@ -156,6 +168,7 @@ pub(crate) fn render_pair(
         filter,
         second,
         environment,
+        sparse,
     } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
@@ -335,6 +348,31 @@ pub(crate) fn render_pair(
         bilinear,
     };
     let band = ROWS * w.max(1);
+    let rows = Rows {
+        basis: &basis,
+        source: &source,
+        slot_of: &slot_of,
+        skipped: &skipped,
+        env: env.as_deref(),
+        env_bilinear,
+        width: w,
+    };
+    // Sparse: the anchors' lookups first, at half resolution (sparse.rs), the mask
+    // rasterized on the way (its depths become distances along the rays).
+    let sparse = match &source {
+        MaskSource::Raster(tris) if sparse && fast.len() <= 16 => Some(tris),
+        _ => None,
+    };
+    let mut prims: Vec<u32> = Vec::new();
+    let anchors = sparse.map(|tris| {
+        let pass = sparse::AnchorPass {
+            tris,
+            rows: &rows,
+            shade: &shade,
+            band,
+        };
+        pass.run(&mut frame.depth, &mut frame.object, &mut prims)
+    });
     // The second colour's band, where there is one.
     let bands2 = if second.is_some() {
         Either::Left(plane2.par_chunks_mut(band).map(Some))
@@ -350,85 +388,61 @@ pub(crate) fn render_pair(
         .zip(bands2)
         .enumerate()
         .for_each_init(
-            Scratch::default,
-            |s, (i, ((((rad, dep), obj), cls), mut rad2))| {
+            || (Scratch::default(), Scratch::default(), Vec::new()),
+            |(s, packed, xs), (i, ((((rad, dep), obj), cls), mut rad2))| {
                 let y0 = i * ROWS;
-                if let MaskSource::Raster(tris) = &source {
+                if let (MaskSource::Raster(tris), None) = (&source, &anchors) {
                     // Camera-space depth into `dep`, object into `obj`.
                     crate::raster::raster_band(tris, w, y0, dep, obj, None);
                 }
-                let rows = rad
+                let lines = rad
                     .chunks_mut(w)
                     .zip(dep.chunks_mut(w))
                     .zip(obj.chunks_mut(w))
                     .zip(cls.chunks_mut(w));
-                for (r, (((rad, dep), obj), cls)) in rows.enumerate() {
+                for (r, (((rad, dep), obj), cls)) in lines.enumerate() {
                     let y = y0 + r;
-                    s.resize(w);
-                    s.directions(&basis, y, w);
-                    // The hit point of every pixel of the row.
-                    match &source {
-                        MaskSource::Raster(_) => {
-                            for (z, &o) in dep.iter_mut().zip(obj.iter()) {
-                                if o == 0 {
-                                    *z = f32::INFINITY;
+                    let mut row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
+                    if anchors.is_some() {
+                        s.slot.resize(w, NO_SLOT);
+                        rows.slots(&mut s.slot, y, obj, Some((rad, cls)));
+                    } else {
+                        rows.prepare(s, y, dep, obj, Some((rad, cls)));
+                    }
+                    // Each pixel's lookup, or the anchors' where they stand for it.
+                    xs.clear();
+                    for x in (0..w).filter(|&x| s.slot[x] != NO_SLOT) {
+                        let between = anchors
+                            .as_ref()
+                            .and_then(|a| a.interpolate(x, y, obj[x], dep[x], tol));
+                        match between {
+                            Some((c, c2)) => {
+                                rad[x] = c;
+                                if let Some(row2) = row2.as_deref_mut() {
+                                    row2[x] = c2;
                                 }
+                                cls[x] = DIRECT;
                             }
-                            s.points_from_depth(&basis, dep);
-                        }
-                        MaskSource::Mask(m) => {
-                            for x in 0..w {
-                                let o = m.object[y * w + x];
-                                if o != 0 {
-                                    obj[x] = o;
-                                    dep[x] = m.depth[y * w + x];
-                                }
-                                s.set_p(x, m.position[y * w + x]);
-                            }
-                            s.eye_directions(basis.position, w);
+                            None => xs.push(x),
                         }
                     }
-                    for x in 0..w {
-                        let o = obj[x];
-                        s.slot[x] = NO_SLOT;
-                        if o == 0 {
-                            cls[x] = NONE;
-                            if let Some(env) = &env {
-                                rad[x] = if env_bilinear {
-                                    sample::bilinear(env, s.dir_at(x))
-                                } else {
-                                    env.texels[sample::texel(env.face_size, s.dir_at(x))]
-                                };
-                            }
-                            continue;
-                        }
-                        match slot_of.get(o) {
-                            Some(slot) if !skipped[slot] => s.slot[x] = slot as u32,
-                            _ => cls[x] = NONE,
-                        }
-                    }
-                    shade.row(s, obj);
-                    let row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
-                    if let Some(row2) = row2 {
-                        let sums = s.slot.iter().zip(&s.sum).zip(&s.sum2);
-                        for (out, ((&slot, c), c2)) in row2.iter_mut().zip(sums) {
-                            if slot != NO_SLOT && c.w > 0.0 {
-                                *out = *c2 / c.w;
-                            }
-                        }
-                    }
-                    for x in 0..w {
-                        if s.slot[x] == NO_SLOT {
-                            continue;
-                        }
-                        let c = s.sum[x];
+                    let lanes = if anchors.is_some() && !xs.is_empty() {
+                        packed.gather_rays(&basis, y, xs, dep, &s.slot);
+                        &mut *packed
+                    } else {
+                        &mut *s
+                    };
+                    lookup_some(&shade, lanes, anchors.is_some(), xs, obj, |_, x, c, c2| {
                         if c.w > 0.0 {
                             rad[x] = c.truncate() / c.w;
+                            if let Some(row2) = row2.as_deref_mut() {
+                                row2[x] = c2 / c.w;
+                            }
                             cls[x] = DIRECT;
                         } else {
                             cls[x] = HOLE;
                         }
-                    }
+                    });
                 }
             },
         );
@@ -487,10 +501,15 @@ pub(crate) fn render_pair(
     let count = |c: u8| class.iter().filter(|&&x| x == c).count();
     report.fallback =
         FallbackReport::from_counts(count(DIRECT), count(VOLUME), hole, background, count(NONE));
+    let triangles = match source {
+        MaskSource::Raster(tris) if anchors.is_some() => Some((tris, prims)),
+        _ => None,
+    };
     Ok(PairFrame {
         frame,
         second: plane2,
         environment: env.is_some(),
+        triangles,
     })
 }
 

@@ -49,6 +49,7 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
             filter,
             second,
             environment: None,
+            sparse: false,
         };
         let mut report = Report::default();
         let pair = geometry::render_pair(
@@ -113,6 +114,7 @@ fn a_pass_shows_the_environment_of_the_channel_asked_for() {
                 filter: CubeFilter::Bilinear,
                 second: Some(Channel::NonDiffuse),
                 environment: Some((Channel::Radiance, filter)),
+                sparse: false,
             },
             &mut report,
         )
@@ -147,4 +149,70 @@ fn a_pass_shows_the_environment_of_the_channel_asked_for() {
                 .any(|&j| radiance.radiance[j].max_element() > 0.0)
         );
     }
+}
+
+/// The lighting looked up at a quarter of the pixels and interpolated where the lookups
+/// agree (geometry/sparse.rs) is the lighting looked up at every pixel, within 0.3 % on
+/// average and 5 % at any pixel (measured: 0.003 % and 0.9 % for the lighting, 0.14 % and
+/// 2.9 % for the non-diffuse radiance), with the same objects and fallbacks; and more than a
+/// third of the pixels were interpolated (their values changed).
+#[test]
+fn sparse_lighting_agrees_with_every_pixel() {
+    let (_dir, rec) = textured_pack(&room(true));
+    let camera = Camera::look_at(
+        Vec3::new(0.3, 1.2, 0.8),
+        Vec3::new(-0.2, 0.7, -2.0),
+        Vec3::Y,
+        1.2,
+        160,
+        120,
+    )
+    .unwrap();
+    let render = |sparse| {
+        let pass = Pass {
+            layer: Layer::All,
+            channel: Channel::Lighting,
+            skip: &[],
+            filter: CubeFilter::Bilinear,
+            second: Some(Channel::NonDiffuse),
+            environment: None,
+            sparse,
+        };
+        let mut report = Report::default();
+        let pair = geometry::render_pair(&rec, &camera, 0.6, None, pass, &mut report).unwrap();
+        (pair, report.fallback)
+    };
+    let ((dense, dense_fallback), (sparse, sparse_fallback)) = (render(false), render(true));
+    assert_eq!(dense.frame.object, sparse.frame.object);
+    for (a, b) in dense.frame.depth.iter().zip(&sparse.frame.depth) {
+        assert!(a == b || (a - b).abs() <= 1e-5 * a, "{a} {b}");
+    }
+    for (a, b) in [
+        (&dense.frame.radiance, &sparse.frame.radiance),
+        (&dense.second, &sparse.second),
+    ] {
+        let (mut diff, mut total, mut worst, mut changed) = (0.0f64, 0.0f64, 0.0f32, 0);
+        for (x, y) in a.iter().zip(b.iter()) {
+            let d = (*x - *y).abs().max_element();
+
+            diff += d as f64;
+            total += x.max_element() as f64;
+            worst = worst.max(d / (x.max_element() + 0.02));
+            changed += usize::from(d > 0.0);
+        }
+        let mean = diff / total;
+        assert!(mean < 0.003, "mean relative difference {mean}");
+        assert!(worst < 0.05, "largest relative difference {worst}");
+        eprintln!(
+            "mean {mean}, largest {worst}, {changed} of {} changed",
+            a.len()
+        );
+        assert!(
+            changed > a.len() / 3,
+            "{changed} of {} interpolated",
+            a.len()
+        );
+    }
+    let (d, s) = (dense_fallback, sparse_fallback);
+    assert!((d.direct - s.direct).abs() < 0.01, "{d:?} {s:?}");
 }

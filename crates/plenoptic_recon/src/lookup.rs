@@ -118,6 +118,9 @@ pub(crate) struct Scratch {
     pub sum: Vec<Vec4>,
     /// Weighted sum of the keys' second colours (same weights as `sum`).
     pub sum2: Vec<Vec3>,
+    /// Which keys' lookups were accepted: bit 2k for key k, bit 2k + 1 where all four of its
+    /// bilinear taps were (keys from the 16th on share the last two bits).
+    pub accepted: Vec<u32>,
 }
 
 impl Scratch {
@@ -139,6 +142,39 @@ impl Scratch {
         self.fy.resize(n, 0.0);
         self.sum.resize(n, Vec4::ZERO);
         self.sum2.resize(n, Vec3::ZERO);
+        self.accepted.resize(n, 0);
+    }
+
+    /// Makes this scratch hold the pixels `xs` of row `y` side by side (lane `i` is pixel
+    /// `xs[i]`): their unit ray directions, hit points at distances `dist` along the rays,
+    /// eye directions, and slots from `slots`.
+    pub fn gather_rays(
+        &mut self,
+        b: &CameraBasis,
+        y: usize,
+        xs: &[usize],
+        dist: &[f32],
+        slots: &[u32],
+    ) {
+        let n = xs.len();
+        self.resize(n);
+        let o = b.position;
+        for (i, &x) in xs.iter().enumerate() {
+            let d = b.direction(x as f32 + 0.5, y as f32 + 0.5);
+            let p = o + d * dist[x];
+            let e = (o - p).normalize_or_zero();
+            for (c, (dc, pc, ec)) in [(d.x, p.x, e.x), (d.y, p.y, e.y), (d.z, p.z, e.z)]
+                .into_iter()
+                .enumerate()
+            {
+                self.dir[c][i] = dc;
+                self.p[c][i] = pc;
+                self.e[c][i] = ec;
+            }
+            self.slot[i] = slots[x];
+        }
+        // The padding of the last group of four looks nothing up.
+        self.slot[n..].fill(NO_SLOT);
     }
 
     /// The unit ray directions of row `y` (what [`CameraBasis::direction`] gives at the pixel
@@ -171,12 +207,6 @@ impl Scratch {
             dy[x] = ry * r;
             dz[x] = rz * r;
         }
-    }
-
-    /// The direction of pixel `x` as a vector.
-    #[inline]
-    pub fn dir_at(&self, x: usize) -> Vec3 {
-        Vec3::new(self.dir[0][x], self.dir[1][x], self.dir[2][x])
     }
 
     /// Hit points from camera-space depths `z` (∞: none): writes the distance along the ray
@@ -251,9 +281,10 @@ impl Shade<'_> {
         let n = obj.len();
         s.sum[..n].fill(Vec4::ZERO);
         s.sum2[..n].fill(Vec3::ZERO);
+        s.accepted[..n].fill(0);
         for (ki, k) in self.fast.iter().enumerate() {
             self.lookups(s, k, ki == 0, n);
-            self.accumulate(s, k, obj);
+            self.accumulate(s, k, obj, 2 * ki.min(15) as u32);
         }
     }
 
@@ -376,7 +407,7 @@ impl Shade<'_> {
 
     /// Tests the current lookups of key `k` and adds the accepted ones to the sums.
     #[inline(never)]
-    fn accumulate(&self, s: &mut Scratch, k: &FastKey<'_>, obj: &[u32]) {
+    fn accumulate(&self, s: &mut Scratch, k: &FastKey<'_>, obj: &[u32], bit: u32) {
         let n = obj.len();
         let tol = self.tol;
         let (ti, dist, wa) = (&s.ti[..n], &s.dist[..n], &s.wa[..n]);
@@ -406,6 +437,7 @@ impl Shade<'_> {
                 }
             }
             // The colour and, with a second colour, that one with the same weights.
+            let mut whole = !self.bilinear;
             let (radiance, second) = if !self.bilinear {
                 (tx.radiance, k.second.and_then(|c| c.get(t).copied()))
             } else if tap[x] != NO_TEXEL {
@@ -428,6 +460,10 @@ impl Shade<'_> {
                     (i + n, w(&b[0], i + n, (1.0 - fx) * fy)),
                     (i + n + 1, w(&b[1], i + n + 1, fx * fy)),
                 ];
+                whole = keep(&a[0], i)
+                    && keep(&a[1], i + 1)
+                    && keep(&b[0], i + n)
+                    && keep(&b[1], i + n + 1);
                 let acc = a[0].radiance * taps[0].1
                     + a[1].radiance * taps[1].1
                     + b[0].radiance * taps[2].1
@@ -446,6 +482,7 @@ impl Shade<'_> {
                 let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
                 filtered(k, d, t, obj[x], l, tol)
             };
+            s.accepted[x] |= (1 | (whole as u32) << 1) << bit;
             let weight = k.weight * wa[x];
             sum[x] += radiance * weight;
             if let Some(c) = second {

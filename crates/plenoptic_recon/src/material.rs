@@ -233,7 +233,7 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
         None => (uv, 1.0),
     };
     let texels = footprint * scale * top.width.max(top.height) as f32;
-    let lod = if texels > 1.0 { texels.log2() } else { 0.0 };
+    let lod = if texels > 1.0 { log2(texels) } else { 0.0 };
     let last = texture.levels.len() - 1;
     let l0 = (floor(lod) as usize).min(last);
     let l1 = (l0 + 1).min(last);
@@ -248,6 +248,23 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
 
 /// `x.floor()` without a call into libm (the baseline x86-64 target has no rounding
 /// instruction, and the texture lookups are hot): exact for every finite `x`.
+/// `x.log2()` within 2·10⁻⁵ for finite x ≥ 1 (∞ stays ∞): the exponent, and the mantissa
+/// m ∈ [1, 2) through log₂ m = (2/ln 2)·atanh((m − 1)/(m + 1)) to its t⁷ term. A level of
+/// detail needs far less; libm's `log2f` was 3 % of a materials frame.
+#[inline]
+fn log2(x: f32) -> f32 {
+    if !x.is_finite() {
+        return x;
+    }
+    let bits = x.to_bits();
+    let exponent = ((bits >> 23) & 0xff) as i32 - 127;
+    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    let t = (m - 1.0) / (m + 1.0);
+    let t2 = t * t;
+    let series = t * (1.0 + t2 * (1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0))));
+    exponent as f32 + series * (2.0 / std::f32::consts::LN_2)
+}
+
 #[inline]
 fn floor(x: f32) -> f32 {
     // From 2²³ up every f32 is an integer.
@@ -319,6 +336,23 @@ mod tests {
             }
         }
         TextureImage::with_mips(ColourSpace::Linear, 4, 4, texels).unwrap()
+    }
+
+    #[test]
+    fn the_fast_log2_agrees_with_libm() {
+        let mut x = 1.0f32;
+        while x < 1e6 {
+            assert!(
+                (log2(x) - x.log2()).abs() < 2e-5,
+                "{x}: {} {}",
+                log2(x),
+                x.log2()
+            );
+            x *= 1.0137;
+        }
+        assert_eq!(log2(f32::INFINITY), f32::INFINITY);
+        assert_eq!(log2(1.0), 0.0);
+        assert_eq!(log2(1024.0), 10.0);
     }
 
     fn binding() -> TextureBinding {

@@ -36,6 +36,9 @@ pub(crate) struct Projected {
     /// Per projected triangle: (index into the projected objects, triangle index in its
     /// mesh). A triangle clipped into two shares its source.
     pub sources: Vec<(u32, u32)>,
+    /// Per source: the triangle's unit normal in camera space (either side; zero when
+    /// degenerate).
+    pub normals: Vec<Vec3>,
 }
 
 /// Places, clips and projects `objects` for `camera`.
@@ -44,6 +47,7 @@ pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)
     let (sx, sy) = (0.5 * b.width / b.tan_x, 0.5 * b.height / b.tan_y);
     let mut tris = Vec::new();
     let mut sources = Vec::new();
+    let mut normals = Vec::new();
     let mut cam: Vec<Vec3> = Vec::new();
     for (oi, &(object, xf, mesh)) in objects.iter().enumerate() {
         cam.clear();
@@ -109,10 +113,15 @@ pub(crate) fn project(camera: &Camera, objects: &[(u32, Affine3A, &TriangleMesh)
             }
             if used {
                 sources.push((oi as u32, ti as u32));
+                normals.push((v1 - v0).cross(v2 - v0).normalize_or_zero());
             }
         }
     }
-    Projected { tris, sources }
+    Projected {
+        tris,
+        sources,
+        normals,
+    }
 }
 
 /// Scan-converts the rows `y0..y0 + zbuf.len() / width` of `tris`: `zbuf` (camera-space depth,

@@ -73,6 +73,13 @@ pub struct ReconSettings {
     /// with n². Depth and object id come from the sample nearest the pixel's centre. The
     /// plugin's GPU path ignores it: there Bevy's `Msaa` antialiases the proxies' edges.
     pub supersampling: u32,
+    /// Materials' frames: look the lighting up at a quarter of the pixels (even rows and
+    /// columns) and interpolate between them where the lookups agree: same object, same
+    /// keys answering with whole bilinear footprints, no depth step
+    /// (`geometry/sparse.rs`); every other pixel is looked up itself. The lighting is at cube
+    /// resolution, so this changes a frame by a fraction of a percent; it roughly halves the
+    /// lighting pass (benches/recon.rs). The plugin's GPU path looks up every fragment.
+    pub sparse_lighting: bool,
 }
 
 /// What the geometry-assisted mode shows on objects with a material (the `shading` module;
@@ -124,6 +131,7 @@ impl Default for ReconSettings {
             sun_edge_rays: 32,
             specular: Specular::default(),
             supersampling: 1,
+            sparse_lighting: true,
         }
     }
 }

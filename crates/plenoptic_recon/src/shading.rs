@@ -53,7 +53,7 @@ use crate::geometry::{self, Layer, Pass};
 use crate::proxy::GeometryMask;
 use crate::settings::{CubeFilter, Shading};
 use crate::specular::{self, Reflections};
-use crate::surface::{SurfacePixel, Surfaces};
+use crate::surface::{SharedRaster, SurfacePixel, Surfaces};
 use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
@@ -126,6 +126,7 @@ pub(crate) fn render(
         skip,
         second: None,
         environment: None,
+        sparse: false,
         filter: if channel == Channel::Radiance {
             rec.settings.cube_filter
         } else {
@@ -144,6 +145,7 @@ pub(crate) fn render(
     let fused = Pass {
         second: Some(Channel::NonDiffuse),
         environment: all_lit.then_some((Channel::Radiance, rec.settings.cube_filter)),
+        sparse: rec.settings.sparse_lighting,
         ..pass(Channel::Lighting, &unlit)
     };
     let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
@@ -151,8 +153,8 @@ pub(crate) fn render(
         "lighting_pass".to_string(),
         start.elapsed().as_secs_f64() * 1e3,
     ));
-    let (lighting, non_diffuse, environment) = match both {
-        Ok(pair) => (pair.frame, pair.second, pair.environment),
+    let (lighting, non_diffuse, environment, triangles) = match both {
+        Ok(pair) => (pair.frame, pair.second, pair.environment, pair.triangles),
         Err(e) => {
             report.missing.push(format!("materials not applied: {e}"));
             return radiance_only(report);
@@ -163,14 +165,14 @@ pub(crate) fn render(
     // every object has a material the lighting pass's frame becomes the frame, its pixels
     // shaded in place (each read before it is written), the environment where nothing is and
     // black on objects left unshaded, as the radiance pass would leave them.
-    let (mut frame, lighting) = if all_lit && environment {
+    let (mut frame, lighting, triangles) = if all_lit && environment {
         report.base_views = side.base_views.clone();
-        (lighting, None)
+        (lighting, None, triangles)
     } else {
         let frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
         // The same proxies rasterized the same way: the same objects per pixel.
         debug_assert_eq!(frame.object, lighting.object);
-        (frame, Some(lighting.radiance))
+        (frame, Some(lighting.radiance), None)
     };
     stages.push((
         "radiance_pass".to_string(),
@@ -196,34 +198,44 @@ pub(crate) fn render(
         layer,
         with_footprint,
         glossy,
+        // The lighting pass's raster where it made one with triangles and its frame is this
+        // one: the same proxies and pixels.
+        triangles.map(|(projected, prim)| SharedRaster {
+            projected,
+            prim,
+            object: &frame.object,
+            depth: &frame.depth,
+        }),
     );
     let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
     // Pixel `j` of surface `px` under `light`; its reflection marched through `reflections`
     // where it is marched.
     let shade = |j: usize, px: &SurfacePixel, light: Vec3, reflections: Option<&Reflections>| {
-        // The BSDF only where the sun or a reflection needs it.
-        let front = px.view.dot(px.ng) < 0.0;
-        let bsdf = (sun.is_some() || px.marched)
-            .then(|| Bsdf::new(px.material, px.ng, px.ns, -px.view, front));
+        // The BSDF only where the sun or a reflection needs it (there the pixel has its
+        // geometry).
+        let bsdf = px.geometry.as_ref().map(|g| {
+            let front = g.view.dot(g.ng) < 0.0;
+            (g, Bsdf::new(px.material, g.ng, g.ns, -g.view, front), front)
+        });
         let marching = reflections.filter(|_| px.marched).zip(bsdf.as_ref());
-        let specular = marching.and_then(|(r, bsdf)| {
+        let specular = marching.and_then(|(r, (g, bsdf, front))| {
             let n = bsdf.normal();
-            let cos_o = -px.view.dot(n);
-            let dir = (px.view + n * (2.0 * cos_o)).normalize_or(n);
+            let cos_o = -g.view.dot(n);
+            let dir = (g.view + n * (2.0 * cos_o)).normalize_or(n);
             let alpha = px.material.roughness * px.material.roughness;
-            let eta = if front {
+            let eta = if *front {
                 px.material.ior
             } else {
                 1.0 / px.material.ior
             };
             let delta = px.material.roughness < DELTA_ROUGHNESS;
             let incoming = if delta {
-                r.incoming(px.position, dir, 0.0)
+                r.incoming(g.position, dir, 0.0)
                     .map(|l| specular::reflectance(&px.material, cos_o, eta) * l)
             } else {
                 // A per-pixel turn of the lobe's directions (golden-ratio sequence).
                 let turn = (j as f32 * 0.618_034).fract();
-                r.lobe(px.position, bsdf, alpha, turn)
+                r.lobe(g.position, bsdf, alpha, turn)
             };
             marched_pixels.fetch_add(1, Ordering::Relaxed);
             if incoming.is_none() {
@@ -233,7 +245,7 @@ pub(crate) fn render(
             let highlights = if delta {
                 Vec3::ZERO
             } else {
-                r.highlights(px.position, px.ng, bsdf)
+                r.highlights(g.position, g.ng, bsdf)
             };
             Some(px.emission + incoming? + highlights)
         });
@@ -248,8 +260,8 @@ pub(crate) fn render(
             non_diffuse[j]
         };
         let mut c = px.material.albedo() * light + specular.unwrap_or(baked);
-        if let (Some(sun), Some(bsdf)) = (&sun, &bsdf) {
-            c += sun.radiance(px.position, px.ng, px.footprint, bsdf, j as u32);
+        if let (Some(sun), Some((g, bsdf, _))) = (&sun, &bsdf) {
+            c += sun.radiance(g.position, g.ng, g.footprint, bsdf, j as u32);
         }
         c
     };
