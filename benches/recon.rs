@@ -3,7 +3,9 @@
 //! built in the setup; the geometry-assisted mode also with seamless bilinear cube filtering
 //! (`geometry_bilinear`, `ReconSettings::cube_filter`; the other cases use the default,
 //! nearest texel) and with materials (`geometry_textured`: pack 2.0's albedo from a 256²
-//! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`), and
+//! texture at each pixel's UV × bilinear lighting + non-diffuse, `Shading::Materials`; the
+//! lighting looked up at a quarter of the pixels, and `geometry_textured_dense` the same with
+//! `ReconSettings::sparse_lighting` off, every pixel looked up), and
 //! with pack 3's runtime sun on top (`geometry_sun`: the room with a skylight, the sun's
 //! direct light through each pixel's BSDF with `ReconSettings::sun_shadow_rays` = 4 shadow
 //! rays against the proxies), and with a mirror and a glossy metal wall whose reflections
@@ -63,6 +65,10 @@ fn bench(c: &mut Criterion) {
         &textured_path,
     );
     let textured = Reconstructor::open(&textured_path).unwrap();
+    // The same with the lighting looked up at every pixel (`ReconSettings::sparse_lighting`
+    // off): the comparison for the sparse lighting, in the same run.
+    let mut textured_dense = Reconstructor::open(&textured_path).unwrap();
+    textured_dense.settings.sparse_lighting = false;
     // Textured, in the room with a skylight, with the sun left to the runtime (pack 3).
     let sun_path = dir.path().join("sun.pack");
     write_pack(
@@ -107,6 +113,10 @@ fn bench(c: &mut Criterion) {
         let _ = textured.render(&cam, T, mode).unwrap();
         group.bench_function(format!("geometry_textured/{w}x{h}"), |b| {
             b.iter(|| black_box(textured.render(black_box(&cam), T, mode).unwrap()))
+        });
+        let _ = textured_dense.render(&cam, T, mode).unwrap();
+        group.bench_function(format!("geometry_textured_dense/{w}x{h}"), |b| {
+            b.iter(|| black_box(textured_dense.render(black_box(&cam), T, mode).unwrap()))
         });
         let (_, report) = sun.render(&cam, T, mode).unwrap();
         assert!(sun.runtime_sun().is_some(), "{:?}", report.missing);
@@ -158,11 +168,14 @@ fn bench(c: &mut Criterion) {
     let pt = median(&mut || {
         black_box(tracer.render(&accel.at_time(T), &pin));
     });
-    let cases = Mode::ALL.into_iter().map(|m| (m, m.name(), &rec)).chain([(
-        Mode::GeometryAssisted,
-        "geometry_textured",
-        &textured,
-    )]);
+    let cases = Mode::ALL.into_iter().map(|m| (m, m.name(), &rec)).chain([
+        (Mode::GeometryAssisted, "geometry_textured", &textured),
+        (
+            Mode::GeometryAssisted,
+            "geometry_textured_dense",
+            &textured_dense,
+        ),
+    ]);
     for (mode, name, rec) in cases {
         let ms = median(&mut || {
             black_box(rec.render(&cam, T, mode).unwrap());
