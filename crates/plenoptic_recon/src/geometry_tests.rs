@@ -27,20 +27,25 @@ fn textured_pack(scene: &plenoptic_scene::Scene) -> (tempfile::TempDir, Reconstr
     (dir, rec)
 }
 
+/// A `w` × `h` camera in the test room, looking across it at its boxes.
+fn room_camera(w: u32, h: u32) -> Camera {
+    Camera::look_at(
+        Vec3::new(0.3, 1.2, 0.8),
+        Vec3::new(-0.2, 0.7, -2.0),
+        Vec3::Y,
+        1.2,
+        w,
+        h,
+    )
+    .unwrap()
+}
+
 /// One pass that looks up two channels gives each what a pass of its own gives: the same
 /// lookups, weights and fallbacks, nearest and bilinear.
 #[test]
 fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
     let (_dir, rec) = textured_pack(&room(true));
-    let camera = Camera::look_at(
-        Vec3::new(0.3, 1.2, 0.8),
-        Vec3::new(-0.2, 0.7, -2.0),
-        Vec3::Y,
-        1.2,
-        96,
-        64,
-    )
-    .unwrap();
+    let camera = room_camera(96, 64);
     for filter in [CubeFilter::Nearest, CubeFilter::Bilinear] {
         let pass = |channel, second| Pass {
             layer: Layer::All,
@@ -159,15 +164,7 @@ fn a_pass_shows_the_environment_of_the_channel_asked_for() {
 #[test]
 fn sparse_lighting_agrees_with_every_pixel() {
     let (_dir, rec) = textured_pack(&room(true));
-    let camera = Camera::look_at(
-        Vec3::new(0.3, 1.2, 0.8),
-        Vec3::new(-0.2, 0.7, -2.0),
-        Vec3::Y,
-        1.2,
-        160,
-        120,
-    )
-    .unwrap();
+    let camera = room_camera(160, 120);
     let render = |sparse| {
         let pass = Pass {
             layer: Layer::All,
