@@ -450,9 +450,8 @@ impl Shade<'_> {
                     continue;
                 };
                 let o = obj[x];
-                let keep = |tj: &Texel, j: usize| {
-                    j == t || (tj.id == o && (tj.distance - l).abs() <= tol * l)
-                };
+                let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
+                let keep = |tj: &Texel, j: usize| j == t || same_surface(k, tj, j, o, d, l, tol);
                 let w = |tj: &Texel, j: usize, w: f32| if keep(tj, j) { w } else { 0.0 };
                 let taps = [
                     (i, w(&a[0], i, (1.0 - fx) * (1.0 - fy))),
@@ -492,14 +491,36 @@ impl Shade<'_> {
     }
 }
 
+/// Whether texel `j` of key `k` (its texel `tj`) shows the surface of the lookup `d` (from
+/// the base view, length `l`) of object `o`: the same object, and its distance agrees within
+/// the relative tolerance `tol`, or (where the key has normals) the texel's centre point lies
+/// on the plane through the lookup's point with the texel's normal, within `tol · l`. A
+/// surface seen at a grazing angle changes distance by more than the tolerance from one
+/// texel to the next; without the plane the bilinear footprint lost those taps, and the
+/// lighting showed the cube's texels as blocks (docs/architecture.md, "Reconstruction").
+#[inline]
+fn same_surface(k: &FastKey<'_>, tj: &Texel, j: usize, o: u32, d: Vec3, l: f32, tol: f32) -> bool {
+    if tj.id != o {
+        return false;
+    }
+    if (tj.distance - l).abs() <= tol * l {
+        return true;
+    }
+    let Some(n) = k.normal.and_then(|c| c.get(j)) else {
+        return false;
+    };
+    let centre = cube::texel_direction(k.face, j) * tj.distance;
+    (centre - d).dot(*n).abs() <= tol * l
+}
+
 /// The radiance of key `k` in direction `d` (length `l`) filtered over the bilinear taps that
-/// show object `o` at distance `l` (relative tolerance `tol`) or are the nearest texel `t`,
+/// show the lookup's surface of object `o` ([`same_surface`]) or are the nearest texel `t`,
 /// as radiance and 1; and its second colour filtered alike.
 fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> (Vec4, Option<Vec3>) {
     let (mut acc, mut acc2) = (Vec4::ZERO, Vec3::ZERO);
     for (i, w) in sample::bilinear_taps(k.face, d) {
         let Some(tx) = k.texels.get(i) else { continue };
-        if w > 0.0 && (i == t || (tx.id == o && (tx.distance - l).abs() <= tol * l)) {
+        if w > 0.0 && (i == t || same_surface(k, tx, i, o, d, l, tol)) {
             acc += tx.radiance * w;
             if let Some(c) = k.second.and_then(|c| c.get(i)) {
                 acc2 += *c * w;

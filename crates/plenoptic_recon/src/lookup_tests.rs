@@ -70,3 +70,53 @@ fn branch_free_texel_matches_the_reference() {
         "exact where no rounding occurs"
     );
 }
+
+/// A floor seen at a grazing angle from a base view: the next texel along the floor is the
+/// same surface although its distance differs by far more than the tolerance; a texel of
+/// the same object 0.5 m behind the floor's plane is not; without normals only the distance
+/// counts.
+#[test]
+fn a_grazing_surface_keeps_its_neighbouring_texels() {
+    let face = 32u32;
+    let count = 6 * (face * face) as usize;
+    // The floor y = −0.3 below a base view at the origin, seen along +z.
+    let floor_at = |j: usize| {
+        let dir = cube::texel_direction(face, j);
+        (dir.y < -1e-3).then(|| -0.3 / dir.y)
+    };
+    let texels: Vec<Texel> = (0..count)
+        .map(|j| Texel {
+            radiance: Vec4::ONE,
+            id: 1,
+            distance: floor_at(j).unwrap_or(100.0),
+        })
+        .collect();
+    let normals = vec![Vec3::Y; count];
+    let key = |normal| FastKey {
+        base: Vec3::ZERO,
+        weight: 1.0,
+        face,
+        texels: &texels,
+        second: None,
+        normal,
+        motion: &[],
+        reuse: Vec::new(),
+    };
+    let (with, without) = (key(Some(normals.as_slice())), key(None));
+    // A point on the floor 6 m ahead: its texel and the next one towards the view.
+    let d = Vec3::new(0.0, -0.3, 6.0);
+    let t = cube::direction_to_texel(face, d);
+    let next = t + face as usize; // one row down on the +z face: nearer along the floor
+    let l = d.length();
+    let (near, far) = (texels[next].distance, texels[t].distance);
+    assert!((near - far).abs() > 0.03 * l, "{near} {far}: not grazing");
+    assert!(same_surface(&with, &texels[next], next, 1, d, l, 0.03));
+    assert!(!same_surface(&without, &texels[next], next, 1, d, l, 0.03));
+    // Another object, and the same object half a metre below the floor's plane.
+    assert!(!same_surface(&with, &texels[next], next, 2, d, l, 0.03));
+    let behind = Texel {
+        distance: near + 0.5 / (cube::texel_direction(face, next).y.abs()),
+        ..texels[next]
+    };
+    assert!(!same_surface(&with, &behind, next, 1, d, l, 0.03));
+}

@@ -274,10 +274,29 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
     return normalize(v);
 }
 
+// Whether key texel `c` (its key-texture texel `texel`) shows the surface of the lookup `d`
+// (length `l`) of `object`: the same object at the distance within `tol · l`, or, where the
+// key has normals (`normals`), its centre point on the plane through the lookup's point with
+// the texel's normal within `tol · l` (plenoptic_recon's lookup::same_surface).
+fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32>, l: f32, tol: f32, normals: bool) -> bool {
+    if texel.z != object {
+        return false;
+    }
+    let dc = bitcast<f32>(texel.y);
+    if abs(dc - l) <= tol * l {
+        return true;
+    }
+    if !normals {
+        return false;
+    }
+    let nrm = oct_decode(max(unpack2x16snorm(texel.w), vec2<f32>(-1.0)));
+    return abs(dot(texel_direction(c, n) * dc - d, nrm)) <= tol * l;
+}
+
 // The radiance of the key at `layer0` in direction `d` (length `l`), seamlessly bilinear
-// over the taps that show `object` at distance `l` (relative tolerance `tol`) or are the
+// over the taps that show the lookup's surface of `object` (same_surface) or are the
 // nearest texel `t` (plenoptic_recon's lookup::filtered).
-fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32, tol: f32) -> vec3<f32> {
+fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32, tol: f32, normals: bool) -> vec3<f32> {
     var acc = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
         let tap = bilinear_tap(d, n, k);
@@ -287,7 +306,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32
         let c = vec3<u32>(tap.xyz);
         let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
         let nearest = all(c == t);
-        if nearest || (texel.z == object && abs(bitcast<f32>(texel.y) - l) <= tol * l) {
+        if nearest || same_surface(c, n, texel, object, d, l, tol, normals) {
             acc += vec4<f32>(colour(c, layer0, texel), 1.0) * tap.w;
         }
     }
@@ -355,7 +374,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         var radiance = rgb9e5_decode(texel.x);
         // Lighting is always filtered (plenoptic_recon's shading module).
         if cam.flags.x == 1.0 || lit() {
-            radiance = filtered(u32(cam.base[k].w), n, d, t, object, dist, tol);
+            radiance = filtered(u32(cam.base[k].w), n, d, t, object, dist, tol, cam.weight[k].y != 0.0);
         }
         sum += radiance * w;
         ws += w;
