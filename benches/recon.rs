@@ -184,9 +184,10 @@ fn bench(c: &mut Criterion) {
         #[expect(clippy::print_stdout, reason = "the benchmark reports its ratio")]
         {
             println!(
-                "ratio 640x360 {name}: {ms:.2} ms vs path tracer {PATH_SPP} spp {pt:.1} ms = {:.0}× faster; {:?}; stages {:?}",
+                "ratio 640x360 {name}: {ms:.2} ms vs path tracer {PATH_SPP} spp {pt:.1} ms = {:.0}× faster; {:?}; {} pixels' lighting interpolated; stages {:?}",
                 pt / ms,
                 report.fallback,
+                report.interpolated_pixels,
                 report.stage_ms
             );
         }

@@ -141,9 +141,18 @@ impl CameraBasis {
     /// (x + ½, y + ½)); identical to the tracer's pinhole rays.
     #[inline]
     pub fn direction(&self, px: f32, py: f32) -> Vec3 {
+        self.ray(px, py).normalize()
+    }
+
+    /// The ray through the continuous image point (px, py), not normalised:
+    /// `forward + right · sx + up · sy`, one unit along the viewing direction (so its length
+    /// is 1 / cos of its angle to the axis, and a camera-space depth times that length is the
+    /// distance along the ray).
+    #[inline]
+    pub fn ray(&self, px: f32, py: f32) -> Vec3 {
         let sx = (2.0 * px / self.width - 1.0) * self.tan_x;
         let sy = (1.0 - 2.0 * py / self.height) * self.tan_y;
-        (self.right * sx + self.up * sy + self.forward).normalize()
+        self.right * sx + self.up * sy + self.forward
     }
 
     /// Projects a world point: continuous image coordinates and the depth along the viewing

@@ -161,6 +161,10 @@ pub struct Report {
     /// (they show the baked non-diffuse radiance).
     #[serde(default)]
     pub reflections: (usize, usize),
+    /// Geometry-assisted mode with materials: pixels whose lighting was interpolated between
+    /// the lookups around them instead of looked up (`ReconSettings::sparse_lighting`).
+    #[serde(default)]
+    pub interpolated_pixels: usize,
     /// Wall-clock milliseconds of the stages of the reconstruction (diagnostics).
     pub stage_ms: Vec<(String, f64)>,
 }

@@ -27,6 +27,7 @@
 //! the hole fill then visit only the pixels that need them.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
@@ -118,6 +119,9 @@ pub(crate) struct PairFrame {
     /// projected triangles and each pixel's triangle (index into their sources; `u32::MAX`:
     /// none), for the surfaces of the same pixels ([`crate::surface`]).
     pub triangles: Option<(crate::raster::Projected, Vec<u32>)>,
+    /// Pixels that took their anchors' mean instead of a lookup of their own (sparse.rs;
+    /// the anchors themselves not counted).
+    pub interpolated: usize,
 }
 
 impl<'a> Pass<'a> {
@@ -373,6 +377,7 @@ pub(crate) fn render_pair(
         };
         pass.run(&mut frame.depth, &mut frame.object, &mut prims)
     });
+    let interpolated = AtomicUsize::new(0);
     // The second colour's band, where there is one.
     let bands2 = if second.is_some() {
         Either::Left(plane2.par_chunks_mut(band).map(Some))
@@ -395,6 +400,7 @@ pub(crate) fn render_pair(
                     // Camera-space depth into `dep`, object into `obj`.
                     crate::raster::raster_band(tris, w, y0, dep, obj, None);
                 }
+                let mut between_count = 0;
                 let lines = rad
                     .chunks_mut(w)
                     .zip(dep.chunks_mut(w))
@@ -417,6 +423,7 @@ pub(crate) fn render_pair(
                             .and_then(|a| a.interpolate(x, y, obj[x], dep[x], tol));
                         match between {
                             Some((c, c2)) => {
+                                between_count += 1;
                                 rad[x] = c;
                                 if let Some(row2) = row2.as_deref_mut() {
                                     row2[x] = c2;
@@ -444,6 +451,7 @@ pub(crate) fn render_pair(
                         }
                     });
                 }
+                interpolated.fetch_add(between_count, Ordering::Relaxed);
             },
         );
     report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
@@ -510,6 +518,7 @@ pub(crate) fn render_pair(
         second: plane2,
         environment: env.is_some(),
         triangles,
+        interpolated: interpolated.into_inner(),
     })
 }
 

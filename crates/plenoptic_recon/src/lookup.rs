@@ -452,17 +452,21 @@ impl Shade<'_> {
                 let o = obj[x];
                 let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
                 let keep = |tj: &Texel, j: usize| j == t || same_surface(k, tj, j, o, d, l, tol);
-                let w = |tj: &Texel, j: usize, w: f32| if keep(tj, j) { w } else { 0.0 };
-                let taps = [
-                    (i, w(&a[0], i, (1.0 - fx) * (1.0 - fy))),
-                    (i + 1, w(&a[1], i + 1, fx * (1.0 - fy))),
-                    (i + n, w(&b[0], i + n, (1.0 - fx) * fy)),
-                    (i + n + 1, w(&b[1], i + n + 1, fx * fy)),
+                // Each tap tested once (the plane test is not free).
+                let kept = [
+                    keep(&a[0], i),
+                    keep(&a[1], i + 1),
+                    keep(&b[0], i + n),
+                    keep(&b[1], i + n + 1),
                 ];
-                whole = keep(&a[0], i)
-                    && keep(&a[1], i + 1)
-                    && keep(&b[0], i + n)
-                    && keep(&b[1], i + n + 1);
+                whole = kept == [true; 4];
+                let w = |k: usize, w: f32| if kept[k] { w } else { 0.0 };
+                let taps = [
+                    (i, w(0, (1.0 - fx) * (1.0 - fy))),
+                    (i + 1, w(1, fx * (1.0 - fy))),
+                    (i + n, w(2, (1.0 - fx) * fy)),
+                    (i + n + 1, w(3, fx * fy)),
+                ];
                 let acc = a[0].radiance * taps[0].1
                     + a[1].radiance * taps[1].1
                     + b[0].radiance * taps[2].1

@@ -246,8 +246,6 @@ pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footpr
     a.lerp(bilinear(texture, l1, b, uv), f)
 }
 
-/// `x.floor()` without a call into libm (the baseline x86-64 target has no rounding
-/// instruction, and the texture lookups are hot): exact for every finite `x`.
 /// `x.log2()` within 2·10⁻⁵ for finite x ≥ 1 (∞ stays ∞): the exponent, and the mantissa
 /// m ∈ [1, 2) through log₂ m = (2/ln 2)·atanh((m − 1)/(m + 1)) to its t⁷ term. A level of
 /// detail needs far less; libm's `log2f` was 3 % of a materials frame.
@@ -265,6 +263,8 @@ fn log2(x: f32) -> f32 {
     exponent as f32 + series * (2.0 / std::f32::consts::LN_2)
 }
 
+/// `x.floor()` without a call into libm (the baseline x86-64 target has no rounding
+/// instruction, and the texture lookups are hot): exact for every finite `x`.
 #[inline]
 fn floor(x: f32) -> f32 {
     // From 2²³ up every f32 is an integer.

@@ -154,7 +154,10 @@ pub(crate) fn render(
         start.elapsed().as_secs_f64() * 1e3,
     ));
     let (lighting, non_diffuse, environment, triangles) = match both {
-        Ok(pair) => (pair.frame, pair.second, pair.environment, pair.triangles),
+        Ok(pair) => {
+            report.interpolated_pixels += pair.interpolated;
+            (pair.frame, pair.second, pair.environment, pair.triangles)
+        }
         Err(e) => {
             report.missing.push(format!("materials not applied: {e}"));
             return radiance_only(report);

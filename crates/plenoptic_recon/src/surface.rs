@@ -209,10 +209,7 @@ impl<'a> Surfaces<'a> {
         }
         let (x, y) = ((j % self.width) as f32 + 0.5, (j / self.width) as f32 + 0.5);
         let b = &self.basis;
-        // The pixel's ray, not normalised: forward + right·sx + up·sy.
-        let sx = (2.0 * x / b.width - 1.0) * b.tan_x;
-        let sy = (1.0 - 2.0 * y / b.height) * b.tan_y;
-        let ray = b.right * sx + b.up * sy + b.forward;
+        let ray = b.ray(x, y);
         let len = ray.length();
         // The pixel's ray met on the triangle's plane: the raster's interpolated depth is
         // off by ~10⁻⁴ of the distance, enough to put the point under the surface for a

@@ -90,15 +90,12 @@ impl Rows<'_> {
     /// Row `y`'s camera-space depths `dep` as distances along the rays (∞ where nothing is),
     /// as [`Rows::prepare`] leaves them.
     pub fn distances(&self, y: usize, dep: &mut [f32], obj: &[u32]) {
-        let b = self.basis;
-        let sy = (1.0 - 2.0 * (y as f32 + 0.5) / b.height) * b.tan_y;
+        let py = y as f32 + 0.5;
         for (x, (z, &o)) in dep.iter_mut().zip(obj).enumerate() {
-            let sx = (2.0 * (x as f32 + 0.5) / b.width - 1.0) * b.tan_x;
-            // |forward + right·sx + up·sy| per unit of depth.
             *z = if o == 0 {
                 f32::INFINITY
             } else {
-                *z * (1.0 + sx * sx + sy * sy).sqrt()
+                *z * self.basis.ray(x as f32 + 0.5, py).length()
             };
         }
     }
