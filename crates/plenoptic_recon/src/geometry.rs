@@ -423,7 +423,8 @@ pub(crate) fn render_pair(
                             .and_then(|a| a.interpolate(x, y, obj[x], dep[x], tol));
                         match between {
                             Some((c, c2)) => {
-                                between_count += 1;
+                                // The anchors themselves are looked up, not interpolated.
+                                between_count += usize::from(x % 2 == 1 || y % 2 == 1);
                                 rad[x] = c;
                                 if let Some(row2) = row2.as_deref_mut() {
                                     row2[x] = c2;
