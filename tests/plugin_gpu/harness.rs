@@ -9,6 +9,15 @@ use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::upload::KeyUploadStats;
 use bevy_plenoptic::streaming::{StreamState, StreamingStats, key_bytes};
 
+/// plenoptic_recon's reconstructor on the pack at `path`, set to reconstruct as the plugin's
+/// GPU path does: the surface a mirror's ray meets shows the base views' radiance there
+/// (`ReconSettings::shaded_reflections` off; the GPU does not shade it as a pixel yet).
+pub(crate) fn cpu_as_gpu(path: &std::path::Path) -> plenoptic_recon::Reconstructor {
+    let mut rec = plenoptic_recon::Reconstructor::open(path).unwrap();
+    rec.settings.shaded_reflections = false;
+    rec
+}
+
 /// What [`plugin_and_cpu_frames`] returns.
 pub(crate) struct Frames {
     /// The plugin's frame, linear radiance.
@@ -113,7 +122,6 @@ pub(crate) fn plugin_and_cpu_frames_with(
         ball,
     } = extras.into();
     use bevy::camera::Hdr;
-    use plenoptic_recon::Reconstructor;
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("room.pack");
@@ -136,7 +144,9 @@ pub(crate) fn plugin_and_cpu_frames_with(
     let transform = Transform::from_translation(eye).looking_at(view.1, Vec3::Y);
 
     // CPU reference.
-    let mut rec = Reconstructor::open(&path).unwrap();
+    let mut rec = cpu_as_gpu(&path);
+    // The plugin's CPU backend reconstructs with the camera's settings, as plenoptic_recon does.
+    rec.settings.shaded_reflections = backend == Backend::Cpu;
     let cam = plenoptic_recon::Camera::new(
         eye,
         transform.rotation,

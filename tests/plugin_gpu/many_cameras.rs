@@ -7,14 +7,13 @@
 use std::sync::{Arc, Mutex};
 
 use crate::common::*;
-use crate::harness::compare;
+use crate::harness::{compare, cpu_as_gpu};
 use crate::pack::{Materials, PackSpec, open_room, room, write_pack};
 use bevy::camera::Hdr;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
-use plenoptic_recon::Reconstructor;
 
 /// One camera of a test: where it is, what it looks at, its time and mode.
 #[derive(Clone, Copy)]
@@ -33,7 +32,7 @@ impl Eye {
 
 /// `plenoptic_recon`'s frame of the pack at `path` for `eye`.
 pub(crate) fn cpu_frame(path: &std::path::Path, eye: Eye) -> Vec<Vec3> {
-    let rec = Reconstructor::open(path).unwrap();
+    let rec = cpu_as_gpu(path);
     let cam = plenoptic_recon::Camera::new(
         eye.at,
         eye.transform().rotation,

@@ -7,6 +7,7 @@
 //! CPU's composite, with the sky's lit ground below the horizon.
 
 use crate::common::*;
+use crate::harness::cpu_as_gpu;
 use crate::pack::{
     Materials, PackSpec, glass_window_room, open_room, windowed_room, write_pack_with,
 };
@@ -16,7 +17,7 @@ use bevy_plenoptic::camera::EV100_UNIT;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::streaming::StreamState;
 use plenoptic_pack::plenoptic_sky::{Environment, SkyParams};
-use plenoptic_recon::{Mode, Reconstructor};
+use plenoptic_recon::Mode;
 
 /// Compares `gpu` with `cpu` over the pixels `which`, as `scene_render.rs` does: per
 /// pixel the largest channel's |gpu − cpu| / (cpu + 0.02). Returns (mean, fraction within
@@ -139,7 +140,7 @@ fn cpu_camera(eye: Vec3, transform: &Transform) -> plenoptic_recon::Camera {
 /// of [`view`].
 fn sky_fixture() -> (
     tempfile::TempDir,
-    Reconstructor,
+    plenoptic_recon::Reconstructor,
     plenoptic_recon::Camera,
     Transform,
     f32,
@@ -148,7 +149,7 @@ fn sky_fixture() -> (
     let path = dir.path().join("sky.pack");
     sky_pack(&path);
     let (eye, transform, t) = view();
-    let rec = Reconstructor::open(&path).unwrap();
+    let rec = cpu_as_gpu(&path);
     (dir, rec, cpu_camera(eye, &transform), transform, t)
 }
 
@@ -165,7 +166,7 @@ fn gpu_sky_through_the_opening_matches_cpu_and_exposure_scales_the_frame() {
     let (eye, transform, t) = view();
 
     // CPU reference, and which pixels see no proxy.
-    let rec = Reconstructor::open(&path).unwrap();
+    let rec = cpu_as_gpu(&path);
     let cam = cpu_camera(eye, &transform);
     let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     let (cpu_image, _) = rec.render(&cam, t, Mode::Image).unwrap();
@@ -325,7 +326,7 @@ fn gpu_image_and_uniform_environments_match_cpu() {
         let path = dir.path().join("sky.pack");
         env_pack(&path, env.clone());
         let (eye, transform, t) = view();
-        let rec = Reconstructor::open(&path).unwrap();
+        let rec = cpu_as_gpu(&path);
         let cam = cpu_camera(eye, &transform);
         let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
         let mask = rec.proxy().unwrap().mask_raster(&cam, t);
@@ -358,7 +359,7 @@ fn gpu_window_open_or_glazed_matches_cpu() {
             ..SkyParams::default()
         });
         write_room_pack(&windowed_room(glazing), &path, sky);
-        let rec = Reconstructor::open(&path).unwrap();
+        let rec = cpu_as_gpu(&path);
         let cam = cpu_camera(eye, &transform);
         let (cpu, report) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
         let mask = rec.proxy().unwrap().mask_raster(&cam, t);
@@ -435,7 +436,7 @@ fn gpu_glass_window_matches_cpu() {
     let path = dir.path().join("sky.pack");
     write_pack_with(&glass_window_room(), &spec, &path, Some((sky, track)));
     let cam = cpu_camera(eye, &transform);
-    let mut rec = Reconstructor::open(&path).unwrap();
+    let mut rec = cpu_as_gpu(&path);
     let (cpu, report) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
     let pane = rec.pack().manifest().objects.len() as u32;
     let mask = rec.proxy().unwrap().mask_raster(&cam, t);
@@ -449,8 +450,7 @@ fn gpu_glass_window_matches_cpu() {
     );
     assert!(report.glazing_pixels >= glass.len() / 2, "{report:?}");
     // Through the glass, the open window's sky at about T² = 0.92, plus a faint reflection.
-    let (open, _) = Reconstructor::open(&open_path)
-        .unwrap()
+    let (open, _) = cpu_as_gpu(&open_path)
         .render(&cam, t, Mode::GeometryAssisted)
         .unwrap();
     let mean = |f: &[Vec3]| glass.iter().map(|&j| f[j].element_sum()).sum::<f32>();

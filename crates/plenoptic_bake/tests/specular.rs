@@ -252,8 +252,12 @@ fn measure(
 ///
 /// | scene | mirror baked → marched | steel baked → marched | diffuse |
 /// |---|---|---|---|
-/// | sun | 0.594 → 0.244 | 0.213 → 0.181 | 0.094 |
-/// | lamp | 0.187 → 0.088 | 0.203 → 0.104 | 0.036 |
+/// | sun | 0.592 → 0.254 | 0.194 → 0.169 | 0.094 |
+/// | lamp | 0.186 → 0.083 | 0.197 → 0.096 | 0.035 |
+///
+/// (The mirror's hits are shaded as pixels, `ReconSettings::shaded_reflections`; with the base
+/// views' radiance at the hit the mirror was at 0.244 and 0.088. At one sample per pixel
+/// its sharper reflection aliases: the antialiased test below shows what it gained.)
 ///
 /// (The steel's 8 rays per pixel are each weighted by the lobe's `F·G·(ω_o·h)/((n·ω_o)
 /// (n·h))`; with their plain mean times Karis's split-sum fit the steel came out at 0.92
@@ -289,7 +293,9 @@ fn mirror_and_steel_reflect_for_the_camera() {
     );
     // 0.213 -> 0.181 while the baked specular was looked up at every pixel; interpolated
     // between the lighting pass's anchors (geometry/sparse.rs) the baked highlight's texels
-    // blur a little and its error fell to 0.194. The marched 0.181 did not change.
+    // blur a little and its error fell to 0.194. The marched 0.181 did not change; it became
+    // 0.169 once the views answer the point the proxies say a ray meets, where they see it,
+    // before any march.
     assert!(
         steel_m < 0.95 * steel_b,
         "sun: steel {steel_b} -> {steel_m}"
@@ -301,7 +307,9 @@ fn mirror_and_steel_reflect_for_the_camera() {
     );
     // The bound is the mirror's error within 2× the diffuse pixels'. It held (0.088
     // against 0.052) until the bake's final gather lowered the diffuse pixels' error to 0.036;
-    // the mirror's stayed at 0.088, 2.4×. Held here: what the sun's scene holds.
+    // the mirror's stayed at 0.088, 2.4× (0.083, 2.36×, with its hits shaded as pixels: at
+    // one sample per pixel its sharp edges alias). The antialiased test below holds 2×; held
+    // here: what the sun's scene holds.
     assert!(
         mirror_m < 3.0 * diffuse,
         "lamp: mirror {mirror_m}, diffuse {diffuse}"
@@ -317,9 +325,18 @@ fn mirror_and_steel_reflect_for_the_camera() {
 /// The comparison with antialiased frames, as the tour's are compared (release,
 /// about a minute): 320 × 180, 4 × 4 samples per pixel, 2 × 64 spp. Both panels reflect
 /// for the camera in both scenes; under the lamp the steel adds the placed lamp's highlight
-/// at runtime. Measured: sun: mirror 2.18×, steel 1.29× the diffuse pixels' error; lamp:
-/// mirror 2.08×, steel 1.49× (the bound is 2×). Held here: the march halves the
-/// mirror's error, the steel within 2×, the mirror within 2.5×.
+/// at runtime. Held here: the bound, both within 2× the diffuse pixels' error, and
+/// the mirror's error below half the baked one's. Measured:
+///
+/// | scene | mirror | steel | diffuse |
+/// |---|---|---|---|
+/// | sun | 0.082 (1.32×) | 0.067 (1.09×) | 0.062 |
+/// | lamp | 0.064 (1.59×) | 0.052 (1.30×) | 0.040 |
+///
+/// The mirror's hits are shaded as pixels (`ReconSettings::shaded_reflections`, reflected.rs
+/// in plenoptic_recon). With the base views' radiance at the hit instead it was at 2.18× and
+/// 2.08×: the reflected floor's sun-shadow edges at cube resolution, and a pale ghost beside
+/// the red box, whose front no base view sees (the views stand level with it).
 #[test]
 #[ignore]
 fn mirror_and_steel_antialiased() {
@@ -330,7 +347,7 @@ fn mirror_and_steel_antialiased() {
         let ([mirror, steel, diffuse], _) = r[1];
         assert!(mirror < 0.5 * mirror_b, "mirror {mirror_b} -> {mirror}");
         assert!(
-            mirror <= 2.5 * diffuse && steel <= 2.0 * diffuse,
+            mirror <= 2.0 * diffuse && steel <= 2.0 * diffuse,
             "mirror {mirror}, steel {steel}, diffuse {diffuse}"
         );
     }

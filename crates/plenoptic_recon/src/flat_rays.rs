@@ -110,6 +110,7 @@ impl FlatRays {
     /// [`crate::shadow::ShadowScene::new`].
     pub fn new(proxy: &ProxyGeometry) -> Self {
         let (fixed, moving) = crate::shadow::split_triangles(proxy, |_| true);
+        let fixed: Vec<Triangle> = fixed.into_iter().map(|(t, _)| t).collect();
         let fixed = flatten(&fixed);
         let moving: Vec<(u32, Flat)> = moving
             .into_iter()

@@ -173,3 +173,46 @@ fn no_geometry_occludes_nothing() {
     assert_eq!(flat.words()[0].w.to_bits(), 1);
     assert_eq!(flat.words()[1].z.to_bits(), 3);
 }
+
+/// The CPU's nearest hit (the surface a mirror's ray meets, `crate::reflected`) names the
+/// object and the triangle of its mesh, the moving cube's in its own space included.
+#[test]
+fn the_nearest_hit_names_its_object_and_triangle() {
+    let geometry = scene();
+    let shadows = ShadowScene::new(&geometry);
+    // Off the cube's face diagonal, which obvhs's triangle test misses (see hits_triangle).
+    let o = Vec3::new(0.0, 1.6, 0.1);
+    // At t = 0 the cube (half-size 0.25 at x = 1) is in front of the window: its −x face
+    // (quad 0: triangles 0 and 1) at 0.75 m.
+    let hit = shadows
+        .at(&geometry, 0.0)
+        .nearest(o, Vec3::X, 100.0)
+        .unwrap();
+    assert_eq!((hit.object, hit.triangle / 2), (3, 0));
+    assert!((hit.t - 0.75).abs() < 1e-4, "{hit:?}");
+    // At t = 1 it has slid away: out through the window, nothing.
+    assert_eq!(shadows.at(&geometry, 1.0).nearest(o, Vec3::X, 100.0), None);
+    // Down to the floor (room quad 2) at 1.5 m, and towards the pillar (object 2), whose
+    // +x face (quad 1) is nearer than the room's wall behind it.
+    let floor = shadows
+        .at(&geometry, 1.0)
+        .nearest(o, Vec3::NEG_Y, 100.0)
+        .unwrap();
+    assert_eq!((floor.object, floor.triangle / 2), (1, 2));
+    assert!((floor.t - 1.6).abs() < 1e-4);
+    let to_pillar = (Vec3::new(-0.8, 1.6, -0.8) - o).normalize();
+    let pillar = shadows
+        .at(&geometry, 1.0)
+        .nearest(o, to_pillar, 100.0)
+        .unwrap();
+    assert_eq!(pillar.object, 2);
+    assert!(
+        pillar.t < (Vec3::new(-0.8, 1.6, -0.8) - o).length(),
+        "{pillar:?}"
+    );
+    // Beyond tmax: nothing.
+    assert_eq!(
+        shadows.at(&geometry, 1.0).nearest(o, Vec3::NEG_Y, 1.0),
+        None
+    );
+}

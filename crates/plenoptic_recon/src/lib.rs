@@ -101,6 +101,7 @@ pub mod path;
 pub mod proxy;
 mod raster;
 pub mod reconstructor;
+mod reflected;
 mod sample;
 pub mod settings;
 mod shading;

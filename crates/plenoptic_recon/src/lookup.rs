@@ -544,6 +544,25 @@ fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> (Ve
     }
 }
 
+/// Key `k`'s colour at point `p` of object `o` (placed at the key's time; `None` where the
+/// key's nearest texel towards it shows another surface, [`same_surface`]), filtered as a
+/// pixel's lookup is, with its second colour: a single lookup outside the pixel loop (the
+/// surface a reflected ray meets, [`crate::specular`]).
+pub(crate) fn at_point(k: &FastKey<'_>, p: Vec3, o: u32, tol: f32) -> Option<(Vec3, Option<Vec3>)> {
+    let d = p - k.base;
+    let l = d.length();
+    if l.is_nan() || l <= 1e-6 {
+        return None;
+    }
+    let t = cube::direction_to_texel(k.face, d);
+    let tx = k.texels.get(t)?;
+    if !same_surface(k, tx, t, o, d, l, tol) {
+        return None;
+    }
+    let (c, second) = filtered(k, d, t, o, l, tol);
+    Some((c.truncate(), second))
+}
+
 /// 2²³ as f32.
 const TWO_23: f32 = (1u32 << 23) as f32;
 

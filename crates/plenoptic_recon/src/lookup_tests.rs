@@ -119,4 +119,10 @@ fn a_grazing_surface_keeps_its_neighbouring_texels() {
         ..texels[next]
     };
     assert!(!same_surface(&with, &behind, next, 1, d, l, 0.03));
+    // A single point's lookup (a reflected ray's hit) answers on the floor and not for
+    // another object or a point half a metre above it.
+    let (c, second) = at_point(&with, d, 1, 0.03).unwrap();
+    assert!((c - Vec3::ONE).abs().max_element() < 1e-6 && second.is_none());
+    assert!(at_point(&with, d, 2, 0.03).is_none());
+    assert!(at_point(&with, d + Vec3::Y * 0.5, 1, 0.03).is_none());
 }

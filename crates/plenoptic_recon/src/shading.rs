@@ -294,7 +294,7 @@ pub(crate) fn render(
     timed("albedo", start);
     let start = std::time::Instant::now();
     let reflections = (!marched.is_empty())
-        .then(|| Reflections::new(rec, camera.position, t, &mut report.missing));
+        .then(|| Reflections::new(rec, camera, t, sun.as_ref(), &mut report.missing));
     let reflected: Vec<(usize, Vec3)> = marched
         .par_iter()
         .map(|(j, px)| {

@@ -17,22 +17,30 @@ use glam::{Affine3A, Vec3, Vec3A};
 use obvhs::{
     BvhBuildParams,
     cwbvh::{CwBvh, builder::build_cwbvh_from_tris},
-    ray::Ray,
+    ray::{Ray, RayHit},
     triangle::Triangle,
 };
 
 use crate::proxy::ProxyGeometry;
 
+/// (pack object id, triangle index in its mesh).
+pub(crate) type TriangleTag = (u32, u32);
+
+/// Each animated object's pack id and its triangles in object space, in mesh order.
+pub(crate) type MovingTriangles = Vec<(u32, Vec<Triangle>)>;
+
 /// A BVH and its triangles in BVH order.
 struct TriangleBvh {
     bvh: CwBvh,
     triangles: Vec<Triangle>,
+    /// (pack object id, triangle index in its mesh) of each triangle, in BVH order.
+    tags: Vec<TriangleTag>,
     /// Bounds (min, max) of the triangles.
     bounds: (Vec3, Vec3),
 }
 
 impl TriangleBvh {
-    fn new(tris: Vec<Triangle>) -> Option<Self> {
+    fn new(tris: Vec<Triangle>, tags: Vec<TriangleTag>) -> Option<Self> {
         if tris.is_empty() {
             return None;
         }
@@ -51,9 +59,15 @@ impl TriangleBvh {
             .iter()
             .map(|&i| tris[i as usize])
             .collect();
+        let tags = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| tags[i as usize])
+            .collect();
         Some(Self {
             bvh,
             triangles,
+            tags,
             bounds: (lo.into(), hi.into()),
         })
     }
@@ -64,6 +78,24 @@ impl TriangleBvh {
         !self
             .bvh
             .ray_traverse_miss(ray, |r, i| self.triangles[i].intersect(r))
+    }
+
+    /// The nearest triangle within `tmax`.
+    fn nearest(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<ProxyHit> {
+        let ray = Ray::new(origin, dir + Vec3A::ZERO, 0.0, tmax);
+        let mut hit = RayHit::none();
+        if !self
+            .bvh
+            .ray_traverse(ray, &mut hit, |r, i| self.triangles[i].intersect(r))
+        {
+            return None;
+        }
+        let (object, triangle) = *self.tags.get(hit.primitive_id as usize)?;
+        Some(ProxyHit {
+            t: hit.t,
+            object,
+            triangle,
+        })
     }
 
     /// How many triangles the ray from `origin` along `dir` crosses closer than `tmax`.
@@ -77,6 +109,17 @@ impl TriangleBvh {
         });
         n
     }
+}
+
+/// Where a ray meets the proxies ([`PlacedShadows::nearest`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProxyHit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Pack id of the object met.
+    pub object: u32,
+    /// The triangle met, an index into the object's mesh triangles.
+    pub triangle: u32,
 }
 
 /// The proxies as shadow rays see them.
@@ -111,11 +154,15 @@ impl ShadowScene {
     /// The geometry of the objects of `proxy` whose pack id `keep` accepts.
     pub fn of_objects(proxy: &ProxyGeometry, keep: impl Fn(u32) -> bool) -> Self {
         let (fixed, moving) = split_triangles(proxy, keep);
+        let (fixed, tags) = fixed.into_iter().unzip();
         Self {
-            fixed: TriangleBvh::new(fixed),
+            fixed: TriangleBvh::new(fixed, tags),
             moving: moving
                 .into_iter()
-                .filter_map(|(id, tris)| Some((id, TriangleBvh::new(tris)?)))
+                .filter_map(|(id, tris)| {
+                    let tags = (0..tris.len() as u32).map(|k| (id, k)).collect();
+                    Some((id, TriangleBvh::new(tris, tags)?))
+                })
                 .collect(),
         }
     }
@@ -175,6 +222,31 @@ impl PlacedShadows<'_> {
             })
     }
 
+    /// The nearest triangle along the ray from `origin` along unit `dir` within `tmax`
+    /// (both faces count).
+    pub fn nearest(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<ProxyHit> {
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        let mut best = self
+            .scene
+            .fixed
+            .as_ref()
+            .and_then(|b| b.nearest(o, d, tmax));
+        for ((_, b), (to_object, lo, hi)) in self.scene.moving.iter().zip(&self.moving) {
+            let reach = best.map_or(tmax, |h| h.t);
+            if !ray_meets_box(origin, dir, reach, *lo, *hi) {
+                continue;
+            }
+            // An affine map keeps the ray parameter: t is the same in object space.
+            let hit = b.nearest(
+                to_object.transform_point3a(o),
+                to_object.transform_vector3a(d),
+                reach,
+            );
+            best = hit.or(best);
+        }
+        best
+    }
+
     /// How many triangles the ray from `origin` along unit `dir` crosses closer than `tmax`
     /// (both faces count).
     pub fn crossings(&self, origin: Vec3, dir: Vec3, tmax: f32) -> u32 {
@@ -203,12 +275,13 @@ impl PlacedShadows<'_> {
 }
 
 /// The triangles of the objects of `proxy` whose pack id `keep` accepts: those that never move
-/// together in world space, and each animated object's own in object space (with its pack
-/// id). Shared by the CPU's BVHs and the GPU's flat layout ([`crate::flat_rays`]).
+/// together in world space (each with its pack id and index in its mesh), and each animated
+/// object's own in object space, in mesh order (with its pack id). Shared by the CPU's BVHs
+/// and the GPU's flat layout ([`crate::flat_rays`]).
 pub(crate) fn split_triangles(
     proxy: &ProxyGeometry,
     keep: impl Fn(u32) -> bool,
-) -> (Vec<Triangle>, Vec<(u32, Vec<Triangle>)>) {
+) -> (Vec<(Triangle, TriangleTag)>, MovingTriangles) {
     let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
         m.triangles
             .iter()
@@ -229,7 +302,11 @@ pub(crate) fn split_triangles(
             Some(m) if m.is_animated() => {
                 moving.push((id, triangles(mesh, Affine3A::IDENTITY)));
             }
-            _ => fixed.extend(triangles(mesh, proxy.transform(id, 0.0))),
+            _ => fixed.extend(
+                triangles(mesh, proxy.transform(id, 0.0))
+                    .into_iter()
+                    .zip((0..).map(|k| (id, k))),
+            ),
         }
     }
     (fixed, moving)

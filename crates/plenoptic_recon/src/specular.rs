@@ -27,6 +27,16 @@
 //!   beside the window (a silhouette), so no view answered and the pixel kept the baked
 //!   reflection of another place. On the tour, the mirror of room A showed its windows at
 //!   0.47–0.51 of the path tracer's luminance and in the wrong place (frames 14–15).
+//! - A ray that meets a proxy triangle is answered at that point, without a march:
+//!   - an ideal mirror's ray (with [`crate::ReconSettings::shaded_reflections`]) shows the
+//!     point shaded as a pixel is, albedo at its UV × the baked lighting + the runtime sun
+//!     (`reflected.rs`): the reflected scene at screen resolution, as the camera's own
+//!     pixels show it;
+//!   - otherwise (glossy rays, each averaged over its cone, and mirrors with the setting off)
+//!     every view whose distance cube holds the point (within the depth tolerance and a texel)
+//!     gives its radiance there.
+//!
+//!   Only where no view holds the point is the ray marched, as without proxies.
 //! - A ray marched to the scene's far distance without meeting a stored surface sees the
 //!   environment too (packs without proxies).
 //! - Roughness: a glossy surface marches [`GLOSSY_RAYS`] rays reflected about half-vectors
@@ -59,8 +69,10 @@ use plenoptic_pack::{CubeImage, LightKind, Manifest, plenoptic_sky::PlacedEnviro
 
 use crate::Reconstructor;
 use crate::brdf::{DELTA_ROUGHNESS, SurfaceMaterial, fresnel_dielectric, fresnel_schlick};
-use crate::shadow::PlacedShadows;
-use crate::temporal::bracketing;
+use crate::reflected::ShadedHits;
+use crate::shadow::{PlacedShadows, ProxyHit};
+use crate::sun::PlacedSun;
+use crate::temporal::key_weights;
 
 /// How the geometry-assisted mode shows the specular part of surfaces with a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,6 +172,10 @@ pub fn see_through_transmittance(
 /// How far (m) a reflected ray starts off its surface when it is cast against the proxies.
 pub const RAY_OFFSET: f32 = 1e-3;
 
+/// The cone (half-angle, radians) over which a gathering ray of [`crate::reflected`] averages
+/// the views' radiance.
+const GATHER_CONE: f32 = 0.1;
+
 /// Rays per pixel on a glossy surface (`Reflections::lobe`).
 pub const GLOSSY_RAYS: usize = 8;
 /// Most march steps per view.
@@ -195,29 +211,31 @@ pub(crate) struct Reflections<'r> {
     far: f32,
     depth_tolerance: f32,
     angular_power: f32,
+    /// Mirror rays' hits shaded as pixels are ([`crate::reflected`]), where the pack has
+    /// proxies and materials.
+    shaded: Option<ShadedHits<'r>>,
+    /// The camera's position and the angle one pixel subtends: a ray's footprint.
+    eye: Vec3,
+    pixel_angle: f32,
 }
 
 impl<'r> Reflections<'r> {
-    /// The cubes of the views blended for a camera at `position` at time `t` (unreadable
-    /// keys are listed in `missing` and left out).
-    pub fn new(rec: &'r Reconstructor, position: Vec3, t: f32, missing: &mut Vec<String>) -> Self {
+    /// The cubes of the views blended for `camera` at time `t`, the runtime `sun` shining on
+    /// the surfaces mirrors show (unreadable keys are listed in `missing` and left out).
+    pub fn new(
+        rec: &'r Reconstructor,
+        camera: &crate::Camera,
+        t: f32,
+        sun: Option<&'r PlacedSun<'r>>,
+        missing: &mut Vec<String>,
+    ) -> Self {
+        let position = camera.position;
         let manifest = rec.pack().manifest();
         let mut views = Vec::new();
         for (v, w) in rec.view_weights(position) {
             let bv = &manifest.base_views[v];
-            let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
-                continue;
-            };
-            let keys: Vec<(usize, f32)> = if k0 == k1 {
-                vec![(k0, 1.0)]
-            } else {
-                vec![(k0, 1.0 - s), (k1, s)]
-            };
             // Each key is marched in its own cubes (the GPU's lookups are per view and key).
-            for (k, wk) in keys {
-                if wk <= 0.0 {
-                    continue;
-                }
+            for (k, wk) in key_weights(&bv.time_keys, t) {
                 let Some(cubes) = rec.key_cubes(v, k, missing) else {
                     continue;
                 };
@@ -242,6 +260,16 @@ impl<'r> Reflections<'r> {
             far: march_distance(manifest),
             depth_tolerance: rec.settings.depth_tolerance,
             angular_power: rec.settings.angular_power,
+            shaded: if rec.settings.shaded_reflections {
+                ShadedHits::new(rec, position, t, sun, missing)
+            } else {
+                None
+            },
+            eye: position,
+            pixel_angle: {
+                let b = camera.basis();
+                2.0 * b.tan_y / b.height
+            },
         }
     }
 
@@ -249,23 +277,52 @@ impl<'r> Reflections<'r> {
     /// half-angle `cone` (radians): `None` where no base view can tell.
     pub fn incoming(&self, origin: Vec3, dir: Vec3, cone: f32) -> Option<Vec3> {
         // Off the surface the ray starts on before it is cast.
-        if let Some(rays) = &self.rays
-            && !rays.occluded(origin + dir * RAY_OFFSET, dir, self.far)
-        {
-            return Some(self.environment.radiance(dir));
+        let cast = self.rays.as_ref().map(|rays| {
+            rays.nearest(origin + dir * RAY_OFFSET, dir, self.far)
+                .map(|h| ProxyHit {
+                    t: h.t + RAY_OFFSET,
+                    ..h
+                })
+        });
+        let hit = match cast {
+            Some(None) => return Some(self.environment.radiance(dir)),
+            Some(Some(s)) => Some(s),
+            None => None,
+        };
+        // Where the proxies tell where the ray meets a surface, the views that see that
+        // point answer; the march is for packs without proxies, and for points no view sees.
+        if let Some(hit) = hit {
+            // A mirror's ray: the surface it meets shaded as a pixel is.
+            if cone == 0.0
+                && let Some(shaded) = &self.shaded
+            {
+                let width = ((origin - self.eye).length() + hit.t) * self.pixel_angle;
+                // A point no view shows gathers its lighting from the rays it sends out,
+                // answered as a glossy surface's are (the views' radiance where they meet).
+                let gather = |o: Vec3, wi: Vec3| self.incoming(o, wi, GATHER_CONE);
+                if let Some(c) = shaded.radiance(origin, dir, hit, width, &gather) {
+                    return Some(c);
+                }
+            }
+            let s = hit.t;
+            let point = origin + dir * s;
+            let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
+            for v in self.views.iter().filter(|v| self.sees(v, point)) {
+                let (l, w) = self.answer(v, dir, s, point, cone);
+                sum += l * w;
+                total += w;
+            }
+            if total > 0.0 {
+                return Some(sum / total);
+            }
         }
         let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
         let mut escaped = false;
         for v in &self.views {
             match self.march(v, origin, dir) {
                 March::Hit { s, point } => {
-                    let to = point - v.centre;
-                    let d = to.length();
-                    let cos = to.dot(dir) / d.max(1e-6);
-                    let w = v.weight * ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power);
-                    // The lobe's cone, as wide as it is at the hit, seen from the view.
-                    let angle = (cone * s / d.max(1e-3)).min(0.5);
-                    sum += self.fetch(v, to, angle) * w;
+                    let (l, w) = self.answer(v, dir, s, point, cone);
+                    sum += l * w;
                     total += w;
                 }
                 March::Escaped => escaped = true,
@@ -279,6 +336,30 @@ impl<'r> Reflections<'r> {
         } else {
             None
         }
+    }
+
+    /// Whether `v`'s distance cube holds `point`: the distance stored towards it is the
+    /// point's within the depth tolerance and a texel's size there (the march's test of a
+    /// crossing).
+    fn sees(&self, v: &MarchView, point: Vec3) -> bool {
+        let to = point - v.centre;
+        let d = to.length();
+        let cube = &v.distance;
+        let stored = cube.texels[direction_to_texel(cube.face_size, to)];
+        (d - stored).abs() <= (self.depth_tolerance + v.texel_angle) * d
+    }
+
+    /// `v`'s radiance at `point`, met at `s` along the ray `dir`, over the lobe's cone
+    /// `cone` as wide as it is there, and `v`'s weight for it: its view-space weight times
+    /// how close its direction to the point is to the ray's.
+    fn answer(&self, v: &MarchView, dir: Vec3, s: f32, point: Vec3, cone: f32) -> (Vec3, f32) {
+        let to = point - v.centre;
+        let d = to.length();
+        let cos = to.dot(dir) / d.max(1e-6);
+        let w = v.weight * ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power);
+        // The lobe's cone, as wide as it is at the hit, seen from the view.
+        let angle = (cone * s / d.max(1e-3)).min(0.5);
+        (self.fetch(v, to, angle), w)
     }
 
     /// Radiance arriving at `origin` over a GGX lobe of roughness `alpha` (α = perceptual²)
@@ -490,6 +571,9 @@ mod tests {
             far: 20.0,
             depth_tolerance: 0.03,
             angular_power: 8.0,
+            shaded: None,
+            eye: Vec3::ZERO,
+            pixel_angle: 1e-3,
         }
     }
 

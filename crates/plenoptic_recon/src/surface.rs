@@ -6,7 +6,7 @@
 
 use std::borrow::Cow;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::Reconstructor;
@@ -14,7 +14,7 @@ use crate::brdf::SurfaceMaterial;
 use crate::camera::{Camera, CameraBasis};
 use crate::geometry::Layer;
 use crate::material::Materials;
-use crate::proxy::ProxyGeometry;
+use crate::proxy::{ProxyGeometry, TriangleMesh};
 
 /// What the compose stage needs of the surface seen through one pixel.
 pub(crate) struct SurfacePixel {
@@ -146,35 +146,7 @@ impl<'a> Surfaces<'a> {
             .par_iter()
             .map(|&(oi, ti)| {
                 let (id, xf, mesh) = placed.get(oi as usize)?;
-                let m = materials.object(*id)?;
-                let tri = mesh.triangles.get(ti as usize)?;
-                let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
-                let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
-                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-                    _ => None,
-                };
-                let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
-                    let to_world = xf.matrix3.inverse().transpose();
-                    tri.map(|i| to_world * mesh.normals[i as usize])
-                });
-                // Tangents only where a normal map needs them (placed as the tracer places them).
-                let tangents = (m.material.normal_texture.is_some()
-                    && m.tangents.len() == mesh.positions.len())
-                .then(|| {
-                    let t = tri.map(|i| m.tangents[i as usize]);
-                    // A mirroring placement flips the bitangent's handedness, as in the tracer.
-                    let sign = t[0].w * xf.matrix3.determinant().signum();
-                    (t.map(|t| xf.matrix3 * t.truncate()), sign)
-                });
-                let mut t = SurfaceTriangle::new(*id, m, v, uv, eye)?;
-                if xf.matrix3.determinant() < 0.0 {
-                    // The tracer's geometric normal is the object-space one carried by the normal
-                    // matrix, which a mirroring transform turns against the placed winding.
-                    t.flip();
-                }
-                t.normals = normals;
-                t.tangents = tangents;
-                Some(t)
+                SurfaceTriangle::placed(*id, materials.object(*id)?, mesh, *xf, ti, eye)
             })
             .collect();
         let basis = camera.basis();
@@ -286,22 +258,8 @@ impl<'a> Surfaces<'a> {
         (x, y): (f32, f32),
         along: f32,
     ) -> PixelGeometry {
-        let b = t.barycentric(position);
         let ng = t.normal;
-        let mut ns = t.normals.map_or(ng, |[a, c, d]| {
-            (a * b.x + c * b.y + d * b.z).normalize_or(ng)
-        });
-        if let Some(([ta, tb, tc], sign)) = t.tangents
-            && let Some(local) =
-                self.materials
-                    .normal(self.rec.pack(), &t.material.material, uv, uv_footprint)
-        {
-            let tangent = ta * b.x + tb * b.y + tc * b.z;
-            ns = crate::material::bend_normal(ns, tangent, sign, local);
-        }
-        if ns.dot(ng) < 0.0 {
-            ns = -ns;
-        }
+        let ns = t.shading_normal(self.rec, self.materials, position, uv, uv_footprint);
         // The neighbouring pixels' rays met on the triangle's plane; at most 4 pixels'
         // worth of depth away, so that a grazing plane does not smear the footprint.
         let limit = 4.0 * along * self.pixel_angle;
@@ -330,6 +288,59 @@ impl<'a> Surfaces<'a> {
             footprint,
         }
     }
+}
+
+/// The surface a reflected ray meets, shaded as a pixel's ([`surface_at`]).
+pub(crate) struct HitSurface {
+    pub material: SurfaceMaterial,
+    /// Emitted radiance towards the ray where the pack leaves the emission to the runtime
+    /// (pack 4; else it is in the non-diffuse cube); zero from a single-sided emitter's back.
+    pub emission: Vec3,
+    /// Geometric normal as the mesh winds it (world, unit).
+    pub ng: Vec3,
+    /// Shading normal on `ng`'s side ([`SurfaceTriangle::shading_normal`]).
+    pub ns: Vec3,
+}
+
+/// The surface of triangle `ti` of object `id`'s `mesh` (placed by `xf`) at its point `p`,
+/// met by a ray along unit `dir` whose footprint is `width` metres across there: the
+/// material at the point's UV, with the texture's mip chosen by that footprint on the surface,
+/// as [`Surfaces::pixel`] shades a pixel. `None` for an object without a material or a
+/// degenerate triangle.
+#[expect(clippy::too_many_arguments, reason = "the hit and where its mesh is")]
+pub(crate) fn surface_at(
+    rec: &Reconstructor,
+    materials: &Materials,
+    id: u32,
+    mesh: &TriangleMesh,
+    xf: Affine3A,
+    ti: u32,
+    p: Vec3,
+    dir: Vec3,
+    width: f32,
+) -> Option<HitSurface> {
+    let m = materials.object(id)?;
+    let t = SurfaceTriangle::placed(id, m, mesh, xf, ti, p - dir)?;
+    let uv = t.uv_at(p);
+    let uv_footprint = if t.uv.is_some() {
+        t.scale * width / t.normal.dot(dir).abs().max(0.05).sqrt()
+    } else {
+        f32::INFINITY
+    };
+    let material = materials.surface(rec.pack(), &m.material, uv, uv_footprint);
+    let ng = t.normal;
+    let emits = m.material.double_sided || dir.dot(ng) < 0.0;
+    let emission = if emits && rec.pack().runtime_emission() {
+        materials.emission(rec.pack(), &m.material, uv, uv_footprint)
+    } else {
+        Vec3::ZERO
+    };
+    Some(HitSurface {
+        material,
+        emission,
+        ng,
+        ns: t.shading_normal(rec, materials, p, uv, uv_footprint),
+    })
 }
 
 /// A placed proxy triangle of an object with a material, ready for per-pixel UVs.
@@ -364,6 +375,46 @@ struct SurfaceTriangle<'m> {
 }
 
 impl<'m> SurfaceTriangle<'m> {
+    /// Triangle `ti` of object `id`'s `mesh` placed by `xf`, seen from `eye`: its corners,
+    /// UVs, vertex normals, and tangents where the material's normal map needs them.
+    fn placed(
+        id: u32,
+        m: &'m crate::material::ObjectMaterial,
+        mesh: &TriangleMesh,
+        xf: Affine3A,
+        ti: u32,
+        eye: Vec3,
+    ) -> Option<Self> {
+        let tri = mesh.triangles.get(ti as usize)?;
+        let v = tri.map(|i| xf.transform_point3(mesh.positions[i as usize]));
+        let uv = match tri.map(|i| m.uvs.get(i as usize).copied()) {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            _ => None,
+        };
+        let normals = (mesh.normals.len() == mesh.positions.len()).then(|| {
+            let to_world = xf.matrix3.inverse().transpose();
+            tri.map(|i| to_world * mesh.normals[i as usize])
+        });
+        // Tangents only where a normal map needs them (placed as the tracer places them).
+        let tangents = (m.material.normal_texture.is_some()
+            && m.tangents.len() == mesh.positions.len())
+        .then(|| {
+            let t = tri.map(|i| m.tangents[i as usize]);
+            // A mirroring placement flips the bitangent's handedness, as in the tracer.
+            let sign = t[0].w * xf.matrix3.determinant().signum();
+            (t.map(|t| xf.matrix3 * t.truncate()), sign)
+        });
+        let mut t = SurfaceTriangle::new(id, m, v, uv, eye)?;
+        if xf.matrix3.determinant() < 0.0 {
+            // The tracer's geometric normal is the object-space one carried by the normal
+            // matrix, which a mirroring transform turns against the placed winding.
+            t.flip();
+        }
+        t.normals = normals;
+        t.tangents = tangents;
+        Some(t)
+    }
+
     /// The triangle `v` (with `uv` at its corners) as seen from `eye`.
     fn new(
         object: u32,
@@ -411,6 +462,32 @@ impl<'m> SurfaceTriangle<'m> {
             uv_constant,
             uv_gradient,
         })
+    }
+
+    /// The shading normal at `p` (UV `uv`, footprint `uv_footprint`) on the geometric
+    /// normal's side: the vertex normals interpolated, else the geometric normal, bent by the
+    /// material's normal map.
+    fn shading_normal(
+        &self,
+        rec: &Reconstructor,
+        materials: &Materials,
+        p: Vec3,
+        uv: Vec2,
+        uv_footprint: f32,
+    ) -> Vec3 {
+        let b = self.barycentric(p);
+        let ng = self.normal;
+        let mut ns = self.normals.map_or(ng, |[a, c, d]| {
+            (a * b.x + c * b.y + d * b.z).normalize_or(ng)
+        });
+        if let Some(([ta, tb, tc], sign)) = self.tangents
+            && let Some(local) =
+                materials.normal(rec.pack(), &self.material.material, uv, uv_footprint)
+        {
+            let tangent = ta * b.x + tb * b.y + tc * b.z;
+            ns = crate::material::bend_normal(ns, tangent, sign, local);
+        }
+        if ns.dot(ng) < 0.0 { -ns } else { ns }
     }
 
     /// Flips the geometric normal (a mirroring placement), keeping the projective form.

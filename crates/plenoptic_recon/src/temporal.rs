@@ -113,6 +113,19 @@ pub fn bracketing(times: &[f32], t: f32) -> Option<(usize, usize, f32)> {
     Some((i, i + 1, s))
 }
 
+/// The keys bracketing `t` that weigh anything, with their linear weights ([`bracketing`]):
+/// one key at or outside the ends, else the two around `t`.
+pub fn key_weights(times: &[f32], t: f32) -> Vec<(usize, f32)> {
+    match bracketing(times, t) {
+        None => Vec::new(),
+        Some((k0, k1, _)) if k0 == k1 => vec![(k0, 1.0)],
+        Some((k0, k1, s)) => [(k0, 1.0 - s), (k1, s)]
+            .into_iter()
+            .filter(|&(_, w)| w > 0.0)
+            .collect(),
+    }
+}
+
 /// Texel-wise weighted sum of radiance cubes (all of one face size), clamped to ≥ 0 (the
 /// cubic may overshoot). `None` if the list is empty or the sizes differ.
 pub fn blend_cubes(cubes: &[(&CubeImage<Vec3>, f32)]) -> Option<CubeImage<Vec3>> {

@@ -1,0 +1,265 @@
+//! The surface a mirror's reflected ray meets, shaded as a pixel of the camera's own frame
+//! (docs/architecture.md, "Pack v2"; thesis ch. 8: illumination quality apart from image
+//! quality, applied to what a mirror shows).
+//!
+//! A reflected ray cast against the proxies ([`crate::shadow::PlacedShadows::nearest`]) knows
+//! the object and triangle it meets. That point is shaded as [`crate::shading`] shades a
+//! pixel:
+//!
+//! `albedo(uv) · lighting + emission(uv) + non-diffuse + sun`
+//!
+//! - the *lighting* and the *non-diffuse radiance* are the base views' cubes at the point,
+//!   looked up as a pixel's lookup is ([`crate::lookup::at_point`]: the nearest texel must
+//!   show the point's surface, the bilinear taps that show it are blended), carried along the
+//!   object's motion to each key's time, and weighted by the view's weight and by how close
+//!   its direction to the point is to the ray's; where no cube shows the point, the views'
+//!   temporal-volume samples of its object near it;
+//! - the *albedo* and the *emission* are the material's at the point's UV, the texture's mip
+//!   chosen by the ray's footprint there (the pixel's cone, continued past the mirror);
+//! - the runtime sun's direct light is evaluated at the point with its shadow rays
+//!   ([`crate::sun`]).
+//!
+//! Reading the base views' *radiance* at the hit instead (what the march does) showed the
+//! reflected scene at cube resolution, its sun-shadow edges blurred, and took the colour of
+//! whatever a view's texel showed there: surfaces every view sees edge-on (the front of a box
+//! level with the base views) came out as the colour of the box's top or of the floor behind
+//! it, a pale ghost beside the box in the `specular` test's mirror.
+//!
+//! Where no view's cubes or samples show the point, its lighting is the irradiance arriving at
+//! the views ([`crate::irradiance`]) on its normal, as an engine's light probe lights it.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+
+use crate::Reconstructor;
+use crate::brdf::Bsdf;
+use crate::lookup::{FastKey, PackedTexels, at_point};
+use crate::material::Materials;
+use crate::proxy::{ProxyGeometry, TriangleMesh};
+use crate::reconstructor::KeyCubes;
+use crate::shading::Channel;
+use crate::shadow::ProxyHit;
+use crate::sun::PlacedSun;
+use crate::volume::VolumeIndex;
+
+/// One (view, key)'s lighting cubes, with the non-diffuse radiance beside them.
+struct LitKey {
+    base: Vec3,
+    /// The view's weight × the key's time weight.
+    weight: f32,
+    /// The key's time.
+    time: f32,
+    cubes: KeyCubes,
+    packed: Arc<PackedTexels>,
+    non_diffuse: Option<Arc<plenoptic_pack::CubeImage<Vec3>>>,
+}
+
+/// What shading a reflected ray's hit needs at one camera position and time.
+pub(crate) struct ShadedHits<'r> {
+    rec: &'r Reconstructor,
+    proxy: &'r ProxyGeometry,
+    materials: &'r Materials,
+    /// Pack id → (object-to-world transform at the frame's time, mesh).
+    placed: HashMap<u32, (Affine3A, &'r TriangleMesh)>,
+    t: f32,
+    keys: Vec<LitKey>,
+    /// Per base view: its position, weight and temporal-volume samples of the lighting.
+    volumes: Vec<(Vec3, f32, VolumeIndex)>,
+    sun: Option<&'r PlacedSun<'r>>,
+    depth_tolerance: f32,
+    angular_power: f32,
+}
+
+impl<'r> ShadedHits<'r> {
+    /// The lighting of the views blended for a camera at `position` at time `t`; `None`
+    /// without proxies or materials (unreadable keys are listed in `missing` and left out).
+    pub fn new(
+        rec: &'r Reconstructor,
+        position: Vec3,
+        t: f32,
+        sun: Option<&'r PlacedSun<'r>>,
+        missing: &mut Vec<String>,
+    ) -> Option<Self> {
+        let proxy = rec.proxy()?;
+        let materials = rec.materials();
+        if materials.is_empty() {
+            return None;
+        }
+        let manifest = rec.pack().manifest();
+        let mut keys = Vec::new();
+        let mut volumes = Vec::new();
+        for (v, w) in rec.view_weights(position) {
+            let bv = &manifest.base_views[v];
+            for (k, wk) in crate::temporal::key_weights(&bv.time_keys, t) {
+                let Some(cubes) = rec.key_cubes_in(v, k, Channel::Lighting, missing) else {
+                    continue;
+                };
+                let non_diffuse = rec
+                    .key_cubes_in(v, k, Channel::NonDiffuse, missing)
+                    .map(|c| c.radiance)
+                    .filter(|c| c.face_size == cubes.distance.face_size);
+                keys.push(LitKey {
+                    base: bv.position,
+                    weight: w * wk,
+                    time: bv.time_keys[k],
+                    packed: rec.packed_texels(v, k, Channel::Lighting, &cubes),
+                    cubes,
+                    non_diffuse,
+                });
+            }
+            if let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing) {
+                volumes.push((bv.position, w, index));
+            }
+        }
+        let placed = proxy
+            .placed_meshes(t)
+            .into_iter()
+            .map(|(id, xf, mesh)| (id, (xf, mesh)))
+            .collect();
+        Some(ShadedHits {
+            rec,
+            proxy,
+            materials,
+            placed,
+            t,
+            keys,
+            volumes,
+            sun,
+            depth_tolerance: rec.settings.depth_tolerance,
+            angular_power: rec.settings.angular_power,
+        })
+    }
+
+    /// The radiance leaving `hit`, met by the ray from `origin` along unit `dir`, towards
+    /// `origin`; the ray's footprint is `width` metres across there. `None` where the object
+    /// has no material.
+    pub fn radiance(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        hit: ProxyHit,
+        width: f32,
+        gather: &dyn Fn(Vec3, Vec3) -> Option<Vec3>,
+    ) -> Option<Vec3> {
+        let &(xf, mesh) = self.placed.get(&hit.object)?;
+        let p = origin + dir * hit.t;
+        let surface = crate::surface::surface_at(
+            self.rec,
+            self.materials,
+            hit.object,
+            mesh,
+            xf,
+            hit.triangle,
+            p,
+            dir,
+            width,
+        )?;
+        // The side of the surface the ray meets.
+        let n = if surface.ns.dot(dir) > 0.0 {
+            -surface.ns
+        } else {
+            surface.ns
+        };
+        let (lighting, non_diffuse) = match self.lighting(p, dir, hit.object) {
+            Some(l) => l,
+            None => (self.gathered(p, n, surface.ng, gather)?, Vec3::ZERO),
+        };
+        let mut c = surface.material.albedo() * lighting + non_diffuse + surface.emission;
+        if let Some(sun) = self.sun {
+            let front = dir.dot(surface.ng) < 0.0;
+            let bsdf = Bsdf::new(surface.material, surface.ng, surface.ns, -dir, front);
+            c += sun.radiance(p, surface.ng, (Vec3::ZERO, Vec3::ZERO), &bsdf, 0);
+        }
+        Some(c)
+    }
+
+    /// The lighting and non-diffuse radiance at point `p` of `object`, met along `dir`: the
+    /// keys' cubes that show it, else the views' volume samples near it; `None` where neither
+    /// does.
+    fn lighting(&self, p: Vec3, dir: Vec3, object: u32) -> Option<(Vec3, Vec3)> {
+        let tol = self.depth_tolerance;
+        let angular = |base: Vec3| {
+            let to = p - base;
+            let cos = to.dot(dir) / to.length().max(1e-6);
+            ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power)
+        };
+        let now_inverse = self.proxy.transform(object, self.t).inverse();
+        let (mut sum, mut sum2, mut total) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
+        for k in &self.keys {
+            let fast = FastKey {
+                base: k.base,
+                weight: k.weight,
+                face: k.cubes.distance.face_size,
+                texels: &k.packed.texels,
+                second: k.non_diffuse.as_deref().map(|c| c.texels.as_slice()),
+                normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
+                motion: &[],
+                reuse: Vec::new(),
+            };
+            // The point carried along the object's motion to the key's time.
+            let at_key = (self.proxy.transform(object, k.time) * now_inverse).transform_point3(p);
+            if let Some((l, second)) = at_point(&fast, at_key, object, tol) {
+                let w = k.weight * angular(k.base);
+                sum += l * w;
+                sum2 += second.unwrap_or(Vec3::ZERO) * w;
+                total += w;
+            }
+        }
+        if total <= 0.0 {
+            for (base, w, index) in &self.volumes {
+                if let Some((l, second, wv)) =
+                    index.lookup_pair(p - *base, object, tol, Some(Channel::NonDiffuse))
+                {
+                    let w = w * angular(*base) * wv;
+                    sum += l * w;
+                    sum2 += second * w;
+                    total += w;
+                }
+            }
+        }
+        (total > 0.0).then(|| (sum / total, sum2 / total))
+    }
+
+    /// The diffuse lighting at `p` (normal `n` on the side it is seen from, geometric normal
+    /// `ng`) gathered over [`GATHER_RAYS`] cosine-distributed directions: the mean of the
+    /// radiance `gather` finds arriving along them (rays it cannot answer left out), which is
+    /// `E/π` for cosine-weighted directions. `None` where no ray is answered.
+    fn gathered(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        ng: Vec3,
+        gather: &dyn Fn(Vec3, Vec3) -> Option<Vec3>,
+    ) -> Option<Vec3> {
+        let (a, b) = n.any_orthonormal_pair();
+        // A turn of the set per point (its coordinates hashed), so that neighbouring rays'
+        // sets differ.
+        let turn = {
+            let h = (p * 1e4).as_ivec3();
+            let k = (h.x as u32).wrapping_mul(0x9E37_79B1)
+                ^ (h.y as u32).wrapping_mul(0x85EB_CA77)
+                ^ (h.z as u32).wrapping_mul(0xC2B2_AE3D);
+            (k >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let (mut sum, mut count) = (Vec3::ZERO, 0u32);
+        for k in 0..GATHER_RAYS {
+            let u1 = (k as f32 + 0.5) / GATHER_RAYS as f32;
+            let u2 = ((k as u32).reverse_bits() as f32 / 4_294_967_296.0 + turn).fract();
+            let r = u1.sqrt();
+            let phi = std::f32::consts::TAU * u2;
+            let wi =
+                (a * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).sqrt()).normalize_or(n);
+            let origin = p + crate::shadow::shadow_lift(p, ng, wi);
+            if let Some(l) = gather(origin, wi) {
+                sum += l;
+                count += 1;
+            }
+        }
+        (count > 0).then(|| sum / count as f32)
+    }
+}
+
+/// Rays gathering the lighting of a point no view shows ([`ShadedHits::radiance`]).
+pub const GATHER_RAYS: usize = 8;
