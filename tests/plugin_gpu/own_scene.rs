@@ -115,6 +115,13 @@ fn frame_with(dir: &std::path::Path, own_scene: bool, darken: bool, backend: Bac
             },
         ));
     }
+    // The CPU backend reflects as the GPU does: the GPU marches every reflected ray and reads
+    // the radiance where it crosses the cubes (`ReconSettings::shaded_reflections` off).
+    app.update();
+    let world = app.world_mut();
+    for mut camera in world.query::<&mut PlenopticCamera>().iter_mut(world) {
+        camera.settings.shaded_reflections = false;
+    }
     let sphere = |app: &mut App| {
         let world = app.world_mut();
         world

@@ -81,13 +81,15 @@ pub struct ReconSettings {
     /// frame of benches/recon.rs takes 0.84× the time at 640 × 360 (`geometry_textured`
     /// against `geometry_textured_dense`). The plugin's GPU path looks up every fragment.
     pub sparse_lighting: bool,
-    /// With [`Specular::Marched`] on a pack with proxies and materials: the surface an ideal
-    /// mirror's ray meets is shaded as a pixel is, its material at the hit's UV × the baked
-    /// lighting there + the runtime sun ([`crate::specular`], `reflected.rs`), instead of the
-    /// base views' radiance at the hit. In the `specular` test (320 × 180, 4 × 4 samples) the
-    /// mirror's error fell from 2.18× to 1.32× the diffuse pixels' under the sun, and from
-    /// 2.08× to 1.59× under a lamp. The plugin's GPU path does not do this yet: it reads the
-    /// radiance at the hit, as this does when off.
+    /// With [`Specular::Marched`] on a pack with proxies: a reflected ray that meets a proxy
+    /// is answered at that point ([`crate::specular`]), and on a pack with materials the
+    /// surface an ideal mirror's ray meets is shaded as a pixel is, its material at the
+    /// hit's UV × the baked lighting there + the runtime sun (`reflected.rs`). Off, every ray
+    /// is marched through the distance cubes and reads the base views' radiance where it
+    /// crosses them. In the `specular` test (320 × 180, 4 × 4 samples) the mirror's error
+    /// fell from 2.18× to 1.32× the diffuse pixels' under the sun, and from 2.08× to 1.59×
+    /// under a lamp. The plugin's GPU path does not do this yet: it marches as this does
+    /// when off.
     pub shaded_reflections: bool,
 }
 

@@ -211,8 +211,11 @@ pub(crate) struct Reflections<'r> {
     far: f32,
     depth_tolerance: f32,
     angular_power: f32,
+    /// Whether a ray that meets a proxy is answered at that point
+    /// ([`crate::ReconSettings::shaded_reflections`]).
+    at_hits: bool,
     /// Mirror rays' hits shaded as pixels are ([`crate::reflected`]), where the pack has
-    /// proxies and materials.
+    /// proxies and materials and `at_hits`.
     shaded: Option<ShadedHits<'r>>,
     /// The camera's position and the angle one pixel subtends: a ray's footprint.
     eye: Vec3,
@@ -260,6 +263,7 @@ impl<'r> Reflections<'r> {
             far: march_distance(manifest),
             depth_tolerance: rec.settings.depth_tolerance,
             angular_power: rec.settings.angular_power,
+            at_hits: rec.settings.shaded_reflections,
             shaded: if rec.settings.shaded_reflections {
                 ShadedHits::new(rec, position, t, sun, missing)
             } else {
@@ -286,11 +290,12 @@ impl<'r> Reflections<'r> {
         });
         let hit = match cast {
             Some(None) => return Some(self.environment.radiance(dir)),
-            Some(Some(s)) => Some(s),
+            Some(Some(s)) => Some(s).filter(|_| self.at_hits),
             None => None,
         };
         // Where the proxies tell where the ray meets a surface, the views that see that
-        // point answer; the march is for packs without proxies, and for points no view sees.
+        // point answer; the march is for packs without proxies, and for points no view sees
+        // (and for every ray, as on the GPU, with `shaded_reflections` off).
         if let Some(hit) = hit {
             // A mirror's ray: the surface it meets shaded as a pixel is.
             if cone == 0.0
@@ -571,6 +576,7 @@ mod tests {
             far: 20.0,
             depth_tolerance: 0.03,
             angular_power: 8.0,
+            at_hits: false,
             shaded: None,
             eye: Vec3::ZERO,
             pixel_angle: 1e-3,
