@@ -299,15 +299,9 @@ pub(crate) fn render_pair(
     let mut fast: Vec<FastKey<'_>> = keys
         .iter()
         .filter(|k| k.weight > 1e-4)
-        .map(|k| FastKey {
-            base: k.base,
-            weight: k.weight,
-            face: k.cubes.ids.face_size,
-            texels: &k.packed.texels,
-            second: k.second.as_deref().map(|c| c.texels.as_slice()),
-            normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
-            motion: &k.motion,
-            reuse: Vec::new(),
+        .map(|k| {
+            let second = k.second.as_deref();
+            FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &k.motion)
         })
         .collect();
     for i in 0..fast.len() {

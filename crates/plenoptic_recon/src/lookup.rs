@@ -85,6 +85,30 @@ pub(crate) struct FastKey<'a> {
     pub reuse: Vec<bool>,
 }
 
+impl<'a> FastKey<'a> {
+    /// The key at `base` with weight `weight`: its `cubes` (their ids, distances and
+    /// normals), `packed` from them, the `second` colour's cube and the objects' `motion`.
+    pub fn new(
+        base: Vec3,
+        weight: f32,
+        cubes: &'a KeyCubes,
+        packed: &'a PackedTexels,
+        second: Option<&'a plenoptic_pack::CubeImage<Vec3>>,
+        motion: &'a [Affine3A],
+    ) -> Self {
+        FastKey {
+            base,
+            weight,
+            face: cubes.ids.face_size,
+            texels: &packed.texels,
+            second: second.map(|c| c.texels.as_slice()),
+            normal: cubes.normal.as_deref().map(|c| c.texels.as_slice()),
+            motion,
+            reuse: Vec::new(),
+        }
+    }
+}
+
 /// No object slot: nothing to look up for this pixel.
 pub(crate) const NO_SLOT: u32 = u32::MAX;
 /// No texel.

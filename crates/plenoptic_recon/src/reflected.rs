@@ -197,24 +197,13 @@ impl<'r> ShadedHits<'r> {
     /// does.
     fn lighting(&self, p: Vec3, dir: Vec3, object: u32) -> Option<(Vec3, Vec3)> {
         let tol = self.depth_tolerance;
-        let angular = |base: Vec3| {
-            let to = p - base;
-            let cos = to.dot(dir) / to.length().max(1e-6);
-            ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power)
-        };
+        let angular =
+            |base: Vec3| crate::specular::angular_weight(p - base, dir, self.angular_power);
         let now_inverse = self.proxy.transform(object, self.t).inverse();
         let (mut sum, mut sum2, mut total) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
         for k in &self.keys {
-            let fast = FastKey {
-                base: k.base,
-                weight: k.weight,
-                face: k.cubes.distance.face_size,
-                texels: &k.packed.texels,
-                second: k.non_diffuse.as_deref().map(|c| c.texels.as_slice()),
-                normal: k.cubes.normal.as_deref().map(|c| c.texels.as_slice()),
-                motion: &[],
-                reuse: Vec::new(),
-            };
+            let second = k.non_diffuse.as_deref();
+            let fast = FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &[]);
             // The point carried along the object's motion to the key's time.
             let at_key = (self.proxy.transform(object, k.time) * now_inverse).transform_point3(p);
             if let Some((l, second)) = at_point(&fast, at_key, object, tol) {

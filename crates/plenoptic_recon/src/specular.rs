@@ -360,8 +360,7 @@ impl<'r> Reflections<'r> {
     fn answer(&self, v: &MarchView, dir: Vec3, s: f32, point: Vec3, cone: f32) -> (Vec3, f32) {
         let to = point - v.centre;
         let d = to.length();
-        let cos = to.dot(dir) / d.max(1e-6);
-        let w = v.weight * ((1.0 + cos) * 0.5).max(1e-3).powf(self.angular_power);
+        let w = v.weight * angular_weight(to, dir, self.angular_power);
         // The lobe's cone, as wide as it is at the hit, seen from the view.
         let angle = (cone * s / d.max(1e-3)).min(0.5);
         (self.fetch(v, to, angle), w)
@@ -487,6 +486,14 @@ impl<'r> Reflections<'r> {
         }
         sum / total
     }
+}
+
+/// How much a view whose direction to the point a ray meets is `to` counts for the ray along
+/// unit `dir`: `((1 + cos) / 2)^power` of the angle between them (the view sees the point as
+/// the ray does when they agree; the hit surface may be glossy).
+pub(crate) fn angular_weight(to: Vec3, dir: Vec3, power: f32) -> f32 {
+    let cos = to.dot(dir) / to.length().max(1e-6);
+    ((1.0 + cos) * 0.5).max(1e-3).powf(power)
 }
 
 /// How a march ended.
