@@ -84,7 +84,8 @@ pub(crate) struct ShadedHits<'r> {
 
 impl<'r> ShadedHits<'r> {
     /// The lighting of the views blended for a camera at `position` at time `t`; `None`
-    /// without proxies or materials (unreadable keys are listed in `missing` and left out).
+    /// without proxies, materials or lighting cubes (unreadable keys are listed in `missing`
+    /// and left out).
     pub fn new(
         rec: &'r Reconstructor,
         position: Vec3,
@@ -122,6 +123,11 @@ impl<'r> ShadedHits<'r> {
             if let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing) {
                 volumes.push((bv.position, w, index));
             }
+        }
+        if keys.is_empty() {
+            // No lighting to look up (a pack without it, or unreadable keys): the radiance at
+            // the hit serves, rather than a gather at every hit.
+            return None;
         }
         let glazing: Vec<u32> = manifest
             .objects
