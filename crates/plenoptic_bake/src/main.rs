@@ -8,7 +8,7 @@
 //! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
 //!                    [--exposure E]
 //! plenoptic render PACK --path PATH.json [--mode image|volume|geometry]
-//!     [--shading materials|radiance] --out DIR
+//!     [--shading materials|radiance] [--reflections shaded|marched] --out DIR
 //! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
 //!                   [--plot OUT.svg]
 //! ```
@@ -129,6 +129,11 @@ enum Command {
         /// as version-1 packs were shown).
         #[arg(long, default_value = "materials")]
         shading: String,
+        /// What a mirror shows: shaded (the surface its ray meets shaded as a pixel is, the
+        /// default) or marched (every reflected ray marched through the base views' distance
+        /// cubes and shown in their radiance, as the plugin's GPU path does).
+        #[arg(long, default_value = "shaded")]
+        reflections: String,
         /// Samples per pixel along each axis, box-filtered (1: the pixel centre; a path-traced
         /// reference's pixels are box-filtered, so compare with 2–4).
         #[arg(long, default_value_t = 1)]
@@ -280,6 +285,7 @@ fn run(command: Command) -> Result<()> {
             path,
             mode,
             shading,
+            reflections,
             supersampling,
             out,
         } => {
@@ -295,10 +301,20 @@ fn run(command: Command) -> Result<()> {
                     )));
                 }
             };
+            let shaded_reflections = match reflections.to_ascii_lowercase().as_str() {
+                "shaded" => true,
+                "marched" => false,
+                other => {
+                    return Err(BakeError::Invalid(format!(
+                        "reflections '{other}': expected shaded or marched"
+                    )));
+                }
+            };
             let render = || -> std::result::Result<_, plenoptic_eval::EvalError> {
                 let camera_path = plenoptic_recon::CameraPath::load(&path)?;
                 let mut rec = plenoptic_recon::Reconstructor::open(&pack)?;
                 rec.settings.shading = shading;
+                rec.settings.shaded_reflections = shaded_reflections;
                 rec.settings.supersampling = supersampling;
                 plenoptic_eval::tools::render_path_with(
                     &rec,
