@@ -8,9 +8,12 @@
 //! `ReconSettings::sparse_lighting` off, every pixel looked up), and
 //! with pack 3's runtime sun on top (`geometry_sun`: the room with a skylight, the sun's
 //! direct light through each pixel's BSDF with `ReconSettings::sun_shadow_rays` = 4 shadow
-//! rays against the proxies), and with a mirror and a glossy metal wall whose reflections
-//! are marched for the camera (`geometry_reflections`, `Specular::Marched`) beside the same
-//! pack with the baked specular (`geometry_reflections_baked`); and
+//! rays against the proxies), and with a mirror and a glossy metal wall that reflect for the
+//! camera (`geometry_reflections`, `Specular::Marched`: rays answered where the proxies say
+//! they meet a surface, the mirror's hits shaded as pixels) beside the same pack with every
+//! reflected ray marched, as the plugin's GPU path does (`geometry_reflections_marched`,
+//! `ReconSettings::shaded_reflections` off) and with the baked specular
+//! (`geometry_reflections_baked`); and
 //! the reference path tracer's time for the same frame, as a ratio
 //! measured in the same run. The chunk cache is warm (decoded cubes, interleaved texels and
 //! binned volume blocks are built on the first frame), as in a walk-through.
@@ -93,6 +96,8 @@ fn bench(c: &mut Criterion) {
         &mirror_path,
     );
     let mirror = Reconstructor::open(&mirror_path).unwrap();
+    let mut mirror_marched = Reconstructor::open(&mirror_path).unwrap();
+    mirror_marched.settings.shaded_reflections = false;
     let mut mirror_baked = Reconstructor::open(&mirror_path).unwrap();
     mirror_baked.settings.specular = Specular::Baked;
     let mut group = c.benchmark_group("recon");
@@ -131,8 +136,12 @@ fn bench(c: &mut Criterion) {
             report.reflections.1
         );
         let _ = mirror_baked.render(&cam, T, mode).unwrap();
+        let _ = mirror_marched.render(&cam, T, mode).unwrap();
         group.bench_function(format!("geometry_reflections/{w}x{h}"), |b| {
             b.iter(|| black_box(mirror.render(black_box(&cam), T, mode).unwrap()))
+        });
+        group.bench_function(format!("geometry_reflections_marched/{w}x{h}"), |b| {
+            b.iter(|| black_box(mirror_marched.render(black_box(&cam), T, mode).unwrap()))
         });
         group.bench_function(format!("geometry_reflections_baked/{w}x{h}"), |b| {
             b.iter(|| black_box(mirror_baked.render(black_box(&cam), T, mode).unwrap()))
