@@ -280,18 +280,24 @@ impl<'r> Reflections<'r> {
     /// Radiance arriving at `origin` along unit direction `dir`, averaged over a cone of
     /// half-angle `cone` (radians): `None` where no base view can tell.
     pub fn incoming(&self, origin: Vec3, dir: Vec3, cone: f32) -> Option<Vec3> {
-        // Off the surface the ray starts on before it is cast.
-        let cast = self.rays.as_ref().map(|rays| {
-            rays.nearest(origin + dir * RAY_OFFSET, dir, self.far)
-                .map(|h| ProxyHit {
+        // Off the surface the ray starts on before it is cast: the nearest hit where it is
+        // answered there, else only whether anything is met.
+        let start = origin + dir * RAY_OFFSET;
+        let hit = match &self.rays {
+            None => None,
+            Some(rays) if !self.at_hits => {
+                if !rays.occluded(start, dir, self.far) {
+                    return Some(self.environment.radiance(dir));
+                }
+                None
+            }
+            Some(rays) => match rays.nearest(start, dir, self.far) {
+                None => return Some(self.environment.radiance(dir)),
+                Some(h) => Some(ProxyHit {
                     t: h.t + RAY_OFFSET,
                     ..h
-                })
-        });
-        let hit = match cast {
-            Some(None) => return Some(self.environment.radiance(dir)),
-            Some(Some(s)) => Some(s).filter(|_| self.at_hits),
-            None => None,
+                }),
+            },
         };
         // Where the proxies tell where the ray meets a surface, the views that see that
         // point answer; the march is for packs without proxies, and for points no view sees
