@@ -45,7 +45,7 @@ use crate::Reconstructor;
 use crate::brdf::Bsdf;
 use crate::lookup::{FastKey, PackedTexels, at_point};
 use crate::material::Materials;
-use crate::proxy::{ProxyGeometry, TriangleMesh};
+use crate::proxy::TriangleMesh;
 use crate::reconstructor::KeyCubes;
 use crate::shading::Channel;
 use crate::shadow::ProxyHit;
@@ -64,16 +64,24 @@ struct LitKey {
     non_diffuse: Option<Arc<plenoptic_pack::CubeImage<Vec3>>>,
 }
 
+/// An object placed at the frame's time, as a reflected ray's hit needs it.
+struct PlacedObject<'r> {
+    /// Object-to-world transform at the frame's time.
+    xf: Affine3A,
+    mesh: &'r TriangleMesh,
+    /// Per key of [`ShadedHits::keys`]: M(τ) M(t)⁻¹, a point of the object at the frame's
+    /// time carried to the key's time τ.
+    to_key: Vec<Affine3A>,
+}
+
 /// What shading a reflected ray's hit needs at one camera position and time.
 pub(crate) struct ShadedHits<'r> {
     rec: &'r Reconstructor,
-    proxy: &'r ProxyGeometry,
     materials: &'r Materials,
-    /// Pack id → (object-to-world transform at the frame's time, mesh), for the objects
-    /// shaded: glazing (a coverage, `crate::glazing`) is left out, its cube texels showing
-    /// what lies behind it as the tracer blends it.
-    placed: HashMap<u32, (Affine3A, &'r TriangleMesh)>,
-    t: f32,
+    /// Pack id → the object placed, for the objects shaded: glazing (a coverage,
+    /// `crate::glazing`) is left out, its cube texels showing what lies behind it as the
+    /// tracer blends it.
+    placed: HashMap<u32, PlacedObject<'r>>,
     keys: Vec<LitKey>,
     /// Per base view: its position, weight and temporal-volume samples of the lighting.
     volumes: Vec<(Vec3, f32, VolumeIndex)>,
@@ -139,14 +147,19 @@ impl<'r> ShadedHits<'r> {
             .placed_meshes(t)
             .into_iter()
             .filter(|(id, _, _)| !glazing.contains(id))
-            .map(|(id, xf, mesh)| (id, (xf, mesh)))
+            .map(|(id, xf, mesh)| {
+                let now_inverse = xf.inverse();
+                let to_key = keys
+                    .iter()
+                    .map(|k| proxy.transform(id, k.time) * now_inverse)
+                    .collect();
+                (id, PlacedObject { xf, mesh, to_key })
+            })
             .collect();
         Some(ShadedHits {
             rec,
-            proxy,
             materials,
             placed,
-            t,
             keys,
             volumes,
             sun,
@@ -166,14 +179,14 @@ impl<'r> ShadedHits<'r> {
         width: f32,
         gather: &dyn Fn(Vec3, Vec3) -> Option<Vec3>,
     ) -> Option<Vec3> {
-        let &(xf, mesh) = self.placed.get(&hit.object)?;
+        let object = self.placed.get(&hit.object)?;
         let p = origin + dir * hit.t;
         let surface = crate::surface::surface_at(
             self.rec,
             self.materials,
             hit.object,
-            mesh,
-            xf,
+            object.mesh,
+            object.xf,
             hit.triangle,
             p,
             dir,
@@ -185,7 +198,7 @@ impl<'r> ShadedHits<'r> {
         } else {
             surface.ns
         };
-        let (lighting, non_diffuse) = match self.lighting(p, dir, hit.object) {
+        let (lighting, non_diffuse) = match self.lighting(p, dir, hit.object, &object.to_key) {
             Some(l) => l,
             None => (self.gathered(p, n, surface.ng, gather)?, Vec3::ZERO),
         };
@@ -199,19 +212,23 @@ impl<'r> ShadedHits<'r> {
     }
 
     /// The lighting and non-diffuse radiance at point `p` of `object`, met along `dir`: the
-    /// keys' cubes that show it, else the views' volume samples near it; `None` where neither
-    /// does.
-    fn lighting(&self, p: Vec3, dir: Vec3, object: u32) -> Option<(Vec3, Vec3)> {
+    /// keys' cubes that show it (the point carried to each key's time by `to_key`), else the
+    /// views' volume samples near it; `None` where neither does.
+    fn lighting(
+        &self,
+        p: Vec3,
+        dir: Vec3,
+        object: u32,
+        to_key: &[Affine3A],
+    ) -> Option<(Vec3, Vec3)> {
         let tol = self.depth_tolerance;
         let angular =
             |base: Vec3| crate::specular::angular_weight(p - base, dir, self.angular_power);
-        let now_inverse = self.proxy.transform(object, self.t).inverse();
         let (mut sum, mut sum2, mut total) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-        for k in &self.keys {
+        for (k, motion) in self.keys.iter().zip(to_key) {
             let second = k.non_diffuse.as_deref();
             let fast = FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &[]);
-            // The point carried along the object's motion to the key's time.
-            let at_key = (self.proxy.transform(object, k.time) * now_inverse).transform_point3(p);
+            let at_key = motion.transform_point3(p);
             if let Some((l, second)) = at_point(&fast, at_key, object, tol) {
                 let w = k.weight * angular(k.base);
                 sum += l * w;
@@ -257,8 +274,7 @@ impl<'r> ShadedHits<'r> {
         };
         let (mut sum, mut count) = (Vec3::ZERO, 0u32);
         for k in 0..GATHER_RAYS {
-            let u1 = (k as f32 + 0.5) / GATHER_RAYS as f32;
-            let u2 = ((k as u32).reverse_bits() as f32 / 4_294_967_296.0 + turn).fract();
+            let (u1, u2) = crate::specular::hammersley(k, GATHER_RAYS, turn);
             let r = u1.sqrt();
             let phi = std::f32::consts::TAU * u2;
             let wi =

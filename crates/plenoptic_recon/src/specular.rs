@@ -390,8 +390,7 @@ impl<'r> Reflections<'r> {
         let (a, b) = n.any_orthonormal_pair();
         let (mut sum, mut count) = (Vec3::ZERO, 0u32);
         for k in 0..GLOSSY_RAYS {
-            let u1 = (k as f32 + 0.5) / GLOSSY_RAYS as f32;
-            let u2 = ((k as u32).reverse_bits() as f32 / 4_294_967_296.0 + turn).fract();
+            let (u1, u2) = hammersley(k, GLOSSY_RAYS, turn);
             let tan2 = alpha * alpha * u1 / (1.0 - u1);
             let cos_h = 1.0 / (1.0 + tan2).sqrt();
             let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
@@ -500,6 +499,15 @@ impl<'r> Reflections<'r> {
 pub(crate) fn angular_weight(to: Vec3, dir: Vec3, power: f32) -> f32 {
     let cos = to.dot(dir) / to.length().max(1e-6);
     ((1.0 + cos) * 0.5).max(1e-3).powf(power)
+}
+
+/// Point `k` of a Hammersley set of `n` in the unit square, its second coordinate turned by
+/// `turn` ∈ [0, 1) (a per-pixel or per-point rotation, so that neighbours' sets differ): the
+/// directions of a glossy lobe's rays and of a gather's.
+pub(crate) fn hammersley(k: usize, n: usize, turn: f32) -> (f32, f32) {
+    let u1 = (k as f32 + 0.5) / n as f32;
+    let u2 = ((k as u32).reverse_bits() as f32 / 4_294_967_296.0 + turn).fract();
+    (u1, u2)
 }
 
 /// How a march ended.

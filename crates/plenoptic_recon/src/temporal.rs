@@ -155,6 +155,17 @@ pub fn blend_cubes(cubes: &[(&CubeImage<Vec3>, f32)]) -> Option<CubeImage<Vec3>>
 mod tests {
     use super::*;
 
+    /// One key at or beyond the ends, the two around t inside, a key of zero weight left out.
+    #[test]
+    fn key_weights_are_the_bracketing_keys_that_weigh() {
+        let times = [0.0, 1.0, 2.0];
+        assert_eq!(key_weights(&times, -1.0), vec![(0, 1.0)]);
+        assert_eq!(key_weights(&times, 5.0), vec![(2, 1.0)]);
+        assert_eq!(key_weights(&times, 1.25), vec![(1, 0.75), (2, 0.25)]);
+        assert_eq!(key_weights(&times, 1.0), vec![(1, 1.0)]);
+        assert!(key_weights(&[], 1.0).is_empty());
+    }
+
     fn eval(times: &[f32], values: &[f32], t: f32) -> f32 {
         bezier_weights(times, t)
             .iter()
