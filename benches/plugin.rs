@@ -14,6 +14,11 @@
 //! - `plugin/frame`: one `App::update` of a settled app at 1280 × 720 with one and with two
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes).
 //!
+//! With `PLENOPTIC_TOUR_PACK` set to the architectural tour's baked pack, both groups also
+//! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B
+//! under the sun, glass and glossy steel in view). With `PLENOPTIC_BENCH_PASSES` set, each
+//! frame case also prints its passes' CPU and GPU times (Bevy's render diagnostics).
+//!
 //! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
 //! how the cost grows with pixels and cameras, not what a real GPU takes, and time to first
 //! frame on it is dominated by compiling the shaders on the CPU.
@@ -96,53 +101,102 @@ fn headless_app(assets: &std::path::Path) -> App {
     #[cfg(feature = "window")]
     let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
     app.add_plugins((plugins, PlenopticPlugin));
+    if std::env::var_os("PLENOPTIC_BENCH_PASSES").is_some() {
+        app.add_plugins(bevy::render::diagnostic::RenderDiagnosticsPlugin);
+    }
     app.finish();
     app.cleanup();
     app
 }
 
-/// `cameras` plenoptic cameras on `room.pack`, each rendering `size` into its own image
-/// (split-screen players 0.5 m apart), with a read-back of each image into a slot.
+/// An app with plenoptic cameras, each with a read-back of its image into a slot.
 struct Scene {
     app: App,
     cameras: Vec<Entity>,
     latest: Vec<Arc<Mutex<Option<Vec<u8>>>>>,
 }
 
-fn scene(assets: &std::path::Path, cameras: usize, size: UVec2) -> Scene {
+/// Where a plenoptic camera looks from, with which vertical field of view (`None`: Bevy's
+/// default) and at which scene time.
+struct View {
+    transform: Transform,
+    vfov: Option<f32>,
+    time: f32,
+}
+
+/// `cameras` split-screen players 0.5 m apart in the room of `room.pack`.
+fn room_views(cameras: usize) -> Vec<View> {
+    (0..cameras)
+        .map(|n| View {
+            transform: Transform::from_translation(Vec3::new(0.3 - 0.5 * n as f32, 1.3, 1.0))
+                .looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
+            vfov: None,
+            time: 0.7,
+        })
+        .collect()
+}
+
+/// The architectural tour's pack named by `PLENOPTIC_TOUR_PACK` (baked by the example), with
+/// one camera at 35 % of its camera path (room B under the sun, its glass and steel in
+/// view), or `None` when the variable is not set.
+fn tour() -> Option<(std::path::PathBuf, Vec<View>)> {
+    let pack = std::path::PathBuf::from(std::env::var_os("PLENOPTIC_TOUR_PACK")?);
+    // From this checkout, else from the working directory (the bench binary run from a copy
+    // of the repository on another machine).
+    let file = "examples/architectural_tour/assets/tour_path.json";
+    let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let path =
+        plenoptic_recon::CameraPath::load(if at.exists() { at } else { file.into() }).unwrap();
+    let (t0, t1) = path.time_range();
+    let sample = path.sample(t0 + (t1 - t0) * 0.35);
+    let cam = sample.camera;
+    let view = View {
+        transform: Transform::from_translation(cam.position).with_rotation(cam.orientation),
+        vfov: Some(cam.vfov),
+        time: sample.scene_time,
+    };
+    Some((pack, vec![view]))
+}
+
+/// A plenoptic camera per view on the pack `pack` in `assets`, each rendering `size` into
+/// its own image, with a read-back of each image into a slot.
+fn scene(assets: &std::path::Path, pack: &str, views: &[View], size: UVec2) -> Scene {
     let mut app = headless_app(assets);
-    let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
+    let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load(pack.to_owned());
     let mut entities = Vec::new();
     let mut latest = Vec::new();
-    for n in 0..cameras {
+    for (n, view) in views.iter().enumerate() {
         let image = {
             let mut img =
                 Image::new_target_texture(size.x, size.y, TextureFormat::Rgba8Unorm, None);
             img.texture_descriptor.usage |= TextureUsages::COPY_SRC;
             app.world_mut().resource_mut::<Assets<Image>>().add(img)
         };
-        let eye = Vec3::new(0.3 - 0.5 * n as f32, 1.3, 1.0);
-        let camera = app
-            .world_mut()
-            .spawn((
-                Camera {
-                    clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
-                    order: n as isize,
-                    ..default()
-                },
-                RenderTarget::Image(image.clone().into()),
-                Tonemapping::None,
-                bevy::camera::Exposure {
-                    ev100: bevy_plenoptic::camera::EV100_UNIT,
-                },
-                Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
-                PlenopticCamera {
-                    playback: Playback::Manual,
-                    time: 0.7,
-                    ..PlenopticCamera::new(handle.clone())
-                },
-            ))
-            .id();
+        let mut camera = app.world_mut().spawn((
+            Camera {
+                clear_color: ClearColorConfig::Custom(Color::linear_rgb(1.0, 0.0, 0.0)),
+                order: n as isize,
+                ..default()
+            },
+            RenderTarget::Image(image.clone().into()),
+            Tonemapping::None,
+            bevy::camera::Exposure {
+                ev100: bevy_plenoptic::camera::EV100_UNIT,
+            },
+            view.transform,
+            PlenopticCamera {
+                playback: Playback::Manual,
+                time: view.time,
+                ..PlenopticCamera::new(handle.clone())
+            },
+        ));
+        if let Some(fov) = view.vfov {
+            camera.insert(Projection::Perspective(PerspectiveProjection {
+                fov,
+                ..default()
+            }));
+        }
+        let camera = camera.id();
         let slot: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
         let sink = slot.clone();
         app.world_mut().spawn(Readback::texture(image)).observe(
@@ -229,7 +283,22 @@ fn first_frame(c: &mut Criterion) {
                 (0..iters)
                     .map(|_| {
                         let start = Instant::now();
-                        scene(dir.path(), cameras, size).until_reconstructed();
+                        scene(dir.path(), "room.pack", &room_views(cameras), size)
+                            .until_reconstructed();
+                        start.elapsed()
+                    })
+                    .sum()
+            })
+        });
+    }
+    if let Some((pack, views)) = tour() {
+        let (assets, name) = tour_location(&pack);
+        g.bench_function("tour_1280x720", |b| {
+            b.iter_custom(|iters| {
+                (0..iters)
+                    .map(|_| {
+                        let start = Instant::now();
+                        scene(assets, name, &views, TOUR_SIZE).until_reconstructed();
                         start.elapsed()
                     })
                     .sum()
@@ -237,6 +306,46 @@ fn first_frame(c: &mut Criterion) {
         });
     }
     g.finish();
+}
+
+/// Says which adapter the frames were measured on (the figures mean little without it).
+fn print_adapter(app: &App) {
+    let info = app
+        .world()
+        .resource::<bevy::render::renderer::RenderAdapterInfo>();
+    eprintln!(
+        "adapter: {} ({:?}, {:?}, driver {} {})",
+        info.name, info.backend, info.device_type, info.driver, info.driver_info
+    );
+}
+
+/// With `PLENOPTIC_BENCH_PASSES` set (which adds Bevy's render diagnostics: timestamp
+/// queries around each pass), prints each pass's mean CPU and GPU time over the last frames.
+fn print_passes(app: &App) {
+    let Some(store) = app
+        .world()
+        .get_resource::<bevy::diagnostic::DiagnosticsStore>()
+    else {
+        return;
+    };
+    let mut rows: Vec<(String, f64)> = store
+        .iter()
+        .filter(|d| d.path().as_str().starts_with("render/"))
+        .filter_map(|d| Some((d.path().to_string(), d.average()?)))
+        .collect();
+    rows.sort_by(|a, b| a.0.cmp(&b.0));
+    for (path, mean) in rows {
+        eprintln!("{path}: {mean:.3}");
+    }
+}
+
+/// The tour's frames are measured at 1280 × 720.
+const TOUR_SIZE: UVec2 = UVec2::new(1280, 720);
+
+/// The folder holding `pack` (the asset root) and its file name.
+fn tour_location(pack: &std::path::Path) -> (&std::path::Path, &str) {
+    let name = pack.file_name().and_then(|n| n.to_str()).unwrap();
+    (pack.parent().unwrap(), name)
 }
 
 /// One frame of a settled app (every working set resident, pipelines compiled, the frame
@@ -255,12 +364,32 @@ fn frame(c: &mut Criterion) {
         let mut settled: Option<Scene> = None;
         g.bench_function(*name, |b| {
             let s = settled.get_or_insert_with(|| {
-                let mut s = scene(dir.path(), *cameras, *size);
+                let mut s = scene(dir.path(), "room.pack", &room_views(*cameras), *size);
                 s.until_reconstructed();
+                print_adapter(&s.app);
                 s
             });
             b.iter(|| s.app.update())
         });
+        if let Some(s) = &settled {
+            print_passes(&s.app);
+        }
+    }
+    if let Some((pack, views)) = tour() {
+        let (assets, name) = tour_location(&pack);
+        let mut settled: Option<Scene> = None;
+        g.bench_function("tour_1280x720", |b| {
+            let s = settled.get_or_insert_with(|| {
+                let mut s = scene(assets, name, &views, TOUR_SIZE);
+                s.until_reconstructed();
+                print_adapter(&s.app);
+                s
+            });
+            b.iter(|| s.app.update())
+        });
+        if let Some(s) = &settled {
+            print_passes(&s.app);
+        }
     }
     g.finish();
 }
