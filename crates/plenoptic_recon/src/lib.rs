@@ -112,6 +112,7 @@ pub mod sun;
 mod sun_edge;
 mod surface;
 pub mod temporal;
+mod texels;
 pub mod viewspace;
 pub mod volume;
 pub mod warp;

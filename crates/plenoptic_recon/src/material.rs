@@ -1,7 +1,7 @@
 //! The pack's materials at screen resolution (docs/architecture.md, "Pack v2"; design.md:
 //! "albedo(uv, mip chosen by screen-space footprint) × lighting"): per object its glTF
 //! material and proxy UVs, and the diffuse albedo at any UV, sampled from the material's
-//! mipmapped textures with trilinear filtering.
+//! mipmapped textures with trilinear filtering ([`crate::texels`]).
 //!
 //! The albedo is the one the bake divided the lighting by ([`plenoptic_pack::RangeImage`]):
 //! `(1 − metallic)(1 − transmission) · base colour`, with the base-colour texture in sRGB
@@ -14,17 +14,16 @@
 //! sun and reflections use the bent normal at screen resolution, while the stored lighting
 //! holds its average over a cube texel (the bake's paths start on the bent normal).
 //!
-//! Textures are decoded from the pack on first use and kept (their size is bounded by the
+//! Textures are decoded from the pack on first use and kept, as linear 16-bit texels (their size is bounded by the
 //! pack's `MAX_TEXTURE_SIDE`); one that cannot be read is reported once and treated as white.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::brdf::SurfaceMaterial;
+use crate::texels::{LinearTexture, sample};
 use glam::{Vec2, Vec3, Vec4};
-use plenoptic_pack::{
-    ColourSpace, MaterialEntry, PackReader, TextureBinding, TextureImage, UvTransform, WrapMode,
-};
+use plenoptic_pack::{MaterialEntry, PackReader};
 
 /// One object's material and the UVs and tangents of its proxy vertices (empty: none).
 pub(crate) struct ObjectMaterial {
@@ -37,17 +36,9 @@ pub(crate) struct ObjectMaterial {
 /// The materials of a pack's objects, with their textures decoded on first use.
 pub(crate) struct Materials {
     objects: HashMap<u32, ObjectMaterial>,
-    textures: Vec<OnceLock<Option<Arc<TextureImage>>>>,
+    textures: Vec<OnceLock<Option<Arc<LinearTexture>>>>,
     /// Messages about textures or attributes that could not be read.
     pub missing: Mutex<Vec<String>>,
-}
-
-/// sRGB-encoded byte → linear value.
-fn srgb_table() -> &'static [f32; 256] {
-    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        std::array::from_fn(|i| plenoptic_pack::texture::srgb_to_linear(i as f32 / 255.0))
-    })
 }
 
 impl Materials {
@@ -100,10 +91,10 @@ impl Materials {
         self.objects.is_empty()
     }
 
-    fn texture(&self, pack: &PackReader, index: u32) -> Option<&TextureImage> {
+    fn texture(&self, pack: &PackReader, index: u32) -> Option<&LinearTexture> {
         let slot = self.textures.get(index as usize)?;
         slot.get_or_init(|| match pack.texture(index) {
-            Ok(t) => Some(Arc::new(t)),
+            Ok(t) => Some(Arc::new(LinearTexture::decode(&t))),
             Err(e) => {
                 if let Ok(mut m) = self.missing.lock() {
                     m.push(format!("material texture {index}: {e}"));
@@ -190,200 +181,9 @@ pub(crate) fn bend_normal(ns: Vec3, tangent: Vec3, sign: f32, local: Vec3) -> Ve
     (t * local.x + b * local.y + ns * local.z).normalize_or(ns)
 }
 
-/// `KHR_texture_transform` applied to `uv`.
-#[inline]
-fn transform(t: &UvTransform, uv: Vec2) -> Vec2 {
-    let s = uv * t.scale;
-    if t.rotation == 0.0 {
-        return t.offset + s;
-    }
-    let (sin, cos) = t.rotation.sin_cos();
-    t.offset + Vec2::new(cos * s.x + sin * s.y, -sin * s.x + cos * s.y)
-}
-
-/// Wraps texel coordinate `i` of a side of `n` texels.
-#[inline]
-fn wrap(i: i64, n: i64, mode: WrapMode) -> usize {
-    let n = n.max(1);
-    if (0..n).contains(&i) {
-        return i as usize;
-    }
-    (match mode {
-        // One period off (the texel beside an edge of a reduced coordinate): no division.
-        WrapMode::Repeat if (-n..0).contains(&i) => i + n,
-        WrapMode::Repeat if (n..2 * n).contains(&i) => i - n,
-        WrapMode::Repeat => i.rem_euclid(n),
-        WrapMode::ClampToEdge => i.clamp(0, n - 1),
-        WrapMode::MirroredRepeat => {
-            let p = i.rem_euclid(2 * n);
-            if p < n { p } else { 2 * n - 1 - p }
-        }
-    }) as usize
-}
-
-/// Trilinear sample of `texture` through binding `b` at `uv`, linear RGBA. `footprint` is
-/// the pixel's size in UV units; the level is `log₂(footprint · size)` (the transform's scale
-/// included).
-pub(crate) fn sample(texture: &TextureImage, b: TextureBinding, uv: Vec2, footprint: f32) -> Vec4 {
-    let Some(top) = texture.levels.first() else {
-        return Vec4::ONE;
-    };
-    let (uv, scale) = match &b.transform {
-        Some(t) => (transform(t, uv), t.scale.abs().max_element()),
-        None => (uv, 1.0),
-    };
-    let texels = footprint * scale * top.width.max(top.height) as f32;
-    let lod = if texels > 1.0 { log2(texels) } else { 0.0 };
-    let last = texture.levels.len() - 1;
-    let l0 = (floor(lod) as usize).min(last);
-    let l1 = (l0 + 1).min(last);
-    let f = (lod - l0 as f32).clamp(0.0, 1.0);
-    let a = bilinear(texture, l0, b, uv);
-    // Below one 8-bit step of the blend the second level cannot change the result.
-    if l1 == l0 || f < 1.0 / 512.0 {
-        return a;
-    }
-    a.lerp(bilinear(texture, l1, b, uv), f)
-}
-
-/// `x.log2()` within 2·10⁻⁵ for finite x ≥ 1 (∞ stays ∞): the exponent, and the mantissa
-/// m ∈ [1, 2) through log₂ m = (2/ln 2)·atanh((m − 1)/(m + 1)) to its t⁷ term. A level of
-/// detail needs far less; libm's `log2f` was 3 % of a materials frame.
-#[inline]
-fn log2(x: f32) -> f32 {
-    if !x.is_finite() {
-        return x;
-    }
-    let bits = x.to_bits();
-    let exponent = ((bits >> 23) & 0xff) as i32 - 127;
-    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    let t = (m - 1.0) / (m + 1.0);
-    let t2 = t * t;
-    let series = t * (1.0 + t2 * (1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0))));
-    exponent as f32 + series * (2.0 / std::f32::consts::LN_2)
-}
-
-/// `x.floor()` without a call into libm (the baseline x86-64 target has no rounding
-/// instruction, and the texture lookups are hot): exact for every finite `x`.
-#[inline]
-fn floor(x: f32) -> f32 {
-    // From 2²³ up every f32 is an integer.
-    if x.abs() >= 8_388_608.0 {
-        return x;
-    }
-    let t = x as i32 as f32;
-    if t > x { t - 1.0 } else { t }
-}
-
-/// `uv` reduced to [0, 1) where the wrap mode repeats (the same texels, without an integer
-/// division per texel to wrap them).
-#[inline]
-fn reduce(uv: f32, mode: WrapMode) -> f32 {
-    if mode == WrapMode::Repeat && !(0.0..1.0).contains(&uv) {
-        uv - floor(uv)
-    } else {
-        uv
-    }
-}
-
-fn bilinear(texture: &TextureImage, level: usize, b: TextureBinding, uv: Vec2) -> Vec4 {
-    let l = &texture.levels[level];
-    let (w, h) = (l.width as i64, l.height as i64);
-    let x = reduce(uv.x, b.wrap_s) * w as f32 - 0.5;
-    let y = reduce(uv.y, b.wrap_t) * h as f32 - 0.5;
-    if !(x.is_finite() && y.is_finite()) || l.texels.len() < 4 * (w * h) as usize {
-        return Vec4::ONE;
-    }
-    let (x0, y0) = (floor(x), floor(y));
-    let (fx, fy) = (x - x0, y - y0);
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    // The two columns and rows of the footprint, wrapped once each.
-    let (i0, i1) = (wrap(x0, w, b.wrap_s), wrap(x0 + 1, w, b.wrap_s));
-    let (j0, j1) = (wrap(y0, h, b.wrap_t), wrap(y0 + 1, h, b.wrap_t));
-    let srgb = texture.colour_space == ColourSpace::Srgb;
-    let table = srgb_table();
-    let row = w as usize;
-    let texel = |i: usize, j: usize| {
-        let k = 4 * (j * row + i);
-        let p = &l.texels[k..k + 4];
-        if srgb {
-            Vec4::new(
-                table[p[0] as usize],
-                table[p[1] as usize],
-                table[p[2] as usize],
-                p[3] as f32 / 255.0,
-            )
-        } else {
-            Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
-        }
-    };
-    let top = texel(i0, j0).lerp(texel(i1, j0), fx);
-    let bottom = texel(i0, j1).lerp(texel(i1, j1), fx);
-    top.lerp(bottom, fy)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A 4×4 linear texture: a black and white checker of 2×2 blocks.
-    fn checker() -> TextureImage {
-        let mut texels = Vec::new();
-        for j in 0..4 {
-            for i in 0..4 {
-                let v = if (i / 2 + j / 2) % 2 == 0 { 255 } else { 0 };
-                texels.extend_from_slice(&[v, v, v, 255]);
-            }
-        }
-        TextureImage::with_mips(ColourSpace::Linear, 4, 4, texels).unwrap()
-    }
-
-    #[test]
-    fn the_fast_log2_agrees_with_libm() {
-        let mut x = 1.0f32;
-        while x < 1e6 {
-            assert!(
-                (log2(x) - x.log2()).abs() < 2e-5,
-                "{x}: {} {}",
-                log2(x),
-                x.log2()
-            );
-            x *= 1.0137;
-        }
-        assert_eq!(log2(f32::INFINITY), f32::INFINITY);
-        assert_eq!(log2(1.0), 0.0);
-        assert_eq!(log2(1024.0), 10.0);
-    }
-
-    fn binding() -> TextureBinding {
-        TextureBinding {
-            texture: 0,
-            wrap_s: WrapMode::Repeat,
-            wrap_t: WrapMode::Repeat,
-            transform: None,
-        }
-    }
-
-    #[test]
-    fn texel_centres_are_exact_and_far_pixels_average_the_checker() {
-        let t = checker();
-        let at = |u: f32, v: f32, fp: f32| sample(&t, binding(), Vec2::new(u, v), fp).x;
-        assert!((at(0.125, 0.125, 0.0) - 1.0).abs() < 1e-6);
-        assert!(at(0.625, 0.125, 0.0).abs() < 1e-6);
-        // A pixel covering the whole texture reads the 1×1 level: the mean (to 8 bits).
-        assert!((at(0.3, 0.7, 1.0) - 0.5).abs() < 3e-3);
-        // Repeat wraps; the transform's scale tiles.
-        assert!((at(1.125, -0.875, 0.0) - 1.0).abs() < 1e-6);
-        let scaled = TextureBinding {
-            transform: Some(UvTransform {
-                offset: Vec2::ZERO,
-                rotation: 0.0,
-                scale: Vec2::splat(2.0),
-            }),
-            ..binding()
-        };
-        assert!(sample(&t, scaled, Vec2::new(0.3125, 0.0625), 0.0).x.abs() < 1e-6);
-    }
 
     #[test]
     fn normal_maps_bend_along_the_tangent_frame() {
@@ -404,47 +204,5 @@ mod tests {
         );
         // A tangent along the normal has no frame.
         assert_eq!(bend_normal(up, Vec3::Y, 1.0, tilted), up);
-    }
-
-    #[test]
-    fn floor_is_libm_floor() {
-        for x in [
-            0.0f32,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            2.999_999_8,
-            -2.999_999_8,
-            1e-30,
-            -1e-30,
-            8_388_607.5,
-            -8_388_607.5,
-            3e9,
-            -3e9,
-            123.0,
-            -123.0,
-        ] {
-            assert_eq!(floor(x), x.floor(), "{x}");
-        }
-        // Repeating coordinates reduce to the same texel coordinates as wrapping them.
-        for u in [-3.25f32, -1.0, -0.001, 0.0, 0.4, 1.0, 7.75] {
-            let r = reduce(u, WrapMode::Repeat);
-            assert!(
-                (0.0..1.0).contains(&r) && (r - u - (r - u).round()).abs() < 1e-6,
-                "{u}"
-            );
-            assert_eq!(reduce(u, WrapMode::ClampToEdge), u);
-        }
-    }
-
-    #[test]
-    fn wrap_modes() {
-        assert_eq!(wrap(-1, 4, WrapMode::Repeat), 3);
-        assert_eq!(wrap(-1, 4, WrapMode::ClampToEdge), 0);
-        assert_eq!(wrap(5, 4, WrapMode::ClampToEdge), 3);
-        assert_eq!(wrap(4, 4, WrapMode::MirroredRepeat), 3);
-        assert_eq!(wrap(-1, 4, WrapMode::MirroredRepeat), 0);
     }
 }
