@@ -16,7 +16,8 @@
 //!
 //! With `PLENOPTIC_TOUR_PACK` set to the architectural tour's baked pack, both groups also
 //! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B
-//! under the sun, glass and glossy steel in view). With `PLENOPTIC_BENCH_PASSES` set, each
+//! under the sun, glass and glossy steel in view; `plugin/frame` also with the baked specular
+//! instead of reflections marched for the camera, `tour_baked_specular_1280x720`). With `PLENOPTIC_BENCH_PASSES` set, each
 //! frame case also prints its passes' CPU and GPU times (Bevy's render diagnostics).
 //!
 //! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
@@ -122,6 +123,7 @@ struct View {
     transform: Transform,
     vfov: Option<f32>,
     time: f32,
+    settings: ReconSettings,
 }
 
 /// `cameras` split-screen players 0.5 m apart in the room of `room.pack`.
@@ -132,6 +134,7 @@ fn room_views(cameras: usize) -> Vec<View> {
                 .looking_at(Vec3::new(0.0, 0.8, -2.5), Vec3::Y),
             vfov: None,
             time: 0.7,
+            settings: ReconSettings::default(),
         })
         .collect()
 }
@@ -154,6 +157,7 @@ fn tour() -> Option<(std::path::PathBuf, Vec<View>)> {
         transform: Transform::from_translation(cam.position).with_rotation(cam.orientation),
         vfov: Some(cam.vfov),
         time: sample.scene_time,
+        settings: ReconSettings::default(),
     };
     Some((pack, vec![view]))
 }
@@ -187,6 +191,7 @@ fn scene(assets: &std::path::Path, pack: &str, views: &[View], size: UVec2) -> S
             PlenopticCamera {
                 playback: Playback::Manual,
                 time: view.time,
+                settings: view.settings.clone(),
                 ..PlenopticCamera::new(handle.clone())
             },
         ));
@@ -377,18 +382,35 @@ fn frame(c: &mut Criterion) {
     }
     if let Some((pack, views)) = tour() {
         let (assets, name) = tour_location(&pack);
-        let mut settled: Option<Scene> = None;
-        g.bench_function("tour_1280x720", |b| {
-            let s = settled.get_or_insert_with(|| {
-                let mut s = scene(assets, name, &views, TOUR_SIZE);
-                s.until_reconstructed();
-                print_adapter(&s.app);
-                s
+        // The same frame with the baked specular instead of the reflections marched for the
+        // camera: what the marching costs.
+        let baked: Vec<View> = views
+            .iter()
+            .map(|v| View {
+                settings: ReconSettings {
+                    specular: plenoptic_recon::Specular::Baked,
+                    ..v.settings.clone()
+                },
+                ..*v
+            })
+            .collect();
+        for (case, views) in [
+            ("tour_1280x720", &views),
+            ("tour_baked_specular_1280x720", &baked),
+        ] {
+            let mut settled: Option<Scene> = None;
+            g.bench_function(case, |b| {
+                let s = settled.get_or_insert_with(|| {
+                    let mut s = scene(assets, name, views, TOUR_SIZE);
+                    s.until_reconstructed();
+                    print_adapter(&s.app);
+                    s
+                });
+                b.iter(|| s.app.update())
             });
-            b.iter(|| s.app.update())
-        });
-        if let Some(s) = &settled {
-            print_passes(&s.app);
+            if let Some(s) = &settled {
+                print_passes(&s.app);
+            }
         }
     }
     g.finish();
