@@ -15,9 +15,10 @@
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes).
 //!
 //! With `PLENOPTIC_TOUR_PACK` set to the architectural tour's baked pack, both groups also
-//! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B
-//! under the sun, glass and glossy steel in view; `plugin/frame` also with the baked specular
-//! instead of reflections marched for the camera, `tour_baked_specular_1280x720`). With `PLENOPTIC_BENCH_PASSES` set, each
+//! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B;
+//! `plugin/frame` also room A with its mirror in view, `tour_mirror_1280x720`, and the same
+//! with the baked specular instead of reflections marched for the camera,
+//! `tour_mirror_baked_specular_1280x720`). With `PLENOPTIC_BENCH_PASSES` set, each
 //! frame case also prints its passes' CPU and GPU times (Bevy's render diagnostics).
 //!
 //! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
@@ -139,27 +140,35 @@ fn room_views(cameras: usize) -> Vec<View> {
         .collect()
 }
 
-/// The architectural tour's pack named by `PLENOPTIC_TOUR_PACK` (baked by the example), with
-/// one camera at 35 % of its camera path (room B under the sun, its glass and steel in
-/// view), or `None` when the variable is not set.
-fn tour() -> Option<(std::path::PathBuf, Vec<View>)> {
-    let pack = std::path::PathBuf::from(std::env::var_os("PLENOPTIC_TOUR_PACK")?);
+/// The architectural tour's pack named by `PLENOPTIC_TOUR_PACK` (baked by the example), or
+/// `None` when the variable is not set.
+fn tour_pack() -> Option<std::path::PathBuf> {
+    std::env::var_os("PLENOPTIC_TOUR_PACK").map(Into::into)
+}
+
+/// A camera at `s` (0 to 1) along the tour's camera path in `file` (in its assets folder).
+fn tour_view(file: &str, s: f32) -> View {
     // From this checkout, else from the working directory (the bench binary run from a copy
     // of the repository on another machine).
-    let file = "examples/architectural_tour/assets/tour_path.json";
-    let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let file = format!("examples/architectural_tour/assets/{file}");
+    let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(&file);
     let path =
         plenoptic_recon::CameraPath::load(if at.exists() { at } else { file.into() }).unwrap();
     let (t0, t1) = path.time_range();
-    let sample = path.sample(t0 + (t1 - t0) * 0.35);
+    let sample = path.sample(t0 + (t1 - t0) * s);
     let cam = sample.camera;
-    let view = View {
+    View {
         transform: Transform::from_translation(cam.position).with_rotation(cam.orientation),
         vfov: Some(cam.vfov),
         time: sample.scene_time,
         settings: ReconSettings::default(),
-    };
-    Some((pack, vec![view]))
+    }
+}
+
+/// The tour's view measured: one camera at 35 % of its camera path, in room B (no mirror or
+/// glossy surface in view).
+fn tour() -> Option<(std::path::PathBuf, Vec<View>)> {
+    Some((tour_pack()?, vec![tour_view("tour_path.json", 0.35)]))
 }
 
 /// A plenoptic camera per view on the pack `pack` in `assets`, each rendering `size` into
@@ -382,9 +391,10 @@ fn frame(c: &mut Criterion) {
     }
     if let Some((pack, views)) = tour() {
         let (assets, name) = tour_location(&pack);
-        // The same frame with the baked specular instead of the reflections marched for the
-        // camera: what the marching costs.
-        let baked: Vec<View> = views
+        // Room A with its mirror in view (a tenth of the pixels reflect for the camera), with
+        // the reflections marched and with the baked specular instead: what marching costs.
+        let mirror = vec![tour_view("room_a_mirror.json", 0.0)];
+        let baked: Vec<View> = mirror
             .iter()
             .map(|v| View {
                 settings: ReconSettings {
