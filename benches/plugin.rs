@@ -406,7 +406,8 @@ fn frame(c: &mut Criterion) {
             .collect();
         for (case, views) in [
             ("tour_1280x720", &views),
-            ("tour_baked_specular_1280x720", &baked),
+            ("tour_mirror_1280x720", &mirror),
+            ("tour_mirror_baked_specular_1280x720", &baked),
         ] {
             let mut settled: Option<Scene> = None;
             g.bench_function(case, |b| {
