@@ -12,8 +12,12 @@
 //!   looked up as a pixel's lookup is ([`crate::lookup::at_point`]: the nearest texel must
 //!   show the point's surface, the bilinear taps that show it are blended), carried along the
 //!   object's motion to each key's time, and weighted by the view's weight and by how close
-//!   its direction to the point is to the ray's; where no cube shows the point, the views'
-//!   temporal-volume samples of its object near it;
+//!   its direction to the point is to the ray's. Where none of the views blended for the
+//!   camera shows the point, the other base views' keys at the frame's time are looked up
+//!   the same way (a point far from the camera, seen in a mirror or through glass, is seen
+//!   by a view near it: the `specular` test's mirror went from 0.082 to 0.055, the tour's
+//!   frame 15, glass reflecting the far side of the building, from 0.311 to 0.299); then
+//!   the blended views' temporal-volume samples of its object near it;
 //! - the *albedo* and the *emission* are the material's at the point's UV, the texture's mip
 //!   chosen by the ray's footprint there (the pixel's cone, continued past the mirror);
 //! - the runtime sun's direct light is evaluated at the point with its shadow rays
@@ -82,7 +86,11 @@ pub(crate) struct ShadedHits<'r> {
     /// `crate::glazing`) is left out, its cube texels showing what lies behind it as the
     /// tracer blends it.
     placed: HashMap<u32, PlacedObject<'r>>,
+    /// The keys of the views blended for the camera, then those of every other view.
     keys: Vec<LitKey>,
+    /// How many of `keys` are the blended views' (the others are read only where none of
+    /// these shows a point).
+    blended_keys: usize,
     /// Per base view: its position, weight and temporal-volume samples of the lighting.
     volumes: Vec<(Vec3, f32, VolumeIndex)>,
     sun: Option<&'r PlacedSun<'r>>,
@@ -109,7 +117,18 @@ impl<'r> ShadedHits<'r> {
         let manifest = rec.pack().manifest();
         let mut keys = Vec::new();
         let mut volumes = Vec::new();
-        for (v, w) in rec.view_weights(position) {
+        let blended = rec.view_weights(position);
+        // Then every other view, each weighted 1: a point the blended views cannot see (far
+        // from the camera, seen in a mirror or through glass) is often seen by one of these.
+        let others: Vec<(usize, f32)> = (0..manifest.base_views.len())
+            .filter(|v| !blended.iter().any(|(b, _)| b == v))
+            .map(|v| (v, 1.0))
+            .collect();
+        let mut blended_keys = 0;
+        for (n, (v, w)) in blended.iter().copied().chain(others).enumerate() {
+            if n == blended.len() {
+                blended_keys = keys.len();
+            }
             let bv = &manifest.base_views[v];
             for (k, wk) in crate::temporal::key_weights(&bv.time_keys, t) {
                 let Some(cubes) = rec.key_cubes_in(v, k, Channel::Lighting, missing) else {
@@ -128,9 +147,14 @@ impl<'r> ShadedHits<'r> {
                     non_diffuse,
                 });
             }
-            if let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing) {
+            if n < blended.len()
+                && let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing)
+            {
                 volumes.push((bv.position, w, index));
             }
+        }
+        if blended_keys == 0 {
+            blended_keys = keys.len();
         }
         if keys.is_empty() {
             // No lighting to look up (a pack without it, or unreadable keys): the radiance at
@@ -161,6 +185,7 @@ impl<'r> ShadedHits<'r> {
             materials,
             placed,
             keys,
+            blended_keys,
             volumes,
             sun,
             depth_tolerance: rec.settings.depth_tolerance,
@@ -212,8 +237,9 @@ impl<'r> ShadedHits<'r> {
     }
 
     /// The lighting and non-diffuse radiance at point `p` of `object`, met along `dir`: the
-    /// keys' cubes that show it (the point carried to each key's time by `to_key`), else the
-    /// views' volume samples near it; `None` where neither does.
+    /// blended views' keys whose cubes show it (the point carried to each key's time by
+    /// `to_key`), else the other views' keys that show it, else the blended views' volume
+    /// samples near it; `None` where none does.
     fn lighting(
         &self,
         p: Vec3,
@@ -225,7 +251,10 @@ impl<'r> ShadedHits<'r> {
         let angular =
             |base: Vec3| crate::specular::angular_weight(p - base, dir, self.angular_power);
         let (mut sum, mut sum2, mut total) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-        for (k, motion) in self.keys.iter().zip(to_key) {
+        for (i, (k, motion)) in self.keys.iter().zip(to_key).enumerate() {
+            if i == self.blended_keys && total > 0.0 {
+                break;
+            }
             let second = k.non_diffuse.as_deref();
             let fast = FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &[]);
             let at_key = motion.transform_point3(p);
