@@ -279,19 +279,6 @@ impl<'r> Reflections<'r> {
 
     /// Radiance arriving at `origin` along unit direction `dir`, averaged over a cone of
     /// half-angle `cone` (radians): `None` where no base view can tell.
-    /// The radiance the views whose distance cubes hold the point at `s` along the ray show
-    /// there towards the ray, blended; `None` where no view holds it.
-    fn held(&self, origin: Vec3, dir: Vec3, s: f32, cone: f32) -> Option<Vec3> {
-        let point = origin + dir * s;
-        let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
-        for v in self.views.iter().filter(|v| self.sees(v, point)) {
-            let (l, w) = self.answer(v, dir, s, point, cone);
-            sum += l * w;
-            total += w;
-        }
-        (total > 0.0).then(|| sum / total)
-    }
-
     pub fn incoming(&self, origin: Vec3, dir: Vec3, cone: f32) -> Option<Vec3> {
         // Off the surface the ray starts on before it is cast: the nearest hit where it is
         // answered there, else only whether anything is met.
@@ -328,8 +315,16 @@ impl<'r> Reflections<'r> {
                     return Some(c);
                 }
             }
-            if let Some(c) = self.held(origin, dir, hit.t, cone) {
-                return Some(c);
+            let s = hit.t;
+            let point = origin + dir * s;
+            let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
+            for v in self.views.iter().filter(|v| self.sees(v, point)) {
+                let (l, w) = self.answer(v, dir, s, point, cone);
+                sum += l * w;
+                total += w;
+            }
+            if total > 0.0 {
+                return Some(sum / total);
             }
         }
         let (mut sum, mut total) = (Vec3::ZERO, 0.0f32);
