@@ -373,21 +373,9 @@ fn frame(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(10));
     for (name, size, cameras) in &CASES[1..] {
-        // Set up on the first call only (criterion calls the closure once per sample), and
-        // not at all when a filter leaves this case out.
-        let mut settled: Option<Scene> = None;
-        g.bench_function(*name, |b| {
-            let s = settled.get_or_insert_with(|| {
-                let mut s = scene(dir.path(), "room.pack", &room_views(*cameras), *size);
-                s.until_reconstructed();
-                print_adapter(&s.app);
-                s
-            });
-            b.iter(|| s.app.update())
+        settled_frames(&mut g, name, || {
+            scene(dir.path(), "room.pack", &room_views(*cameras), *size)
         });
-        if let Some(s) = &settled {
-            print_passes(&s.app);
-        }
     }
     if let Some((pack, views)) = tour() {
         let (assets, name) = tour_location(&pack);
@@ -409,22 +397,34 @@ fn frame(c: &mut Criterion) {
             ("tour_mirror_1280x720", &mirror),
             ("tour_mirror_baked_specular_1280x720", &baked),
         ] {
-            let mut settled: Option<Scene> = None;
-            g.bench_function(case, |b| {
-                let s = settled.get_or_insert_with(|| {
-                    let mut s = scene(assets, name, views, TOUR_SIZE);
-                    s.until_reconstructed();
-                    print_adapter(&s.app);
-                    s
-                });
-                b.iter(|| s.app.update())
-            });
-            if let Some(s) = &settled {
-                print_passes(&s.app);
-            }
+            settled_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
     }
     g.finish();
+}
+
+/// Measures `App::update` of the scene `make` builds, once it shows its reconstruction; says
+/// which adapter drew it and, with `PLENOPTIC_BENCH_PASSES`, its passes' times. The scene is
+/// made on the first call only (criterion calls the closure once per sample), and not at all
+/// when a filter leaves the case out.
+fn settled_frames(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    make: impl Fn() -> Scene,
+) {
+    let mut settled: Option<Scene> = None;
+    g.bench_function(name, |b| {
+        let s = settled.get_or_insert_with(|| {
+            let mut s = make();
+            s.until_reconstructed();
+            print_adapter(&s.app);
+            s
+        });
+        b.iter(|| s.app.update())
+    });
+    if let Some(s) = &settled {
+        print_passes(&s.app);
+    }
 }
 
 criterion_group!(benches, decode, first_frame, frame);
