@@ -118,43 +118,19 @@ impl<'r> ShadedHits<'r> {
         let mut keys = Vec::new();
         let mut volumes = Vec::new();
         let blended = rec.view_weights(position);
-        // Then every other view, each weighted 1: a point the blended views cannot see (far
-        // from the camera, seen in a mirror or through glass) is often seen by one of these.
-        let others: Vec<(usize, f32)> = (0..manifest.base_views.len())
-            .filter(|v| !blended.iter().any(|(b, _)| b == v))
-            .map(|v| (v, 1.0))
-            .collect();
-        let mut blended_keys = 0;
-        for (n, (v, w)) in blended.iter().copied().chain(others).enumerate() {
-            if n == blended.len() {
-                blended_keys = keys.len();
-            }
-            let bv = &manifest.base_views[v];
-            for (k, wk) in crate::temporal::key_weights(&bv.time_keys, t) {
-                let Some(cubes) = rec.key_cubes_in(v, k, Channel::Lighting, missing) else {
-                    continue;
-                };
-                let non_diffuse = rec
-                    .key_cubes_in(v, k, Channel::NonDiffuse, missing)
-                    .map(|c| c.radiance)
-                    .filter(|c| c.face_size == cubes.distance.face_size);
-                keys.push(LitKey {
-                    base: bv.position,
-                    weight: w * wk,
-                    time: bv.time_keys[k],
-                    packed: rec.packed_texels(v, k, Channel::Lighting, &cubes),
-                    cubes,
-                    non_diffuse,
-                });
-            }
-            if n < blended.len()
-                && let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing)
-            {
-                volumes.push((bv.position, w, index));
+        for &(v, w) in &blended {
+            keys.extend(lit_keys(rec, v, w, t, missing));
+            if let Some(index) = VolumeIndex::build(rec, v, t, Channel::Lighting, missing) {
+                volumes.push((manifest.base_views[v].position, w, index));
             }
         }
-        if blended_keys == 0 {
-            blended_keys = keys.len();
+        let blended_keys = keys.len();
+        // Then every other view, each weighted 1: a point the blended views cannot see (far
+        // from the camera, seen in a mirror or through glass) is often seen by one of these.
+        for v in 0..manifest.base_views.len() {
+            if !blended.iter().any(|&(b, _)| b == v) {
+                keys.extend(lit_keys(rec, v, 1.0, t, missing));
+            }
         }
         if keys.is_empty() {
             // No lighting to look up (a pack without it, or unreadable keys): the radiance at
@@ -316,6 +292,37 @@ impl<'r> ShadedHits<'r> {
         }
         (count > 0).then(|| sum / count as f32)
     }
+}
+
+/// The lighting cubes of base view `v` (weighted `w`) at the keys that bracket time `t`,
+/// each weighted `w` × its time weight; unreadable keys are listed in `missing` and left out.
+fn lit_keys(
+    rec: &Reconstructor,
+    v: usize,
+    w: f32,
+    t: f32,
+    missing: &mut Vec<String>,
+) -> Vec<LitKey> {
+    let bv = &rec.pack().manifest().base_views[v];
+    let mut keys = Vec::new();
+    for (k, wk) in crate::temporal::key_weights(&bv.time_keys, t) {
+        let Some(cubes) = rec.key_cubes_in(v, k, Channel::Lighting, missing) else {
+            continue;
+        };
+        let non_diffuse = rec
+            .key_cubes_in(v, k, Channel::NonDiffuse, missing)
+            .map(|c| c.radiance)
+            .filter(|c| c.face_size == cubes.distance.face_size);
+        keys.push(LitKey {
+            base: bv.position,
+            weight: w * wk,
+            time: bv.time_keys[k],
+            packed: rec.packed_texels(v, k, Channel::Lighting, &cubes),
+            cubes,
+            non_diffuse,
+        });
+    }
+    keys
 }
 
 /// Rays gathering the lighting of a point no view shows ([`ShadedHits::radiance`]).
