@@ -1,6 +1,7 @@
-//! The scene's materials as the pack stores them (design.md "Pack v2", **Materials**; pack
-//! format 1.2, `docs/pack-format.md` "Materials"): the materials the objects use, their
-//! textures as RGBA8 with full mip chains, and the proxies' UVs and tangents.
+//! The scene's materials as the pack stores them (docs/architecture.md, "Pack v2",
+//! **Materials**; pack format 1.2, `docs/pack-format.md` "Materials"): the materials the
+//! objects use, their textures as RGBA8 with full mip chains, and the proxies' UVs and
+//! tangents.
 //!
 //! - Materials: one pack material per scene material that an object uses, in order of first
 //!   use by object id; objects without a usable material get none.

@@ -1,4 +1,4 @@
-//! Pack v2's textures at screen resolution (issue: pack v2, "Textures"): a rug with a 2 cm
+//! Pack v2's textures at screen resolution (docs/architecture.md, "Pack v2"): a rug with a 2 cm
 //! checker in a closed room is baked with small cubes, reconstructed in geometry-assisted mode
 //! as `albedo(uv) · lighting + non-diffuse` ([`Shading::Materials`]), and compared with the
 //! path tracer, beside the same scene's radiance reconstruction ([`Shading::Radiance`], what a

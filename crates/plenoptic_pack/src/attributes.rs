@@ -1,8 +1,8 @@
-//! Shading attributes of a proxy mesh (pack 1.2; design.md "Pack v2", **Materials**: "proxies
-//! with UVs and tangents"; `docs/pack-format.md`, "Proxy attributes"): per-vertex TEXCOORD_0
-//! and tangents of the [`crate::ProxyMesh`] with the same key, in a chunk of their own
-//! ([`crate::ChunkKind::ProxyAttributes`]) so that the proxy-mesh chunk of 1.0 and 1.1 keeps
-//! its layout and older readers skip the new data.
+//! Shading attributes of a proxy mesh (pack 1.2; docs/architecture.md, "Pack v2",
+//! **Materials**: "proxies with UVs and tangents"; `docs/pack-format.md`, "Proxy attributes"):
+//! per-vertex TEXCOORD_0 and tangents of the [`crate::ProxyMesh`] with the same key, in a chunk
+//! of their own ([`crate::ChunkKind::ProxyAttributes`]) so that the proxy-mesh chunk of 1.0 and
+//! 1.1 keeps its layout and older readers skip the new data.
 //!
 //! UVs are glTF's TEXCOORD_0 as the file has them (origin top left, v down); a texture's
 //! `KHR_texture_transform` stays with the material's texture binding

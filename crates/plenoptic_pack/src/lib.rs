@@ -10,9 +10,9 @@
 //! with their optional (x, y, t) tetrahedral complex; [`volume`]), plus proxy geometry and
 //! animation tracks for the geometry-assisted reconstruction ([`proxy`]).
 //!
-//! Since version 1.2 a pack also carries each object's glTF material ([`material`]), its
+//! From version 1.2 a pack also carries each object's glTF material ([`material`]), its
 //! textures as mipmapped KTX2 files ([`texture`]) and the proxies' UVs and tangents
-//! ([`attributes`]) for the geometry-assisted reconstruction of design.md's "Pack v2".
+//! ([`attributes`]) for the geometry-assisted reconstruction (docs/architecture.md, "Pack v2").
 //!
 //! Layers, bottom-up: byte I/O → [`header`] → [`manifest`] → [`directory`] → [`cube`]
 //! addressing and quantizers → [`ktx`] (KTX2 files) → [`range_image`], [`texture`] →

@@ -1,7 +1,7 @@
-//! The pack's materials (pack 1.2; design.md "Pack v2", **Materials**: "the glTF material and
-//! its textures (mipmapped KTX2), per object"; `docs/pack-format.md`, "Materials"): the
-//! manifest's `textures` and `materials` tables, each object's `material` index into the
-//! latter, their consistency checks, and the reader's access to them.
+//! The pack's materials (pack 1.2; docs/architecture.md, "Pack v2", **Materials**: "the glTF
+//! material and its textures (mipmapped KTX2), per object"; `docs/pack-format.md`,
+//! "Materials"): the manifest's `textures` and `materials` tables, each object's `material`
+//! index into the latter, their consistency checks, and the reader's access to them.
 //!
 //! A material is glTF's metallic-roughness material with the extensions plenoptic imports
 //! (emissive strength folded into `emissive`, transmission, IOR). Texture `i` of the

@@ -1,7 +1,7 @@
-//! Material textures (pack 1.2; design.md "Pack v2", **Materials**: "the glTF material and its
-//! textures (mipmapped KTX2)"; `docs/pack-format.md`, "Material texture"): RGBA8 images with
-//! their full mip chain, stored as one KTX2 file per [`crate::ChunkKind::MaterialTexture`]
-//! chunk that Bevy's own KTX2 loader opens.
+//! Material textures (pack 1.2; docs/architecture.md, "Pack v2", **Materials**: "the glTF
+//! material and its textures (mipmapped KTX2)"; `docs/pack-format.md`, "Material texture"):
+//! RGBA8 images with their full mip chain, stored as one KTX2 file per
+//! [`crate::ChunkKind::MaterialTexture`] chunk that Bevy's own KTX2 loader opens.
 //!
 //! The chain goes down to 1×1 (`levelCount = ⌊log₂ max(W, H)⌋ + 1`), each level a 2×2 box
 //! filter of the one above: in linear light for sRGB textures (decode, average, re-encode), on

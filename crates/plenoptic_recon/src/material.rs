@@ -1,4 +1,4 @@
-//! The pack's materials at screen resolution (docs/architecture.md, "Pack v2"; design.md:
+//! The pack's materials at screen resolution (docs/architecture.md, "Pack v2":
 //! "albedo(uv, mip chosen by screen-space footprint) × lighting"): per object its glTF
 //! material and proxy UVs, and the diffuse albedo at any UV, sampled from the material's
 //! mipmapped textures with trilinear filtering ([`crate::texels`]).

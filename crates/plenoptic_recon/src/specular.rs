@@ -1,6 +1,6 @@
-//! Mirror and glossy reflections for the actual camera (docs/architecture.md, "Pack v2";
-//! design.md: "the view-dependent part for the actual camera — reflected and refracted rays
-//! marched through the base views' distance cubes, filtered by roughness").
+//! Mirror and glossy reflections for the actual camera (docs/architecture.md, "Pack v2": "the
+//! view-dependent part for the actual camera — reflected rays marched through the base views'
+//! distance cubes, glossy lobes sampled by roughness").
 //!
 //! The pack's non-diffuse cube holds a surface's specular radiance as its *base view* saw
 //! it: a mirror shows, from anywhere, what it reflected towards the base view. For surfaces

@@ -1,8 +1,7 @@
-//! Denoising of the baked lighting before quantisation (issue 12, item 4; docs/architecture.md,
-//! "Pack v2: lighting from the pack, detail from the geometry": the diffuse lighting per texel,
+//! Denoising of the baked lighting before quantisation (docs/architecture.md, "Pack v2:
+//! lighting from the pack, detail from the geometry": the diffuse lighting per texel,
 //! "denoised in the bake (edge-aware, guided by id, normal and distance, continuous across
-//! cube seams and time keys)"; thesis ch. 8, separating illumination quality from image
-//! quality).
+//! cube seams)"; thesis ch. 8, separating illumination quality from image quality).
 //!
 //! # What is filtered
 //!
