@@ -40,57 +40,79 @@ use serde::{Deserialize, Serialize};
 use super::ErrFn;
 use crate::error::RecipeError;
 
-/// The `[sun]` table.
+/// The `[sun]` table: a sun study. Its cost in the bake: a sun that moves adds light keys
+/// where what it sees changes (with `quality.runtime_sun`, the default, its direct light is
+/// evaluated at runtime and does not add keys of its own).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(
-    missing_docs,
-    reason = "each key is documented in the module's example"
-)]
 pub struct SunToml {
+    /// Degrees north, in [−90, 90].
     pub latitude: f64,
+    /// Degrees east, in [−180, 180].
     pub longitude: f64,
+    /// The day, `"YYYY-MM-DD"`.
     pub date: String,
+    /// Hours of local time ahead of UTC. Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub utc_offset: Option<f64>,
+    /// Local hours `[from, to]`, mapped onto `[time.start, time.end]`.
     pub local_time: [f64; 2],
+    /// Compass north, in degrees from the model's −Z towards +X. Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub north_deg: Option<f32>,
+    /// Illuminance in lux with the sun at the zenith; it falls with the air mass. Default
+    /// 100,000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub illuminance: Option<f32>,
+    /// Linear colour of the sun. Default white.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub color: Option<[f32; 3]>,
+    /// Angular diameter of the sun's disc in degrees: soft shadows; 0 gives hard ones.
+    /// Default 0.533. Costs nothing at bake time; at runtime the CPU spends more shadow rays
+    /// along softer edges.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angular_diameter_deg: Option<f32>,
+    /// The glTF directional light the study drives (its animation is replaced). Default: a
+    /// light named "Sun" is added.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light: Option<String>,
 }
 
-/// The `[sky]` table.
+/// The `[sky]` table: what rays that leave the scene see. Both tracers importance-sample
+/// it; its cost in the bake is the samples it draws, not more keys.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(
-    missing_docs,
-    reason = "each key is documented in the module's example"
-)]
 pub struct SkyToml {
+    /// `"hosek-wilkie"`, `"image"`, `"uniform"` or `"none"`.
     pub kind: String,
+    /// hosek-wilkie: atmospheric turbidity, 1 (clear) to 10 (hazy). Default 3.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub turbidity: Option<f32>,
+    /// hosek-wilkie: linear albedo of the ground. Default 0.2 on every channel.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ground_albedo: Option<[f32; 3]>,
+    /// hosek-wilkie: the model's kcd/m² in the scene's lux-based units. Default 1000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f32>,
+    /// hosek-wilkie: below the horizon a ground of `ground_albedo` lit by the sky and the sun
+    /// (no shadows), in both tracers and at runtime. Default false: black.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ground: Option<bool>,
+    /// hosek-wilkie without `[sun]`: the glTF directional light that is the sun. Default:
+    /// the scene's first directional light.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<String>,
+    /// image: an equirectangular `.hdr` or `.exr` file, relative to the recipe. Stored in
+    /// the pack.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub file: Option<String>,
+    /// image: multiplies the texels. Default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub intensity: Option<f32>,
+    /// image: turn about +Y in degrees. Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotation_deg: Option<f32>,
+    /// uniform: linear radiance `[r, g, b]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub color: Option<[f32; 3]>,
 }
