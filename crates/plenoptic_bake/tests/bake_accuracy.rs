@@ -1,9 +1,9 @@
-//! The bake's lighting at base views against the reference path tracer (issue: pack v2, "An
-//! accurate bake"). A camera at a base view at one of its time keys sees what the range
+//! The bake's lighting at base views against the reference path tracer (docs/architecture.md,
+//! "Pack v2": the baked lighting agrees with the path tracer within its noise). A camera at a base view at one of its time keys sees what the range
 //! images hold: the multi-stage renderer over the bake's ambient field. Its frame is compared
 //! with a path-traced reference rendered as two independent halves, so that the reference's
 //! own noise is subtracted from the error (`plenoptic_eval::metrics`; docs/architecture.md,
-//! "Measuring against a noisy reference"). Findings: docs/bake-accuracy.md.
+//! "Measuring against a noisy reference"). The figures: docs/bake-accuracy.md.
 
 use std::path::Path;
 
@@ -346,7 +346,7 @@ fn view_of_cube(cube: &plenoptic_pack::RangeImage, camera: &PinholeCamera, k: u3
 /// of `Quality::draft()`), seen through the same cameras and through 3× sharper ones, against
 /// the two-half reference: the denoiser off, on (default settings and two variants, on the
 /// same rendered faces), and off at 8× the samples (what less noise alone would give).
-/// Prints the figures for the issue note; checks only that no variant biases the mean.
+/// Prints the figures of docs/bake-accuracy.md; checks only that no variant biases the mean.
 #[test]
 #[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture denoising"]
 fn range_images_with_and_without_denoising() {
@@ -472,8 +472,8 @@ const TOUR_VIEWS: [(&str, Vec3, f32, f32, f32); 5] = [
     ),
 ];
 
-/// The tour at five base views of its draft bake (the 5 × 5 lattice over its view space),
-/// each at a time key: prints the figures for the issue note. Slow (minutes in release).
+/// The tour at five base views of its draft bake (the 5 × 5 lattice over its view space), each
+/// at a time key, against the targets of docs/bake-accuracy.md. Slow (minutes in release).
 #[test]
 #[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture"]
 fn tour_base_views() {
@@ -505,7 +505,7 @@ fn tour_base_views() {
             (spp, spp),
         );
         println!("{name}: {f}");
-        // The issue's targets, at every view.
+        // The targets, at every view.
         if (f.mean_ratio - 1.0).abs() > 0.03 || f.blocks_within < 0.9 || f.corrected_lrms > 0.1 {
             failures.push((name, f));
         }
@@ -515,8 +515,8 @@ fn tour_base_views() {
 
 /// The tour as its recipe bakes it (the sun study and the sky applied), at base view 13
 /// (0, 1.6, 2.5) looking north across the atrium at the time key t = 10.5: the view that
-/// found the glass balustrade blocking the field (docs/bake-accuracy.md, cause 5). Prints
-/// the figures for the issue note. Slow (minutes in release).
+/// shows glass seen from behind letting the field through (docs/bake-accuracy.md, cause 5).
+/// Prints the figures of docs/bake-accuracy.md. Slow (minutes in release).
 #[test]
 #[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture atrium"]
 fn tour_atrium_under_its_daylight() {
@@ -536,9 +536,9 @@ fn tour_atrium_under_its_daylight() {
 
 /// The tour's range images as the draft bake stores them (256-px faces, 4 samples per
 /// texel), seen through the cameras of [`tour_base_views`]: the field read directly at
-/// each texel (the bake before cause 6 of docs/bake-accuracy.md) against the final gather
+/// each texel (what cause 6 of docs/bake-accuracy.md is about) against the final gather
 /// of the bake, without and with its ambient smoothing (`LightingCube::smooth_ambient`,
-/// 2–4 passes). Prints the figures for the issue note.
+/// 2–4 passes). Prints the figures of docs/bake-accuracy.md.
 #[test]
 #[ignore = "minutes in release: cargo test --release -p plenoptic_bake --test bake_accuracy -- --ignored --nocapture tour_range_images"]
 fn tour_range_images_with_and_without_the_final_gather() {
