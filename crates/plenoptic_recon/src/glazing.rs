@@ -16,9 +16,9 @@
 //! pane modelled as a thin box is two surfaces, and the path tracer's ray meets each with
 //! probability c), and the pixel is `(1 − (1 − c)^k) · L_glazing + (1 − c)^k · L_behind`,
 //! with the glazing's depth and object id: the mean over the coverage the path tracer
-//! samples, with every crossed surface taken to shine as the nearest does. With one crossing
-//! (c · L_glazing + (1 − c) · L_behind) the tour's glazed east window came out 18–20 %
-//! brighter than the path tracer's. The GPU draws both faces in the transparent pass, which
+//! samples, with every crossed surface taken to shine as the nearest does (counting one
+//! crossing, c · L_glazing + (1 − c) · L_behind, would show a pane modelled as a thin box
+//! brighter than the path tracer does). The GPU draws both faces in the transparent pass, which
 //! blends the same way.
 //!
 //! Transmissive glass (glTF `KHR_materials_transmission`, shown with materials and marched
@@ -32,9 +32,8 @@
 //! transmission has it (and the tracer, `plenoptic_trace::material`): exact for every surface
 //! without `KHR_materials_volume`. A solid of glass (the pack's material thickness above 0)
 //! would bend what is seen through it; it is shown as thin walls, its refraction left out.
-//! The baked radiance instead showed the base view's
-//! view through the glass, displaced and at cube resolution: the tour's glass balustrade
-//! was a dark smear over the brick wall behind it (0.43 of the path tracer's luminance).
+//! The baked radiance would show the base view's view through the glass, displaced and at
+//! cube resolution (the tour's glass balustrade a dark smear over the brick wall behind it).
 //! The GPU draws such glass in Bevy's transparent pass with premultiplied alpha, both faces,
 //! its reflection over what lies behind with the mean of T (`bevy_plenoptic::reconstruct`).
 //!

@@ -15,27 +15,25 @@
 //!   its direction to the point is to the ray's. Where none of the views blended for the
 //!   camera shows the point, the other base views' keys at the frame's time are looked up
 //!   the same way (a point far from the camera, seen in a mirror or through glass, is seen
-//!   by a view near it: the `specular` test's mirror went from 0.082 to 0.055, the tour's
-//!   frame 15, glass reflecting the far side of the building, from 0.311 to 0.299); then
+//!   by a view near it: on the tour, glass reflecting the far side of the building); then
 //!   the blended views' temporal-volume samples of its object near it;
 //! - the *albedo* and the *emission* are the material's at the point's UV, the texture's mip
 //!   chosen by the ray's footprint there (the pixel's cone, continued past the mirror);
 //! - the runtime sun's direct light is evaluated at the point with its shadow rays
 //!   ([`crate::sun`]).
 //!
-//! Reading the base views' *radiance* at the hit instead (what the march does) showed the
-//! reflected scene at cube resolution, its sun-shadow edges blurred, and took the colour of
-//! whatever a view's texel showed there: surfaces every view sees edge-on (the front of a box
-//! level with the base views) came out as the colour of the box's top or of the floor behind
+//! Reading the base views' *radiance* at the hit instead (what the march does) shows the
+//! reflected scene at cube resolution, its sun-shadow edges blurred, and takes the colour of
+//! whatever a view's texel shows there: surfaces every view sees edge-on (the front of a box
+//! level with the base views) come out as the colour of the box's top or of the floor behind
 //! it, a pale ghost beside the box in the `specular` test's mirror.
 //!
 //! Where no view's cubes or samples show the point, its lighting is gathered: the mean
 //! radiance arriving along [`GATHER_RAYS`] cosine-distributed rays, each cast against the
 //! proxies and answered by the views that see where it lands (a final gather, as the bake's).
 //! An irradiance probe at the base views (nine spherical-harmonic coefficients of each view's
-//! radiance cube, evaluated on the point's normal) was tried first: it lit the gap behind the
-//! `specular` test's box as the open room is lit, and the mirror's error rose from 0.093 to
-//! 0.197 where the gather gives 0.082.
+//! radiance cube, evaluated on the point's normal) would light the gap behind the `specular`
+//! test's box as the open room is lit; the gather sees the box.
 //!
 //! Glazing (a coverage, [`crate::glazing`]) is not shaded: its cube texels show what lies
 //! behind it, blended as the tracer blends it, and the ray reads them there.

@@ -24,9 +24,9 @@
 //! - A ray that meets no proxy triangle sees the environment (a ray cast through the proxies'
 //!   BVHs, [`crate::shadow`], before any march). The march alone cannot tell: a ray leaving
 //!   through a window is, from every base view but one on its line, first behind the wall
-//!   beside the window (a silhouette), so no view answered and the pixel kept the baked
-//!   reflection of another place. On the tour, the mirror of room A showed its windows at
-//!   0.47–0.51 of the path tracer's luminance and in the wrong place (frames 14–15).
+//!   beside the window (a silhouette), so no view would answer and the pixel would keep the
+//!   baked reflection of another place (on the tour, room A's mirror would show its windows
+//!   dim and in the wrong place).
 //! - A ray that meets a proxy triangle is answered at that point, without a march:
 //!   - an ideal mirror's ray (with [`crate::ReconSettings::shaded_reflections`]) shows the
 //!     point shaded as a pixel is, albedo at its UV × the baked lighting + the runtime sun
@@ -43,16 +43,15 @@
 //!   drawn from the GGX distribution (α = roughness², a Hammersley set turned per pixel),
 //!   and each hit's radiance is averaged over a cone of half-angle 0.7α as it appears from
 //!   the base view at the hit's distance (a 5 × 5 Gaussian-weighted set of directions):
-//!   prefiltering done on the unfiltered cube. A single cone as wide as the lobe missed its
-//!   long tails: the glossy steel of `plenoptic_bake`'s `specular` test came out at 0.81 of
-//!   the path tracer's mean (0.91 with the rays) and worse than the baked specular.
+//!   prefiltering done on the unfiltered cube. A single cone as wide as the lobe would miss
+//!   its long tails and darken the glossy steel of `plenoptic_bake`'s `specular` test.
 //! - `W` is, for ideal mirrors, the tracer's own Fresnel (the exact dielectric one,
 //!   Schlick's for metals). A glossy lobe instead weights each ray by `f·cos θ_i / pdf =
 //!   F·G·(ω_o·h) / ((n·ω_o)(n·h))` ([`crate::brdf::Bsdf::glossy_weight`]), the importance-
-//!   sampled estimate of the lobe's integral, which has no bias. The mean of the rays times
-//!   Karis's split-sum fit of the directional albedo (B. Karis, "Physically Based Shading
-//!   on Mobile", 2014), used before, left the `specular` test's steel at 0.92 and 0.87 of
-//!   the path tracer's mean. Glossy surfaces also add the placed lamps' highlights, which
+//!   sampled estimate of the lobe's integral, which has no bias (the mean of the rays times
+//!   Karis's split-sum fit of the directional albedo, B. Karis, "Physically Based Shading on
+//!   Mobile", 2014, leaves the `specular` test's steel darker than the path tracer's). Glossy
+//!   surfaces also add the placed lamps' highlights, which
 //!   the march cannot see ([`crate::lamps`]).
 //! - Views are weighted by their view-space weight and by how close their direction to the
 //!   hit is to the ray's (the hit surface may be glossy too). A pixel no view answers keeps

@@ -1,13 +1,12 @@
 //! How much of a pixel a hard shadow edge leaves lit (the runtime sun's edge pixels,
-//! [`crate::sun`]; docs/architecture.md, "The runtime sun"; issue 12, "Sun shadows").
+//! [`crate::sun`]; docs/architecture.md, "The runtime sun").
 //!
 //! A sun without a disc casts a hard shadow, and within one pixel the shadow's edge is, to a
 //! very good approximation, a straight line: the projection of an occluder's edge onto the
 //! surface, which the pixel's footprint maps affinely. Estimating the lit fraction with `K`
 //! scattered shadow rays leaves an error of order 1/K in every pixel the edge crosses, and
 //! the path tracer's reference, whose jittered pixels average thousands of samples, shows
-//! that error as a faint crawl along the edge: with 32 and with 64 rays, the band along the
-//! edge kept 12× and 4.4× the error of the open floor.
+//! that error as a faint crawl along the edge.
 //!
 //! Here the line is found instead. The visibility is sampled at [`PERIMETER_SAMPLES`] points
 //! around the pixel's square; where it changes between two neighbouring points, the change

@@ -4,11 +4,11 @@
 //!
 //! A texture is decoded once, when first used, into [`LinearTexture`]: linear RGBA at 16 bits
 //! per channel, sRGB colour decoded through a table. Filtering is then four 8-byte loads per
-//! level, where the pack's sRGB bytes took three dependent table loads per texel at every
-//! sample: the sampler runs in 0.82× the time (one A/B run on the same 640 × 360 UVs; it is
-//! about a third of a textured frame's CPU time, mostly its scalar coordinate arithmetic).
-//! 16 bits keep the decoded value within 8·10⁻⁶ of the exact one, below the darkest sRGB
-//! step (3·10⁻⁴); the texels take twice the pack's 8-bit size in memory.
+//! level, where sampling the pack's sRGB bytes directly would cost three dependent table loads
+//! per texel at every sample. The sampler's cost is part of every textured frame's (`cargo
+//! bench --no-default-features --bench recon -- geometry_textured`). 16 bits keep the decoded
+//! value within 8·10⁻⁶ of the exact one, below the darkest sRGB step (3·10⁻⁴); the texels take
+//! twice the pack's 8-bit size in memory.
 
 use std::sync::OnceLock;
 
