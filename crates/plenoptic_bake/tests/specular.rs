@@ -1,9 +1,10 @@
-//! A mirror and a glossy steel panel seen from a point between base views (issue: pack v2,
-//! "Glossy and mirror"): the geometry-assisted frame against the path tracer on those
-//! pixels and on the diffuse pixels of the same frame, with the specular part as the base
-//! views saw it ([`Specular::Baked`]) and marched through the distance cubes for the camera
-//! ([`Specular::Marched`]). Errors are variance-corrected relative LRMS against a reference
-//! rendered as two halves. Frames go to `target/tmp/specular/`.
+//! A mirror and a glossy steel panel seen from a point between base views
+//! (docs/architecture.md, "Pack v2": the view-dependent part for the actual camera): the
+//! geometry-assisted frame against the path tracer on those pixels and on the diffuse pixels of
+//! the same frame, with the specular part as the base views saw it ([`Specular::Baked`]) and
+//! marched through the distance cubes for the camera ([`Specular::Marched`]). Errors are
+//! variance-corrected relative LRMS against a reference rendered as two halves. Frames go to
+//! `target/tmp/specular/`.
 
 mod common;
 
@@ -244,27 +245,20 @@ fn measure(
     results
 }
 
-/// Both panels are marched in both scenes: under the sun (left to the runtime), and under
-/// a point lamp, which pack 4.1 places so that the steel adds its highlight at runtime
-/// (until then the steel kept its baked highlight, frozen where the base views saw it).
-/// Measured at 160 × 90, 64-px cubes, 2 × 64 spp, one sample per pixel (dev profile and
-/// release alike):
+/// Both panels are marched in both scenes: under the sun (left to the runtime), and under a
+/// point lamp, which pack 4.1 places so that the steel adds its highlight at runtime (baked,
+/// the highlight stays where the base views saw it). Measured at 160 × 90, 64-px cubes, 2 × 64
+/// spp, one sample per pixel (dev profile and release alike):
 ///
-/// | scene | mirror baked → marched | steel baked → marched | diffuse |
-/// |---|---|---|---|
-/// | sun | 0.592 → 0.254 | 0.194 → 0.169 | 0.094 |
-/// | lamp | 0.186 → 0.083 | 0.197 → 0.096 | 0.035 |
+/// | scene | mirror baked | mirror marched | steel baked | steel marched | diffuse |
+/// |---|---|---|---|---|---|
+/// | sun | 0.592 | 0.254 | 0.194 | 0.169 | 0.094 |
+/// | lamp | 0.186 | 0.083 | 0.197 | 0.096 | 0.035 |
 ///
-/// (The mirror's hits are shaded as pixels, `ReconSettings::shaded_reflections`; with the base
-/// views' radiance at the hit the mirror was at 0.244 and 0.088. At one sample per pixel
-/// its sharper reflection aliases: the antialiased test below shows what it gained.)
-///
-/// (The steel's 8 rays per pixel are each weighted by the lobe's `F·G·(ω_o·h)/((n·ω_o)
-/// (n·h))`; with their plain mean times Karis's split-sum fit the steel came out at 0.92
-/// and 0.87 of the path tracer's mean, 0.124 and 0.140 at 320 × 180 against 0.080 and
-/// 0.060.) (Before the bake's final gather the diffuse pixels' errors were 0.097 and
-/// 0.052.) (Baked steel was 0.256 before the range images' texels kept only the samples of
-/// their centre's object, `plenoptic_trace::PixelFilter::SameObject`.)
+/// (The mirror's hits are shaded as pixels, `ReconSettings::shaded_reflections`. At one
+/// sample per pixel its sharp reflection aliases: the antialiased test below measures it
+/// without.) The steel's 8 rays per pixel are each weighted by the lobe's
+/// `F·G·(ω_o·h)/((n·ω_o)(n·h))`, the unbiased estimate of the lobe.
 #[test]
 fn mirror_and_steel_reflect_for_the_camera() {
     let sun: Vec<_> = measure(false, 64, (160, 90), 128, 1)
@@ -291,11 +285,9 @@ fn mirror_and_steel_reflect_for_the_camera() {
         mirror_m < 3.0 * diffuse,
         "sun: mirror {mirror_m}, diffuse {diffuse}"
     );
-    // 0.213 -> 0.181 while the baked specular was looked up at every pixel; interpolated
-    // between the lighting pass's anchors (geometry/sparse.rs) the baked highlight's texels
-    // blur a little and its error fell to 0.194. The marched 0.181 did not change; it became
-    // 0.169 once the views answer the point the proxies say a ray meets, where they see it,
-    // before any march.
+    // The baked steel's highlight is interpolated between the lighting pass's anchors
+    // (geometry/sparse.rs), which blurs its texels a little; the marched steel's rays are
+    // answered at the point the proxies say they meet, where a view sees it, before any march.
     assert!(
         steel_m < 0.95 * steel_b,
         "sun: steel {steel_b} -> {steel_m}"
@@ -305,11 +297,9 @@ fn mirror_and_steel_reflect_for_the_camera() {
         mirror_m < 0.6 * mirror_b,
         "lamp: mirror {mirror_b} -> {mirror_m}"
     );
-    // The issue's bound is the mirror's error within 2× the diffuse pixels'. It held (0.088
-    // against 0.052) until the bake's final gather lowered the diffuse pixels' error to 0.036;
-    // the mirror's stayed at 0.088, 2.4× (0.083, 2.36×, with its hits shaded as pixels: at
-    // one sample per pixel its sharp edges alias). The antialiased test below holds 2×; held
-    // here: what the sun's scene holds.
+    // The bound is the mirror's error within 2× the diffuse pixels'; at one sample per pixel
+    // the mirror's sharp edges alias (0.083 against 0.035, 2.4×). The antialiased test below
+    // holds 2×; held here: what the sun's scene holds.
     assert!(
         mirror_m < 3.0 * diffuse,
         "lamp: mirror {mirror_m}, diffuse {diffuse}"
@@ -322,10 +312,10 @@ fn mirror_and_steel_reflect_for_the_camera() {
     );
 }
 
-/// The issue's comparison with antialiased frames, as the tour's are compared (about 25 s on
-/// 2 cores): 320 × 180, 4 × 4 samples per pixel, 2 × 64 spp. Both panels reflect
-/// for the camera in both scenes; under the lamp the steel adds the placed lamp's highlight
-/// at runtime. Held here: the issue's bound, both within 2× the diffuse pixels' error; the
+/// The comparison with antialiased frames, as the tour's are compared (about 25 s on 2
+/// cores): 320 × 180, 4 × 4 samples per pixel, 2 × 64 spp. Both panels reflect for the camera
+/// in both scenes; under the lamp the steel adds the placed lamp's highlight at runtime. Held
+/// here: both within 2× the diffuse pixels' error; the
 /// mirror within 1.25× (what shading its hits with every base view's lighting reaches); and
 /// the mirror's error below half the baked one's. Measured:
 ///
@@ -335,11 +325,11 @@ fn mirror_and_steel_reflect_for_the_camera() {
 /// | lamp | 0.041 (1.03×) | 0.052 (1.30×) | 0.040 |
 ///
 /// The mirror's hits are shaded as pixels (`ReconSettings::shaded_reflections`, reflected.rs
-/// in plenoptic_recon). With only the views blended for the camera lighting them (session
-/// 24) it was at 0.082 (1.32×) and 0.064 (1.59×): a hit none of them showed gathered its
-/// lighting from 8 rays, noisy and too bright in the gap behind the red box. With the base views' radiance at the hit instead it was at 2.18× and
-/// 2.08×: the reflected floor's sun-shadow edges at cube resolution, and a pale ghost beside
-/// the red box, whose front no base view sees (the views stand level with it).
+/// in plenoptic_recon), lit by every base view that shows them: the views blended for the
+/// camera alone leave hits in the gap behind the red box to a gather of 8 rays, noisy and too
+/// bright there. The base views' radiance at the hit would show the reflected floor's
+/// sun-shadow edges at cube resolution, and a pale ghost beside the red box, whose front no
+/// base view sees (the views stand level with it).
 #[test]
 fn mirror_and_steel_antialiased() {
     let sun = measure(false, 64, (320, 180), 128, 4);
