@@ -1,4 +1,4 @@
-//! The architectural tour end to end at CI's size (issue: the tour remade, "CI"): the
+//! The architectural tour end to end at CI's size: the
 //! committed, textured `tour.glb` is baked with tiny settings (a few base views, small cubes,
 //! few samples), two frames of the tour's camera path are reconstructed in geometry-assisted
 //! mode at low resolution, and each is compared with a path-traced reference rendered here as

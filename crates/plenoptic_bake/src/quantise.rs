@@ -1,6 +1,6 @@
-//! The precision the bake stores (docs/pack-format.md, "Range images"): texels are rounded
-//! to what their own noise can tell before they are encoded, so that zstd is not spent on
-//! noise bits.
+//! The precision the bake stores (docs/pack-format.md, "Range-image chunks"): texels are
+//! rounded to what their own noise can tell before they are encoded, so that zstd is not spent
+//! on noise bits.
 //!
 //! A draft range-image texel is the mean of a few samples (4 in the draft preset): its
 //! relative noise is several per cent, while RGB9E5 keeps 9 bits (0.2 %) and R32F 24 bits of

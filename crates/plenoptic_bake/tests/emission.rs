@@ -1,4 +1,4 @@
-//! Emission at screen resolution (issue: pack v2, "Reconstruction at full resolution": a pixel
+//! Emission at screen resolution (docs/architecture.md, "Pack v2", **Reconstruction**: a pixel
 //! is albedo × lighting *plus emission* plus the view-dependent part). A wall panel emits
 //! through a fine checker texture (8 cm squares) seen from 2 m; the bake's cubes are 16 px,
 //! so a cube texel spans several squares and emission stored in the cubes would blur the

@@ -1,4 +1,4 @@
-//! Normal maps at the runtime (issue: pack v2, "The materials in the pack": normal map): a
+//! Normal maps at the runtime (docs/architecture.md, "Pack v2", **Materials**): a
 //! sunlit floor whose normal map tilts alternate stripes towards and away from the sun. The
 //! sun's direct light is left to the runtime (pack 3), which bends each pixel's shading normal
 //! as the path tracer does, so the stripes show at screen resolution with the tracer's

@@ -1,16 +1,16 @@
-//! A sun-shadow edge on a floor (issue: pack v2, "Sun shadows"): the error of the
+//! A sun-shadow edge on a floor (docs/architecture.md, "The runtime sun"): the error of the
 //! geometry-assisted frame against the path tracer in a 4-pixel band along the edge, against
 //! the error elsewhere on the floor. Pack 3 leaves the sun's direct light to the runtime
 //! (shadow rays against the proxies; for this sun without a disc, the lit fraction of each
 //! pixel an edge crosses is measured along the edge, `plenoptic_recon`'s `sun_edge`), so the
 //! edge is at screen resolution; pack 2.0 had it in the stored lighting, at cube resolution.
 //!
-//! The errors are variance-corrected RMS errors, as every comparison of the issue: from two
-//! reference halves, the reference's own variance is estimated and subtracted per region
+//! The errors are variance-corrected RMS errors, as every comparison with the path tracer: from
+//! two reference halves, the reference's own variance is estimated and subtracted per region
 //! (`plenoptic_eval::metrics::ErrorSums`). An antialiased edge is where a path tracer is
-//! noisiest, so the uncorrected error of a perfect frame is itself about twice as large in
-//! the band as elsewhere; the mean absolute errors (the old measure, the reference's noise
-//! in) are printed beside. Frames go to `target/tmp/sun_shadow/`.
+//! noisiest, so the uncorrected error of a perfect frame is itself about twice as large in the
+//! band as elsewhere; the mean absolute errors (the reference's noise left in) are printed
+//! beside. Frames go to `target/tmp/sun_shadow/`.
 
 mod common;
 
@@ -211,7 +211,7 @@ fn errors(
     (eb, er)
 }
 
-/// The issue's size (release, about 2.5 minutes): 64-px cubes at 1280 × 720, the default
+/// At full size (release, about 2.5 minutes): 64-px cubes at 1280 × 720, the default
 /// settings within 2× of the rest of the floor; beside them, 4 and 16 rays per pixel
 /// without the edges measured, and the radiance at cube resolution. The reference takes
 /// 512 samples per pixel: at 64, the uncertainty of its own variance in the band's few

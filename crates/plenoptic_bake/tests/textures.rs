@@ -127,7 +127,7 @@ fn textures_at_screen_resolution_beat_radiance_from_cubes_eight_times_larger() {
     assert!((f[0].2 - 1.0).abs() < 0.05, "{f:?}");
 }
 
-/// The size (release build, minutes): 64-px lighting cubes against radiance from
+/// At full size (release build, minutes): 64-px lighting cubes against radiance from
 /// 64-px and 512-px cubes, at 1280 × 720.
 #[test]
 #[ignore]

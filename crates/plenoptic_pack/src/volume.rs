@@ -1,7 +1,7 @@
 //! Temporal-volume blocks (thesis ch. 7): the (direction, t) samples of one base view in one
 //! time bucket, ordered along a Morton curve, quantized column by column and zstd-compressed;
 //! and the optional tetrahedral connectivity over them (see `docs/pack-format.md`, "Volume
-//! blocks").
+//! block").
 
 use glam::Vec3;
 use half::f16;

@@ -1,7 +1,6 @@
-//! Lamps' highlights at runtime (pack 4.1; docs/architecture.md, "Reflections for the
-//! camera"; issue 12: "direct light from punctual lights (sun, point, spot) may be left out
-//! of the stored lighting and evaluated at runtime against the proxy geometry"; thesis
-//! ch. 5, direct and indirect light at different accuracies).
+//! Lamps' highlights at runtime (pack 4.1; docs/architecture.md, "Reconstruction"; thesis ch.
+//! 5, direct and indirect light at different accuracies: the direct light of punctual lights
+//! evaluated at runtime against the proxy geometry).
 //!
 //! A glossy surface's baked non-diffuse radiance holds the highlights of the scene's point
 //! and spot lights as the base views saw them: frozen in the wrong place for any other

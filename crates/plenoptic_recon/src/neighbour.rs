@@ -1,9 +1,9 @@
 //! The thin-object fallback of the geometry-assisted mode (after the same-object hole fill;
-//! `docs/architecture.md`, "Geometry-assisted reconstruction"): a point whose object no
-//! texel centre met (a window's mullion seen from across a room) takes, in each key, the
-//! nearest texel of its own object around the lookup's texel, else the nearest texel of any
-//! surface at about its distance (the wall around the window), instead of the cube in its
-//! direction, which shows what lies behind it (the sky).
+//! `docs/architecture.md`, "Reconstruction"): a point whose object no texel centre met (a
+//! window's mullion seen from across a room) takes, in each key, the nearest texel of its own
+//! object around the lookup's texel, else the nearest texel of any surface at about its
+//! distance (the wall around the window), instead of the cube in its direction, which shows
+//! what lies behind it (the sky).
 //!
 //! The search is a square of [`NEIGHBOUR_TEXELS`] texels on either side of the lookup's texel
 //! on its face. `bevy_plenoptic`'s `geometry.wgsl` searches alike, with these constants.

@@ -1,6 +1,6 @@
 //! The runtime sun (pack 3; docs/architecture.md, "The runtime sun"; thesis ch. 5, direct and
-//! indirect light at different accuracies; issue 12: "direct light from punctual lights may
-//! be left out of the stored lighting and evaluated at runtime against the proxy geometry").
+//! indirect light at different accuracies: the sun's direct light is left out of the stored
+//! lighting and evaluated at runtime against the proxy geometry).
 //!
 //! A pack whose environment entry has `direct_sun` stores its lighting and non-diffuse
 //! radiance without the sun's direct light at the surfaces the base views see. Here it is
