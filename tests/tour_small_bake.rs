@@ -3,8 +3,8 @@
 //! few samples), two frames of the tour's camera path are reconstructed in geometry-assisted
 //! mode at low resolution, and each is compared with a path-traced reference rendered here as
 //! two independent halves (variance-corrected relative LRMS and the mean-luminance ratio,
-//! docs/architecture.md "Measuring against a noisy reference"). The bounds are relative to
-//! what this bake measured when the test was written, with margin: a regression in the bake
+//! docs/architecture.md "Measuring against a noisy reference"). The bounds are what this
+//! bake measures, with margin: a regression in the bake
 //! (dark or noisy lighting), the pack or the reconstruction (wrong lookups, textures
 //! missing) moves them past it.
 

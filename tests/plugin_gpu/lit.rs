@@ -257,9 +257,9 @@ fn own_mesh_is_lit_by_the_pack_near_it() {
     assert!(spread > 1.3, "{spread}");
     // Measured on lavapipe: 857 pixels, mean 0.008, 97 % within 5 %, ratio 0.995; the
     // ambient cube against the exact irradiance: mean 0.11, ratio 1.085 (Valve's six
-    // directions are an approximation). Through the camera's environment light alone (before
-    // the volume), the exact irradiance was matched within 0.018 (ratio 1.004), and 1.54
-    // (ratio 2.15) with its cubemap's z not negated.
+    // directions are an approximation). The camera's environment light alone matches the
+    // exact irradiance within 0.018 (ratio 1.004) when its cubemap's z is negated for Bevy's
+    // left-handed cubemaps, and is off by 1.54 (ratio 2.15) without.
     assert!((ratio - 1.0).abs() < 0.03, "mean luminance ratio {ratio}");
     assert!(mean < 0.05 && f20 > 0.95, "mean {mean}, within 20 %: {f20}");
 }

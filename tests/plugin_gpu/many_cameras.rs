@@ -212,8 +212,8 @@ fn two_cameras_on_one_pack_each_match_their_cpu_frame() {
     let (apart, same, _) = compare(&gpu[0], &gpu[1]);
     eprintln!("the two GPU frames: mean {apart:.3}, within 5 % {same:.3}");
     assert!(apart > 0.05 && same < 0.9, "{apart} {same}");
-    // Measured on lavapipe: mean 0.00038 and 0.00017, 100 % within 5 %. While app-wide state
-    // served the first camera only, both cameras showed the same frame (mean 0.000 apart).
+    // Measured on lavapipe: mean 0.00038 and 0.00017, 100 % within 5 %. State shared by the
+    // app instead of kept per camera would show both cameras the same frame.
     assert_each_matches(&gpu, &cpu, 0.003, 0.995);
 }
 
@@ -248,10 +248,10 @@ fn stereo_pair_each_eye_matches_its_cpu_frame() {
     let (apart, same, _) = compare(&gpu[0], &gpu[1]);
     eprintln!("left against right eye: mean {apart:.3}, within 5 % {same:.3}");
     assert!(apart > 0.01 && same < 0.95, "{apart} {same}");
-    // Measured on lavapipe: both eyes mean 0.00045, 100 % within 5 %. While the proxies
-    // carried one camera's lookups, the right eye showed the left eye's reconstruction:
-    // mean 0.0056 against its own CPU frame (within the one-camera reflection test's bound
-    // of 0.01, hence this tighter one).
+    // Measured on lavapipe: both eyes mean 0.00045, 100 % within 5 %. Proxies carrying one
+    // camera's lookups would show the right eye the left eye's reconstruction, about 0.006
+    // from its own CPU frame: within the one-camera reflection test's bound of 0.01, hence
+    // this tighter one.
     assert_each_matches(&gpu, &cpu, 0.002, 0.995);
 }
 
@@ -287,7 +287,7 @@ fn two_cameras_each_lit_by_the_sun_of_their_time() {
     assert!(apart > 0.02 && same < 0.95, "{apart} {same}");
     let gpu = plugin_frames(dir.path(), &eyes);
     // Measured on lavapipe: mean 0.00073 at t = 0.2 and 0.0044 at t = 1.8 (the brighter sun's
-    // shadow edges), 99.9 % and 98.8 % within 5 %. With one sun for the pack, aimed for the
-    // first camera, the second was 0.070 and 82 %.
+    // shadow edges), 99.9 % and 98.8 % within 5 %. One sun for the pack, aimed for the first
+    // camera, would put the second at about 0.07 and 82 %.
     assert_each_matches(&gpu, &cpu, 0.005, 0.98);
 }

@@ -215,8 +215,7 @@ fn errors(
 /// settings within 2× of the rest of the floor; beside them, 4 and 16 rays per pixel
 /// without the edges measured, and the radiance at cube resolution. The reference takes
 /// 512 samples per pixel: at 64, the uncertainty of its own variance in the band's few
-/// hundred edge pixels was as large as the error measured (the band read 2.3× where it
-/// reads 1.6× at 512).
+/// hundred edge pixels is as large as the error measured.
 #[test]
 #[ignore]
 fn sun_shadow_edge_at_1280x720() {

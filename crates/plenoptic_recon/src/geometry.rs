@@ -16,8 +16,8 @@
 //!    object in screen space (same-object hole fill); then, in each key, the nearest texel
 //!    of the object itself, else of any surface at the point's distance, within
 //!    [`crate::NEIGHBOUR_TEXELS`] of the lookup's texel (`neighbour.rs`: a thin object, a
-//!    window's mullion seen from afar, that no texel centre met; without this it showed the
-//!    sky behind it); then the nearest view's cube in the point's direction regardless of id
+//!    window's mullion seen from afar, that no texel centre met; without this it would show
+//!    the sky behind it); then the nearest view's cube in the point's direction regardless of id
 //!    ("background").
 //!
 //! The per-object matrices `M_o(τ) M_o(t)⁻¹` are computed once per frame and key. The pixel

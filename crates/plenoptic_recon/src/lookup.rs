@@ -524,8 +524,8 @@ impl Shade<'_> {
 /// the relative tolerance `tol`, or (where the key has normals) the texel's centre point lies
 /// on the plane through the lookup's point with the texel's normal, within `tol · l`. A
 /// surface seen at a grazing angle changes distance by more than the tolerance from one
-/// texel to the next; without the plane the bilinear footprint lost those taps, and the
-/// lighting showed the cube's texels as blocks (docs/architecture.md, "Reconstruction").
+/// texel to the next; without the plane the bilinear footprint would lose those taps, and the
+/// lighting would show the cube's texels as blocks (docs/architecture.md, "Reconstruction").
 #[inline]
 fn same_surface(k: &FastKey<'_>, tj: &Texel, j: usize, o: u32, d: Vec3, l: f32, tol: f32) -> bool {
     if tj.id != o {

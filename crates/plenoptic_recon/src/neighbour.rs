@@ -13,11 +13,11 @@ use plenoptic_pack::CubeImage;
 
 /// Texels on either side of a lookup's texel (along each axis of its face) searched for the
 /// object itself, else any surface at the point's distance, when nothing else answered. On
-/// the tour (64-px cubes), 2 left Room A's mullions at 3.8× the path tracer's luminance and 3
-/// at 2.7×. 4 brought them to 1.03× on average, but a base view 7 m from a window sees its
-/// opening 9 texels wide, so that a mullion no texel centre met lies 5 texels from the wall:
-/// at 4, ten of its pixels in frame 6 of 8 (320 × 180) still showed the sky, 86 % of that
-/// frame's squared error (corrected relative LRMS 0.421; 0.087 at 5 and above). 8 leaves a
+/// the tour (64-px cubes), a search of 2 texels leaves Room A's mullions at 3.8× the path
+/// tracer's luminance and 3 at 2.7×. 4 brings them to 1.03× on average, but a base view 7 m
+/// from a window sees its opening 9 texels wide, so that a mullion no texel centre met lies 5
+/// texels from the wall: at 4, ten of its pixels in frame 6 of 8 (320 × 180) show the sky, 86 %
+/// of that frame's squared error (corrected relative LRMS 0.421; 0.087 at 5 and above). 8 leaves a
 /// margin for wider openings; the search only runs for pixels nothing else answered.
 pub const NEIGHBOUR_TEXELS: i64 = 8;
 
@@ -109,7 +109,7 @@ mod tests {
     #[test]
     fn a_point_in_the_middle_of_a_wide_opening_finds_the_wall() {
         // The tour's case: the opening's edge 5 texels from the lookup (a 4-texel search
-        // found nothing there, and the mullion showed the sky).
+        // finds nothing there, and the mullion shows the sky).
         let (ids, distance) = window(4);
         let d = towards(16, 16) * 3.0;
         assert_eq!(

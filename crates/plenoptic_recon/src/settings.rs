@@ -69,7 +69,7 @@ pub struct ReconSettings {
     /// reconstructed at n × its size and each pixel is the mean of its n × n samples: the box
     /// filter over the pixel's area that the path tracer's references use, so that edges
     /// against bright windows are not aliased (on the tour, point-sampled edges of windows
-    /// were most of the error of some frames; docs/architecture.md, "Measuring"). Cost grows
+    /// are most of the error of some frames; docs/architecture.md, "Measuring"). Cost grows
     /// with n². Depth and object id come from the sample nearest the pixel's centre. The
     /// plugin's GPU path ignores it: there Bevy's `Msaa` antialiases the proxies' edges.
     pub supersampling: u32,

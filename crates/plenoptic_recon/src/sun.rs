@@ -27,10 +27,8 @@
 //! are placed instead of scattered: 5 rays, from the pixel's 4 corners and its centre, find
 //! the pixel an edge crosses, and the lit fraction of that pixel is measured along the edge
 //! ([`crate::sun_edge`]: 16 to 30 more rays, exact to about 0.002 for a straight edge).
-//! Scattered rays left an error of order 1/K in each edge pixel, which the path tracer's
-//! reference showed as a crawl along the edge (the band along the edge of the `sun_shadow`
-//! test: 12× the open floor's error with 32 edge rays, 1.6× measured along the edge). The
-//! edge rays remain for the pixels no single straight edge explains.
+//! Scattered rays leave an error of order 1/K in each edge pixel, which the path tracer's
+//! reference shows as a crawl along the edge. The edge rays remain for the pixels no single straight edge explains.
 //! Shadow edges are therefore at screen resolution, and a highlight moves with the camera.
 //!
 //! Surfaces whose every lobe is ideal (a mirror, clear glass) take no light sample, as in the

@@ -27,8 +27,8 @@
 //! [`AmbientLight`] of zero brightness, unless it has an `AmbientLight` of its own. Bevy's
 //! `GlobalAmbientLight` (80 cd/m² by default) otherwise lights every `StandardMaterial` mesh
 //! evenly on top of the probes: at the exposure a pack is shown with (about 1 for the tour,
-//! [`crate::camera::EV100_UNIT`]) that is hundreds of times the baked interior's light, and
-//! the `own_scene` example's white sphere showed as a white disc.
+//! [`crate::camera::EV100_UNIT`]) that is hundreds of times the baked interior's light: the
+//! `own_scene` example's white sphere would show as a white disc.
 //!
 //! Meshes near a base view are lit by that view's own cube instead, through a light probe
 //! at the base view ([`probes`]; where the device has binding arrays); the camera's light

@@ -97,9 +97,8 @@ fn tour_gpu_against_cpu() {
         let decode = crate::common::rgba16f_pixels;
         let prev: RefCell<Option<Vec<u8>>> = RefCell::default();
         // Three equal read-backs in a row, after at least 60: the software driver compiles
-        // pipelines slowly and skips draws whose pipeline is not ready. With two equal
-        // read-backs, one run in four took an earlier frame at s = 0.6 (mean 0.0061 and
-        // 97.8 % within 5 %, against 0.0086 and 98.7 % in the other three).
+        // pipelines slowly and skips draws whose pipeline is not ready. Two equal read-backs
+        // are not enough: in about one run in four they catch a stale frame at s = 0.6.
         let (streak, reads) = (RefCell::new(0u32), RefCell::new(0u32));
         let data = crate::common::render_until(&mut app, image, 600, |d| {
             *reads.borrow_mut() += 1;

@@ -11,13 +11,13 @@
 //! meet there), and the texel holding it is the neighbour. So every texel's footprint is
 //! symmetric on the sphere around it, and two texels either side of a seam get footprints of
 //! the same shape and size (the face grids meet rotated by a multiple of 90°, which maps a
-//! square kernel to itself). Two simpler addressings were measured in the seam test
-//! (`denoise::tests`, a smooth gradient across the −Y/+X seam, 64-px faces, 5 passes):
-//! offsets on the face's texel grid, continued on the face plane extended past its edge,
-//! make a step at the seam of 4.2× the steps beside it (the grid's steps grow towards the
-//! face centre and shrink past the edge, so the footprints either side are lopsided in
-//! opposite directions); the grid inside the face and tangent steps outside, 3.2×; clamping
-//! at the border, 23×.
+//! square kernel to itself). Simpler addressings leave a step at the seam (the set-up of the
+//! seam test in `denoise::tests`: a smooth gradient across the −Y/+X seam, 64-px faces, 5
+//! passes): offsets on the face's texel grid, continued on the face plane extended past its
+//! edge, make a step of about 4× the steps beside it (the grid's steps grow towards the face
+//! centre and shrink past the edge, so the footprints either side are lopsided in opposite
+//! directions); the grid inside the face and tangent steps outside, about 3×; clamping at the
+//! border, over 20×.
 
 use glam::Vec3;
 use plenoptic_pack::cube::{direction_to_texel, face_uv_to_direction, texel_direction};

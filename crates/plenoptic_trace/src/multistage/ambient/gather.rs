@@ -27,18 +27,17 @@
 //! rays from a point that is not in the layout (a pixel's or a texel's first hit) and reads
 //! the converged field where they end: D + K·E for that point alone.
 //!
-//! A ray that meets the back face of a single-sided opaque surface has entered a closed
-//! solid and carries no light (the field is shared by both sides of a triangle, so reading
-//! it there would leak the lit side's light through the wall). Transmissive surfaces are
-//! exempt: a glass balustrade modelled as one single-sided panel is seen from behind through
-//! open air, and a glass case's inner faces through its glass. Treated as solids, the tour's
-//! glass balustrade was a black wall for every gather ray that met its back, and the atrium's
-//! indirect light came out about 12 % low (frames at 0.89–0.93 of the path tracer's mean). Points that lie inside a solid — more
+//! A ray that meets the back face of a single-sided opaque surface has entered a closed solid
+//! and carries no light (the field is shared by both sides of a triangle, so reading it there
+//! would leak the lit side's light through the wall). Transmissive surfaces are exempt: a glass
+//! balustrade modelled as one single-sided panel is seen from behind through open air, and a
+//! glass case's inner faces through its glass. Treated as solids, the tour's glass balustrade
+//! would be a black wall for every gather ray that met its back, and the atrium's indirect
+//! light about 12 % low (docs/bake-accuracy.md, cause 5). Points that lie inside a solid — more
 //! than an eighth of their gather rays first meet such a back face, as on a box face running
-//! under a wall — are **invalid**: their own gather is
-//! dropped, and at every iteration they take the mean of their valid (or already filled)
-//! neighbours on the same surface, so interpolation next to a wall does not pull in the
-//! darkness inside it.
+//! under a wall — are **invalid**: their own gather is dropped, and at every iteration they
+//! take the mean of their valid (or already filled) neighbours on the same surface, so
+//! interpolation next to a wall does not pull in the darkness inside it.
 
 use glam::Vec3;
 use plenoptic_scene::ObjectId;

@@ -180,8 +180,8 @@ impl AmbientField {
     /// interpolates) and adding the light it meets on the way, as the field's own gather
     /// does (`gather.rs`): one bounce traced from the hit itself, the field supplying longer
     /// paths. The field's grid is coarser than the falloff of light into a corner or under
-    /// an object, and its interpolation smooths that falloff away: on the tour, dim blocks
-    /// at base views came out 5–30 % bright (docs/bake-accuracy.md, cause 6). `from` is the
+    /// an object, and its interpolation smooths that falloff away: on the tour, read directly
+    /// it makes dim blocks at base views 5–30 % bright (docs/bake-accuracy.md, cause 6). `from` is the
     /// direction towards the viewer: the gather leaves the side of the surface it faces.
     /// Unbiased where the field is, and noisy: one ray per sample needs smoothing
     /// afterwards (the bake's `LightingCube::smooth_ambient`).
