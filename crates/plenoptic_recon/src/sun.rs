@@ -9,27 +9,26 @@
 //! `L_sun = 1/K Σ_k f(ω_k, ω_o) · E_sun · |n · ω_k| · V(x, ω_k)`
 //!
 //! with `f` the surface's full BSDF ([`crate::brdf`]: the Lambertian lobe, and the GGX
-//! highlight the base views would have frozen in place), `E_sun` the track's illuminance at
-//! t and `V` a shadow ray against the proxies ([`crate::shadow`]). A sun with a disc
-//! (angular radius > 0) is sampled with `K` = [`crate::ReconSettings::sun_shadow_rays`]
-//! directions spread uniformly over the disc's cone, as the tracer draws them (stratified in
-//! cos θ and φ, the strata turned per pixel). The rays also leave from `K` points spread over
-//! the pixel's footprint on the surface (a rotated R₂ lattice), so that a shadow edge is
-//! antialiased as the path tracer's jittered pixels show it; `K` applies to a delta sun too.
-//! Where the `K` rays disagree (some blocked, some not), the pixel straddles an edge or lies
-//! in a penumbra, and its estimate is made again with
-//! [`crate::ReconSettings::sun_edge_rays`] (32): adaptive sampling, so that only edge pixels
-//! pay for a finely antialiased edge. The first rays then spread over twice the pixel's
-//! footprint, so that an edge clipping only a corner of the pixel still splits them (with
-//! 4 rays over the pixel itself, a near-horizontal edge went unrefined in most of the pixels
-//! it crossed).
-//! A sun without a disc (a glTF directional light) casts hard shadows, and there the rays
-//! are placed instead of scattered: 5 rays, from the pixel's 4 corners and its centre, find
-//! the pixel an edge crosses, and the lit fraction of that pixel is measured along the edge
-//! ([`crate::sun_edge`]: 16 to 30 more rays, exact to about 0.002 for a straight edge).
-//! Scattered rays leave an error of order 1/K in each edge pixel, which the path tracer's
-//! reference shows as a crawl along the edge. The edge rays remain for the pixels no single straight edge explains.
-//! Shadow edges are therefore at screen resolution, and a highlight moves with the camera.
+//! highlight the base views would have frozen in place), `E_sun` the track's illuminance at t
+//! and `V` a shadow ray against the proxies ([`crate::shadow`]). A sun with a disc (angular
+//! radius > 0) is sampled with `K` = [`crate::ReconSettings::sun_shadow_rays`] directions
+//! spread uniformly over the disc's cone, as the tracer draws them (stratified in cos θ and φ,
+//! the strata turned per pixel). The rays also leave from `K` points spread over the pixel's
+//! footprint on the surface (a rotated R₂ lattice), so that a shadow edge is antialiased as the
+//! path tracer's jittered pixels show it; `K` applies to a delta sun too. Where the `K` rays
+//! disagree (some blocked, some not), the pixel straddles an edge or lies in a penumbra, and
+//! its estimate is made again with [`crate::ReconSettings::sun_edge_rays`] (32): adaptive
+//! sampling, so that only edge pixels pay for a finely antialiased edge. The first rays then
+//! spread over twice the pixel's footprint, so that an edge clipping only a corner of the pixel
+//! still splits them (with 4 rays over the pixel itself, a near-horizontal edge would go
+//! unrefined in most of the pixels it crosses). A sun without a disc (a glTF directional light) casts
+//! hard shadows, and there the rays are placed instead of scattered: 5 rays, from the pixel's 4
+//! corners and its centre, find the pixel an edge crosses, and the lit fraction of that pixel
+//! is measured along the edge ([`crate::sun_edge`]: 16 to 30 more rays, exact to about 0.002
+//! for a straight edge). Scattered rays leave an error of order 1/K in each edge pixel, which
+//! the path tracer's reference shows as a crawl along the edge. The edge rays remain for the
+//! pixels no single straight edge explains. Shadow edges are therefore at screen resolution,
+//! and a highlight moves with the camera.
 //!
 //! Surfaces whose every lobe is ideal (a mirror, clear glass) take no light sample, as in the
 //! tracer: they show the sun through their baked specular paths.

@@ -108,13 +108,13 @@ where
 pub enum PixelFilter {
     /// Every sample: the mean over the pixel's area (images to look at, references).
     Box,
-    /// Only the samples that hit the object the pixel-centre ray hit (or missed, as it did):
-    /// a pixel's colour then belongs to the surface its distance and id describe, as a range
+    /// Only the samples that hit the object the pixel-centre ray hit (or missed, as it did): a
+    /// pixel's colour then belongs to the surface its distance and id describe, as a range
     /// image's lookups take it. Where rays pass a see-through surface (BLEND coverage c), the
     /// pixel is the surface's own radiance where the centre ray stopped at it, and what lies
     /// behind where it passed, instead of the mix c · surface + (1 − c) · behind in both (with
-    /// the mix, the tour's glazed window would show the sky through its own pane texels). At silhouettes, the
-    /// centre's object alone.
+    /// the mix, the tour's glazed window would show the sky through its own pane texels). At
+    /// silhouettes, the centre's object alone.
     SameObject,
 }
 

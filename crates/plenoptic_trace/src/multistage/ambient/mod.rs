@@ -176,15 +176,15 @@ impl AmbientField {
     }
 
     /// Indirect irradiance at `hit` by a final gather of `rays` cosine-distributed rays, each
-    /// reading the field where it ends (interpolated as [`Self::irradiance_seen`]
-    /// interpolates) and adding the light it meets on the way, as the field's own gather
-    /// does (`gather.rs`): one bounce traced from the hit itself, the field supplying longer
-    /// paths. The field's grid is coarser than the falloff of light into a corner or under
-    /// an object, and its interpolation smooths that falloff away: on the tour, read directly
-    /// it makes dim blocks at base views 5–30 % bright (docs/bake-accuracy.md, cause 6). `from` is the
-    /// direction towards the viewer: the gather leaves the side of the surface it faces.
-    /// Unbiased where the field is, and noisy: one ray per sample needs smoothing
-    /// afterwards (the bake's `LightingCube::smooth_ambient`).
+    /// reading the field where it ends (interpolated as [`Self::irradiance_seen`] interpolates)
+    /// and adding the light it meets on the way, as the field's own gather does (`gather.rs`):
+    /// one bounce traced from the hit itself, the field supplying longer paths. The field's
+    /// grid is coarser than the falloff of light into a corner or under an object, and its
+    /// interpolation smooths that falloff away: on the tour, read directly it makes dim blocks
+    /// at base views 5–30 % bright (docs/bake-accuracy.md, cause 6). `from` is the direction
+    /// towards the viewer: the gather leaves the side of the surface it faces. Unbiased where
+    /// the field is, and noisy: one ray per sample needs smoothing afterwards (the bake's
+    /// `LightingCube::smooth_ambient`).
     pub fn irradiance_gathered(
         &self,
         placed: &PlacedScene<'_>,
