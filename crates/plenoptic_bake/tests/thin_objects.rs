@@ -1,12 +1,10 @@
 //! Thin objects that no cube texel centre meets (geometry-assisted fallbacks, after the
 //! same-object hole fill): a window's mullion seen from the base views across a room. Its
-//! pixels have no accepted lookup, and the last fallback read the cube in the point's
-//! direction, which shows the sky behind the mullion: the tour's mullions glowed (frame 6 of
-//! 8 at 320 × 180: 6.3× the reference's luminance on them, corrected relative LRMS 1.13).
-//! The runtime now takes the nearest texels of the object itself around the lookup, else of
-//! any surface at the point's distance (the wall around the window; `neighbour.rs` in
-//! `plenoptic_recon`, whose unit tests cover an opening wider than this one). Frames go to
-//! `target/tmp/thin_objects/`.
+//! pixels have no accepted lookup, and the cube in the point's direction shows the sky behind
+//! the mullion: read there, the tour's mullions would glow. The runtime takes the nearest
+//! texels of the object itself around the lookup, else of any surface at the point's distance
+//! (the wall around the window; `neighbour.rs` in `plenoptic_recon`, whose unit tests cover an
+//! opening wider than this one). Frames go to `target/tmp/thin_objects/`.
 
 mod common;
 
