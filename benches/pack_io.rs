@@ -5,8 +5,8 @@
 //!
 //! `pack_io/zstd_decode_level_{9,15}`: zstd alone decoding the fixture's radiance, lighting
 //! and distance texels with 5 % noise, rounded as the baker stores them
-//! (`plenoptic_bake::quantise`), compressed at the writer's level (15) and at its former
-//! one (9), measured in the same run; prints the sizes' ratio. With `PLENOPTIC_BENCH_PACK`
+//! (`plenoptic_bake::quantise`), compressed at the writer's level (15) and at level 9, a
+//! faster one, measured in the same run; prints the sizes' ratio. With `PLENOPTIC_BENCH_PACK`
 //! naming a baked pack, every fifth of its radiance, lighting, non-diffuse and distance cubes
 //! instead (the texels as that bake stored them).
 //!
@@ -276,7 +276,7 @@ fn pack_texels(path: &str) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// zstd decoding at the writer's level against its former one (see the module doc).
+/// zstd decoding at the writer's level against level 9 (see the module doc).
 fn zstd_levels(c: &mut Criterion, f: &Fixture) {
     let raw = match std::env::var("PLENOPTIC_BENCH_PACK") {
         Ok(path) => pack_texels(&path),
