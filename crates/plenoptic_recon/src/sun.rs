@@ -24,7 +24,7 @@
 //! unrefined in most of the pixels it crosses). A sun without a disc (a glTF directional light) casts
 //! hard shadows, and there the rays are placed instead of scattered: 5 rays, from the pixel's 4
 //! corners and its centre, find the pixel an edge crosses, and the lit fraction of that pixel
-//! is measured along the edge ([`crate::sun_edge`]: 16 to 30 more rays, exact to about 0.002
+//! is measured along the edge (`sun_edge.rs`: 16 to 30 more rays, exact to about 0.002
 //! for a straight edge). Scattered rays leave an error of order 1/K in each edge pixel, which
 //! the path tracer's reference shows as a crawl along the edge. The edge rays remain for the
 //! pixels no single straight edge explains. Shadow edges are therefore at screen resolution,
