@@ -18,6 +18,7 @@
 
 pub mod camera;
 pub mod frame_io;
+pub mod low_frequency;
 pub mod mask;
 pub mod metrics;
 pub mod plot;

@@ -20,6 +20,7 @@ use plenoptic_recon::{CameraPath, Mode, Reconstructor, Report};
 use plenoptic_trace::Image;
 
 use crate::frame_io::{auto_exposure, read_exr, write_exr, write_png};
+use crate::low_frequency::low_frequency_error;
 use crate::metrics::{
     CorrectedLrms, corrected_relative_lrms, mean_image, mean_luminance_ratio, psnr, relative_lrms,
     ssim,
@@ -217,6 +218,9 @@ pub struct CandidateMetrics {
     /// SSIM of the displayed frames per reference frame ([`ssim`], at the reference frame's
     /// [`auto_exposure`]).
     pub ssim: Vec<f64>,
+    /// Low-frequency relative error per frame ([`low_frequency_error`]: both luminances
+    /// blurred with a Gaussian of σ = 2 % of the width), against the reference's mean.
+    pub low_frequency: Vec<f64>,
 }
 
 fn finite_mean(v: &[f64]) -> f64 {
@@ -253,6 +257,11 @@ impl CandidateMetrics {
     pub fn mean_ssim(&self) -> f64 {
         finite_mean(&self.ssim)
     }
+
+    /// Mean low-frequency relative error over the frames present.
+    pub fn mean_low_frequency(&self) -> f64 {
+        finite_mean(&self.low_frequency)
+    }
 }
 
 /// What [`compare_with`] measured.
@@ -285,34 +294,42 @@ impl Comparison {
         let mut out = String::new();
         if corrected {
             out.push_str(&format!(
-                "{:<16} {:>10} {:>12} {:>9} {:>7} {:>10}\n",
-                "candidate", "corrected", "uncorrected", "PSNR dB", "SSIM", "mean ratio"
+                "{:<16} {:>10} {:>12} {:>9} {:>7} {:>10} {:>9}\n",
+                "candidate",
+                "corrected",
+                "uncorrected",
+                "PSNR dB",
+                "SSIM",
+                "mean ratio",
+                "low-freq"
             ));
         } else {
             out.push_str(&format!(
-                "{:<16} {:>12} {:>9} {:>7} {:>10}\n",
-                "candidate", "rel. LRMS", "PSNR dB", "SSIM", "mean ratio"
+                "{:<16} {:>12} {:>9} {:>7} {:>10} {:>9}\n",
+                "candidate", "rel. LRMS", "PSNR dB", "SSIM", "mean ratio", "low-freq"
             ));
         }
         for m in &self.candidates {
             if corrected {
                 out.push_str(&format!(
-                    "{:<16} {:>10.4} {:>12.4} {:>9.2} {:>7.4} {:>10.4}\n",
+                    "{:<16} {:>10.4} {:>12.4} {:>9.2} {:>7.4} {:>10.4} {:>9.4}\n",
                     m.label,
                     m.mean_corrected_lrms(),
                     m.mean_lrms(),
                     m.mean_psnr(),
                     m.mean_ssim(),
-                    m.mean_ratio()
+                    m.mean_ratio(),
+                    m.mean_low_frequency()
                 ));
             } else {
                 out.push_str(&format!(
-                    "{:<16} {:>12.4} {:>9.2} {:>7.4} {:>10.4}\n",
+                    "{:<16} {:>12.4} {:>9.2} {:>7.4} {:>10.4} {:>9.4}\n",
                     m.label,
                     m.mean_lrms(),
                     m.mean_psnr(),
                     m.mean_ssim(),
-                    m.mean_ratio()
+                    m.mean_ratio(),
+                    m.mean_low_frequency()
                 ));
             }
         }
@@ -371,7 +388,7 @@ pub fn compare(
 /// ([`corrected_relative_lrms`]) and the noise floor. Writes per-frame metrics to `out_csv`
 /// (columns `frame`, `noise_floor`, `halves_ssim`, then per candidate
 /// `<label>_lrms_corrected`, `<label>_lrms`, `<label>_psnr`, `<label>_mean_ratio`,
-/// `<label>_ssim`; the noise floor, the halves' SSIM and the corrected column only with two
+/// `<label>_ssim`, `<label>_low_frequency`; the noise floor, the halves' SSIM and the corrected column only with two
 /// halves) and the error-along-path plot (corrected relative LRMS with two halves, plus the
 /// noise floor; otherwise uncorrected) as `<out_plot stem>.svg` and `.png`.
 pub fn compare_with(
@@ -426,16 +443,18 @@ pub fn compare_with(
         let mut frame_floor = f64::NAN;
         for ((_, dir), m) in candidates.iter().zip(&mut metrics) {
             let c = read_image(&dir.join(frame_name(*idx, "exr"))).ok();
-            let (l, p, r, q) = match &c {
+            let (l, p, r, q, low) = match &c {
                 Some(img) => (
                     relative_lrms(img, &reference),
                     psnr(img, &reference),
                     mean_luminance_ratio(img, &reference),
                     ssim(img, &reference, exposure),
+                    low_frequency_error(img, &reference),
                 ),
-                None => (f64::NAN, f64::NAN, f64::NAN, f64::NAN),
+                None => (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN),
             };
             m.ssim.push(q);
+            m.low_frequency.push(low);
             m.relative_lrms
                 .push(if l.is_finite() { l } else { f64::NAN });
             m.psnr.push(if p.is_finite() || p == f64::INFINITY {
@@ -519,7 +538,7 @@ pub fn write_metrics_csv(path: &Path, comparison: &Comparison) -> Result<()> {
             head.push_str(&format!(",{}_lrms_corrected", m.label));
         }
         head.push_str(&format!(
-            ",{0}_lrms,{0}_psnr,{0}_mean_ratio,{0}_ssim",
+            ",{0}_lrms,{0}_psnr,{0}_mean_ratio,{0}_ssim,{0}_low_frequency",
             m.label
         ));
     }
@@ -535,8 +554,8 @@ pub fn write_metrics_csv(path: &Path, comparison: &Comparison) -> Result<()> {
                 row.push_str(&format!(",{:.6}", m.corrected_lrms[i]));
             }
             row.push_str(&format!(
-                ",{:.6},{:.3},{:.6},{:.4}",
-                m.relative_lrms[i], m.psnr[i], m.mean_ratio[i], m.ssim[i]
+                ",{:.6},{:.3},{:.6},{:.4},{:.6}",
+                m.relative_lrms[i], m.psnr[i], m.mean_ratio[i], m.ssim[i], m.low_frequency[i]
             ));
         }
         writeln!(f, "{row}").map_err(err)?;

@@ -87,7 +87,9 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
     let metrics = compare(&refdir, &candidates, &csv, &png).unwrap();
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
-        text.starts_with("frame,image_lrms,image_psnr,image_mean_ratio,image_ssim,volume_lrms"),
+        text.starts_with(
+            "frame,image_lrms,image_psnr,image_mean_ratio,image_ssim,image_low_frequency,volume_lrms"
+        ),
         "{text}"
     );
     assert_eq!(text.lines().count(), 6);
@@ -137,6 +139,14 @@ fn render_path_then_compare_writes_frames_csv_and_plot() {
         ),
         "{text}"
     );
+    assert!(
+        text.lines()
+            .next()
+            .unwrap()
+            .contains(",image_ssim,image_low_frequency,volume_lrms_corrected"),
+        "{text}"
+    );
+    assert!(cmp.table().contains("low-freq"), "{}", cmp.table());
     print!("{}", cmp.table());
     let floor = cmp.mean_noise_floor();
     assert!(floor > 0.05, "{floor}");
