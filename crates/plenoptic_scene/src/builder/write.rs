@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec3};
 use serde_json::{Map, Value, json};
 
-use super::{SceneBuilder, TrackDesc};
+use super::{CameraDesc, LightDesc, MeshDesc, NodeDesc, SceneBuilder, TrackDesc};
 use crate::anim::{Interpolation, Track};
 use crate::error::{Result, SceneError};
 use crate::model::{LightKind, Mesh, WrapMode};
@@ -196,11 +196,74 @@ fn track_accessors<T: Copy>(
 fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
     let mut bin = Bin::default();
     let mut used = Vec::<String>::new();
+    let images = images(b, &mut bin)?;
+    let materials = super::material::materials(b, &mut used)?;
+    let meshes = b
+        .meshes
+        .iter()
+        .enumerate()
+        .map(|(i, mesh)| mesh_json(b, &mut bin, i, mesh))
+        .collect::<Result<Vec<_>>>()?;
+    let graph = graph(b)?;
+    if !graph.lights.is_empty() {
+        used.push("KHR_lights_punctual".to_owned());
+    }
+    let (channels, anim_samplers) = animations(b, &mut bin)?;
 
-    // Textures as PNG images in buffer views.
-    let mut images = Vec::new();
-    let mut textures = Vec::new();
-    let mut samplers = Vec::new();
+    bin.align();
+    let mut root = Map::new();
+    root.insert(
+        "asset".into(),
+        json!({"version": "2.0", "generator": "plenoptic_scene builder"}),
+    );
+    root.insert("scene".into(), json!(0));
+    root.insert("scenes".into(), json!([{"nodes": graph.roots}]));
+    root.insert("nodes".into(), Value::Array(graph.nodes));
+    let mut put = |key: &str, v: Vec<Value>| {
+        if !v.is_empty() {
+            root.insert(key.into(), Value::Array(v));
+        }
+    };
+    put("meshes", meshes);
+    put("materials", materials);
+    put("images", images.images);
+    put("textures", images.textures);
+    put("samplers", images.samplers);
+    put("cameras", graph.cameras);
+    put("accessors", bin.accessors);
+    put("bufferViews", bin.views);
+    if !channels.is_empty() {
+        put(
+            "animations",
+            vec![json!({"name": "animation", "channels": channels, "samplers": anim_samplers})],
+        );
+    }
+    if !graph.lights.is_empty() {
+        root.insert(
+            "extensions".into(),
+            json!({"KHR_lights_punctual": {"lights": graph.lights}}),
+        );
+    }
+    if !used.is_empty() {
+        root.insert("extensionsUsed".into(), json!(used));
+    }
+    Ok((root, bin.data))
+}
+
+/// The document's images, textures and samplers.
+struct Images {
+    images: Vec<Value>,
+    textures: Vec<Value>,
+    samplers: Vec<Value>,
+}
+
+/// The textures as PNG images in buffer views, each with a sampler where it does not repeat.
+fn images(b: &SceneBuilder, bin: &mut Bin) -> Result<Images> {
+    let mut out = Images {
+        images: Vec::new(),
+        textures: Vec::new(),
+        samplers: Vec::new(),
+    };
     for (i, t) in b.textures.iter().enumerate() {
         let element = format!("texture {i}");
         let expected = 4 * t.width as usize * t.height as usize;
@@ -220,123 +283,105 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
         )
         .map_err(|e| invalid(element, format!("PNG encoding: {e}")))?;
         let view = bin.view(&png, None);
-        images.push(json!({"bufferView": view, "mimeType": "image/png"}));
+        out.images
+            .push(json!({"bufferView": view, "mimeType": "image/png"}));
         if (t.wrap_s, t.wrap_t) == (WrapMode::Repeat, WrapMode::Repeat) {
-            textures.push(json!({"source": i}));
+            out.textures.push(json!({"source": i}));
         } else {
-            textures.push(json!({"source": i, "sampler": samplers.len()}));
-            samplers.push(json!({"wrapS": wrap_code(t.wrap_s), "wrapT": wrap_code(t.wrap_t)}));
+            out.textures
+                .push(json!({"source": i, "sampler": out.samplers.len()}));
+            out.samplers
+                .push(json!({"wrapS": wrap_code(t.wrap_s), "wrapT": wrap_code(t.wrap_t)}));
         }
     }
+    Ok(out)
+}
 
-    let materials = super::material::materials(b, &mut used)?;
-
-    let mut meshes = Vec::new();
-    for (i, mesh) in b.meshes.iter().enumerate() {
-        let mut primitives = Vec::new();
-        for (k, (geometry, material)) in mesh.primitives.iter().enumerate() {
-            let element = format!("mesh {i} '{}' primitive {k}", mesh.name);
-            check_mesh(&element, geometry)?;
-            if material.0 >= b.materials.len() {
-                return Err(invalid(element, "material handle from another builder"));
-            }
-            let mut attributes = Map::new();
-            let pos = bin.floats(
-                &bytemuck_vec3(&geometry.positions),
-                3,
-                "VEC3",
-                true,
-                Some(ARRAY_BUFFER),
-            );
-            attributes.insert("POSITION".into(), json!(pos));
-            if !geometry.normals.is_empty() {
-                let n = bin.floats(
-                    &bytemuck_vec3(&geometry.normals),
-                    3,
-                    "VEC3",
-                    false,
-                    Some(ARRAY_BUFFER),
-                );
-                attributes.insert("NORMAL".into(), json!(n));
-            }
-            if !geometry.uvs.is_empty() {
-                let uv: Vec<f32> = geometry.uvs.iter().flat_map(|v| v.to_array()).collect();
-                check_finite(&element, "uvs", &uv)?;
-                let a = bin.floats(&uv, 2, "VEC2", false, Some(ARRAY_BUFFER));
-                attributes.insert("TEXCOORD_0".into(), json!(a));
-            }
-            if !geometry.colors.is_empty() {
-                let c: Vec<f32> = geometry.colors.iter().flat_map(|v| v.to_array()).collect();
-                if let Some(i) = c.iter().position(|v| !(0.0..=1.0).contains(v)) {
-                    return Err(invalid(
-                        &element,
-                        format!("colors: component {i} is {} outside [0, 1]", c[i]),
-                    ));
-                }
-                let a = bin.floats(&c, 4, "VEC4", false, Some(ARRAY_BUFFER));
-                attributes.insert("COLOR_0".into(), json!(a));
-            }
-            if !geometry.tangents.is_empty() {
-                let t: Vec<f32> = geometry
-                    .tangents
-                    .iter()
-                    .flat_map(|v| v.to_array())
-                    .collect();
-                check_finite(&element, "tangents", &t)?;
-                let a = bin.floats(&t, 4, "VEC4", false, Some(ARRAY_BUFFER));
-                attributes.insert("TANGENT".into(), json!(a));
-            }
-            let indices = bin.indices(&geometry.triangles);
-            primitives.push(json!({
-                "attributes": attributes,
-                "indices": indices,
-                "material": material.0,
-                "mode": 4,
-            }));
+/// Mesh `i`: its primitives' attributes and indices in the buffer.
+fn mesh_json(b: &SceneBuilder, bin: &mut Bin, i: usize, mesh: &MeshDesc) -> Result<Value> {
+    let mut primitives = Vec::new();
+    for (k, (geometry, material)) in mesh.primitives.iter().enumerate() {
+        let element = format!("mesh {i} '{}' primitive {k}", mesh.name);
+        check_mesh(&element, geometry)?;
+        if material.0 >= b.materials.len() {
+            return Err(invalid(element, "material handle from another builder"));
         }
-        let mut m = json!({"primitives": primitives});
-        if !mesh.name.is_empty() {
-            m["name"] = json!(mesh.name);
-        }
-        meshes.push(m);
+        let attributes = attributes(bin, &element, geometry)?;
+        let indices = bin.indices(&geometry.triangles);
+        primitives.push(json!({
+            "attributes": attributes,
+            "indices": indices,
+            "material": material.0,
+            "mode": 4,
+        }));
     }
+    let mut m = json!({"primitives": primitives});
+    if !mesh.name.is_empty() {
+        m["name"] = json!(mesh.name);
+    }
+    Ok(m)
+}
 
-    let mut lights = Vec::new();
-    let mut cameras = Vec::new();
-    let mut nodes: Vec<Value> = Vec::new();
-    let mut roots = Vec::new();
+/// A primitive's vertex attributes as accessors: positions (with their bounds), and the
+/// normals, UVs, colours and tangents it has.
+fn attributes(bin: &mut Bin, element: &str, geometry: &Mesh) -> Result<Map<String, Value>> {
+    let mut attributes = Map::new();
+    let mut put = |name: &str, values: &[f32], components: usize, ty: &str, min_max: bool| {
+        let a = bin.floats(values, components, ty, min_max, Some(ARRAY_BUFFER));
+        attributes.insert(name.into(), json!(a));
+    };
+    let positions = bytemuck_vec3(&geometry.positions);
+    put("POSITION", &positions, 3, "VEC3", true);
+    if !geometry.normals.is_empty() {
+        let normals = bytemuck_vec3(&geometry.normals);
+        put("NORMAL", &normals, 3, "VEC3", false);
+    }
+    if !geometry.uvs.is_empty() {
+        let uv: Vec<f32> = geometry.uvs.iter().flat_map(|v| v.to_array()).collect();
+        check_finite(element, "uvs", &uv)?;
+        put("TEXCOORD_0", &uv, 2, "VEC2", false);
+    }
+    if !geometry.colors.is_empty() {
+        let c: Vec<f32> = geometry.colors.iter().flat_map(|v| v.to_array()).collect();
+        if let Some(i) = c.iter().position(|v| !(0.0..=1.0).contains(v)) {
+            return Err(invalid(
+                element,
+                format!("colors: component {i} is {} outside [0, 1]", c[i]),
+            ));
+        }
+        put("COLOR_0", &c, 4, "VEC4", false);
+    }
+    if !geometry.tangents.is_empty() {
+        let t: Vec<f32> = geometry
+            .tangents
+            .iter()
+            .flat_map(|v| v.to_array())
+            .collect();
+        check_finite(element, "tangents", &t)?;
+        put("TANGENT", &t, 4, "VEC4", false);
+    }
+    Ok(attributes)
+}
+
+/// The node graph: the nodes, the roots, and the lights and cameras the nodes refer to.
+struct Graph {
+    nodes: Vec<Value>,
+    roots: Vec<usize>,
+    lights: Vec<Value>,
+    cameras: Vec<Value>,
+}
+
+/// The nodes with their transforms, meshes, lights, cameras and children.
+fn graph(b: &SceneBuilder) -> Result<Graph> {
+    let mut g = Graph {
+        nodes: Vec::new(),
+        roots: Vec::new(),
+        lights: Vec::new(),
+        cameras: Vec::new(),
+    };
     for (i, n) in b.nodes.iter().enumerate() {
         let element = format!("node {i} '{}'", n.name);
-        let t = n.transform;
-        check_finite(
-            &element,
-            "transform",
-            &[
-                t.translation.x,
-                t.translation.y,
-                t.translation.z,
-                t.rotation.x,
-                t.rotation.y,
-                t.rotation.z,
-                t.rotation.w,
-                t.scale.x,
-                t.scale.y,
-                t.scale.z,
-            ],
-        )?;
-        let mut node = json!({"name": n.name});
-        if n.write_matrix {
-            let m = Mat4::from_scale_rotation_translation(
-                t.scale,
-                t.rotation.normalize(),
-                t.translation,
-            );
-            node["matrix"] = json!(m.to_cols_array());
-        } else {
-            node["translation"] = json!(t.translation.to_array());
-            node["rotation"] = json!(t.rotation.normalize().to_array());
-            node["scale"] = json!(t.scale.to_array());
-        }
+        let mut node = node_transform(&element, n)?;
         if let Some(mesh) = n.mesh {
             if mesh.0 >= b.meshes.len() {
                 return Err(invalid(element, "mesh handle from another builder"));
@@ -344,52 +389,17 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
             node["mesh"] = json!(mesh.0);
         }
         if let Some(l) = &n.light {
-            let mut light = json!({
-                "color": l.color.to_array(),
-                "intensity": l.intensity,
-            });
-            if !l.name.is_empty() {
-                light["name"] = json!(l.name);
-            }
-            match l.kind {
-                LightKind::Point => light["type"] = json!("point"),
-                LightKind::Directional => light["type"] = json!("directional"),
-                LightKind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                } => {
-                    light["type"] = json!("spot");
-                    light["spot"] = json!({
-                        "innerConeAngle": inner_cone_angle,
-                        "outerConeAngle": outer_cone_angle,
-                    });
-                }
-            }
-            if let Some(range) = l.range {
-                light["range"] = json!(range);
-            }
-            node["extensions"] = json!({"KHR_lights_punctual": {"light": lights.len()}});
-            lights.push(light);
+            node["extensions"] = json!({"KHR_lights_punctual": {"light": g.lights.len()}});
+            g.lights.push(light_json(l));
         }
         if let Some(c) = &n.camera {
-            let mut p = json!({"yfov": c.yfov, "znear": c.znear});
-            if let Some(a) = c.aspect_ratio {
-                p["aspectRatio"] = json!(a);
-            }
-            if let Some(f) = c.zfar {
-                p["zfar"] = json!(f);
-            }
-            let mut camera = json!({"type": "perspective", "perspective": p});
-            if !c.name.is_empty() {
-                camera["name"] = json!(c.name);
-            }
-            node["camera"] = json!(cameras.len());
-            cameras.push(camera);
+            node["camera"] = json!(g.cameras.len());
+            g.cameras.push(camera_json(c));
         }
         match n.parent {
-            None => roots.push(i),
+            None => g.roots.push(i),
             Some(p) if p.0 < i => {
-                let children = nodes[p.0]
+                let children = g.nodes[p.0]
                     .as_object_mut()
                     .expect("nodes are objects")
                     .entry("children")
@@ -406,14 +416,93 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
                 ));
             }
         }
-        nodes.push(node);
+        g.nodes.push(node);
     }
-    if !lights.is_empty() {
-        used.push("KHR_lights_punctual".to_owned());
-    }
+    Ok(g)
+}
 
+/// A node's name and transform: a matrix where the node asks for one, else translation,
+/// rotation and scale.
+fn node_transform(element: &str, n: &NodeDesc) -> Result<Value> {
+    let t = n.transform;
+    check_finite(
+        element,
+        "transform",
+        &[
+            t.translation.x,
+            t.translation.y,
+            t.translation.z,
+            t.rotation.x,
+            t.rotation.y,
+            t.rotation.z,
+            t.rotation.w,
+            t.scale.x,
+            t.scale.y,
+            t.scale.z,
+        ],
+    )?;
+    let mut node = json!({"name": n.name});
+    if n.write_matrix {
+        let m =
+            Mat4::from_scale_rotation_translation(t.scale, t.rotation.normalize(), t.translation);
+        node["matrix"] = json!(m.to_cols_array());
+    } else {
+        node["translation"] = json!(t.translation.to_array());
+        node["rotation"] = json!(t.rotation.normalize().to_array());
+        node["scale"] = json!(t.scale.to_array());
+    }
+    Ok(node)
+}
+
+/// A `KHR_lights_punctual` light.
+fn light_json(l: &LightDesc) -> Value {
+    let mut light = json!({
+        "color": l.color.to_array(),
+        "intensity": l.intensity,
+    });
+    if !l.name.is_empty() {
+        light["name"] = json!(l.name);
+    }
+    match l.kind {
+        LightKind::Point => light["type"] = json!("point"),
+        LightKind::Directional => light["type"] = json!("directional"),
+        LightKind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => {
+            light["type"] = json!("spot");
+            light["spot"] = json!({
+                "innerConeAngle": inner_cone_angle,
+                "outerConeAngle": outer_cone_angle,
+            });
+        }
+    }
+    if let Some(range) = l.range {
+        light["range"] = json!(range);
+    }
+    light
+}
+
+/// A perspective camera.
+fn camera_json(c: &CameraDesc) -> Value {
+    let mut p = json!({"yfov": c.yfov, "znear": c.znear});
+    if let Some(a) = c.aspect_ratio {
+        p["aspectRatio"] = json!(a);
+    }
+    if let Some(f) = c.zfar {
+        p["zfar"] = json!(f);
+    }
+    let mut camera = json!({"type": "perspective", "perspective": p});
+    if !c.name.is_empty() {
+        camera["name"] = json!(c.name);
+    }
+    camera
+}
+
+/// The animation's channels and samplers: one per track, its keys in the buffer.
+fn animations(b: &SceneBuilder, bin: &mut Bin) -> Result<(Vec<Value>, Vec<Value>)> {
     let mut channels = Vec::new();
-    let mut anim_samplers = Vec::new();
+    let mut samplers = Vec::new();
     for (k, (node, track)) in b.tracks.iter().enumerate() {
         let element = format!("track {k} (node {})", node.0);
         if node.0 >= b.nodes.len() {
@@ -423,67 +512,27 @@ fn document(b: &SceneBuilder) -> Result<(Map<String, Value>, Vec<u8>)> {
             TrackDesc::Translation(t) => (
                 "translation",
                 t.interpolation,
-                track_accessors(&mut bin, &element, t, 3, "VEC3", |v| v.to_array().to_vec())?,
+                track_accessors(bin, &element, t, 3, "VEC3", |v| v.to_array().to_vec())?,
             ),
             TrackDesc::Scale(t) => (
                 "scale",
                 t.interpolation,
-                track_accessors(&mut bin, &element, t, 3, "VEC3", |v| v.to_array().to_vec())?,
+                track_accessors(bin, &element, t, 3, "VEC3", |v| v.to_array().to_vec())?,
             ),
             TrackDesc::Rotation(t) => (
                 "rotation",
                 t.interpolation,
-                track_accessors(&mut bin, &element, t, 4, "VEC4", |v| v.to_array().to_vec())?,
+                track_accessors(bin, &element, t, 4, "VEC4", |v| v.to_array().to_vec())?,
             ),
         };
-        channels.push(
-            json!({"sampler": anim_samplers.len(), "target": {"node": node.0, "path": path}}),
-        );
-        anim_samplers.push(json!({
+        channels.push(json!({"sampler": samplers.len(), "target": {"node": node.0, "path": path}}));
+        samplers.push(json!({
             "input": input,
             "output": output,
             "interpolation": interpolation_name(interpolation),
         }));
     }
-
-    bin.align();
-    let mut root = Map::new();
-    root.insert(
-        "asset".into(),
-        json!({"version": "2.0", "generator": "plenoptic_scene builder"}),
-    );
-    root.insert("scene".into(), json!(0));
-    root.insert("scenes".into(), json!([{"nodes": roots}]));
-    root.insert("nodes".into(), Value::Array(nodes));
-    let mut put = |key: &str, v: Vec<Value>| {
-        if !v.is_empty() {
-            root.insert(key.into(), Value::Array(v));
-        }
-    };
-    put("meshes", meshes);
-    put("materials", materials);
-    put("images", images);
-    put("textures", textures);
-    put("samplers", samplers);
-    put("cameras", cameras);
-    put("accessors", bin.accessors);
-    put("bufferViews", bin.views);
-    if !channels.is_empty() {
-        put(
-            "animations",
-            vec![json!({"name": "animation", "channels": channels, "samplers": anim_samplers})],
-        );
-    }
-    if !lights.is_empty() {
-        root.insert(
-            "extensions".into(),
-            json!({"KHR_lights_punctual": {"lights": lights}}),
-        );
-    }
-    if !used.is_empty() {
-        root.insert("extensionsUsed".into(), json!(used));
-    }
-    Ok((root, bin.data))
+    Ok((channels, samplers))
 }
 
 /// Binary glTF: 12-byte header, JSON chunk padded with spaces, BIN chunk padded with zeros.
