@@ -38,7 +38,7 @@ use rayon::prelude::*;
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Report};
 use crate::lookup::{FastKey, NO_SLOT, PackedTexels, Scratch, Shade};
-use crate::proxy::GeometryMask;
+use crate::proxy::{GeometryMask, ProxyGeometry};
 use crate::reconstructor::{CubeFilter, KeyCubes, Reconstructor};
 use crate::shading::Channel;
 use crate::temporal::bracketing;
@@ -165,107 +165,22 @@ pub(crate) fn render_pair(
     pass: Pass<'_>,
     report: &mut Report,
 ) -> Result<PairFrame> {
-    let Pass {
-        layer,
-        channel,
-        skip,
-        filter,
-        second,
-        environment,
-        sparse,
-    } = pass;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
         return Err(Error::Unusable("no proxy geometry".into()));
     };
-    let manifest = rec.pack().manifest();
     let views = rec.view_weights(camera.position);
     let ids = proxy.object_ids();
     let slot_of = SlotMap::new(ids);
-    let skipped: Vec<bool> = ids.iter().map(|o| skip.contains(o)).collect();
-    let inv_now: Vec<Affine3A> = ids
-        .iter()
-        .map(|&o| proxy.transform(o, t).inverse())
-        .collect();
-    let mut keys: Vec<ViewKey> = Vec::new();
-    let mut volumes: Vec<(Vec3, f32, VolumeIndex)> = Vec::new();
-    for &(v, w) in &views {
-        let bv = &manifest.base_views[v];
-        let Some((k0, k1, s)) = bracketing(&bv.time_keys, t) else {
-            continue;
-        };
-        let mut pairs = vec![(k0, 1.0 - s)];
-        if k1 != k0 {
-            pairs.push((k1, s));
-        }
-        // A key's cubes, and its second channel's cube of the same size.
-        let mut read = |k: usize| {
-            let c = rec.key_cubes_in(v, k, channel, &mut report.missing)?;
-            let Some(ch) = second else {
-                return Some((c, None));
-            };
-            let s = rec.key_cubes_in(v, k, ch, &mut report.missing)?.radiance;
-            (s.face_size == c.ids.face_size).then_some((c, Some(s)))
-        };
-        let mut got = Vec::new();
-        for (k, wt) in pairs {
-            if let Some(c) = read(k) {
-                got.push((k, wt, c));
-            }
-        }
-        if got.is_empty() {
-            // Both bracketing keys unreadable: try the nearest readable key.
-            let mut order: Vec<usize> = (0..bv.time_keys.len()).collect();
-            order.sort_by(|&a, &b| {
-                (bv.time_keys[a] - t)
-                    .abs()
-                    .total_cmp(&(bv.time_keys[b] - t).abs())
-            });
-            if let Some((k, c)) = order
-                .into_iter()
-                .filter(|&k| k != k0 && k != k1)
-                .take(2)
-                .find_map(|k| read(k).map(|c| (k, c)))
-            {
-                got.push((k, 1.0, c));
-            }
-        }
-        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
-        for (k, wt, (c, second)) in got {
-            let tau = bv.time_keys[k];
-            let motion = ids
-                .iter()
-                .zip(&inv_now)
-                .map(|(&o, inv)| proxy.transform(o, tau) * *inv)
-                .collect();
-            keys.push(ViewKey {
-                view: v,
-                key: k,
-                base: bv.position,
-                weight: w * wt / total,
-                packed: rec.packed_texels(v, k, channel, &c),
-                cubes: c,
-                second,
-                motion,
-            });
-        }
-        if let Some(index) = VolumeIndex::build(rec, v, t, channel, &mut report.missing) {
-            volumes.push((bv.position, w, index));
-        }
-    }
-    if keys.is_empty() {
-        return Err(Error::Unusable(format!(
-            "no readable range image near t = {t}: {}",
-            report.missing.join("; ")
-        )));
-    }
+    let skipped: Vec<bool> = ids.iter().map(|o| pass.skip.contains(o)).collect();
+    let (keys, volumes) = read_keys(rec, proxy, &views, t, pass, report)?;
     report.base_views = views;
     report.stage_ms.push(("setup".into(), ms(start)));
     let start = Instant::now();
     // The mask: rasterized band by band inside the pixel loop, or given (computed
     // beforehand, e.g. ray cast by plenoptic_eval).
     let source = match mask {
-        None => MaskSource::Raster(match layer {
+        None => MaskSource::Raster(match pass.layer {
             Layer::All => proxy.project(camera, t),
             Layer::Without(ids) => proxy.project_only(camera, t, |o| !ids.contains(&o)),
             Layer::Only(ids) => proxy.project_only(camera, t, |o| ids.contains(&o)),
@@ -274,48 +189,10 @@ pub(crate) fn render_pair(
     };
     report.stage_ms.push(("mask_setup".into(), ms(start)));
     let start = Instant::now();
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    // The frame, filled in parallel (the first touch of its pages is a good part of the cost).
-    let n = w * h;
-    let mut frame = Frame {
-        width: camera.width,
-        height: camera.height,
-        radiance: Vec::with_capacity(n),
-        depth: Vec::with_capacity(n),
-        object: Vec::with_capacity(n),
-    };
-    frame
-        .radiance
-        .par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
-    frame
-        .depth
-        .par_extend(rayon::iter::repeat_n(f32::INFINITY, n));
-    frame.object.par_extend(rayon::iter::repeat_n(0, n));
-    let mut plane2: Vec<Vec3> = Vec::new();
-    if second.is_some() {
-        plane2.par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
-    }
-    // Flat views of the cubes for the pixel loop; keys of negligible weight are skipped.
-    let mut fast: Vec<FastKey<'_>> = keys
-        .iter()
-        .filter(|k| k.weight > 1e-4)
-        .map(|k| {
-            let second = k.second.as_deref();
-            FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &k.motion)
-        })
-        .collect();
-    for i in 0..fast.len() {
-        let reuse = (0..ids.len())
-            .map(|s| {
-                i > 0
-                    && fast[i - 1].base == fast[i].base
-                    && fast[i - 1].face == fast[i].face
-                    && fast[i - 1].motion[s] == fast[i].motion[s]
-            })
-            .collect();
-        fast[i].reuse = reuse;
-    }
-    let mut class = vec![HOLE; w * h];
+    let (mut frame, mut plane2) = blank_frame(camera, pass.second.is_some());
+    let fast = fast_keys(&keys, ids.len());
+    let w = camera.width as usize;
+    let mut class = vec![HOLE; frame.radiance.len()];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
     let power = rec.settings.angular_power;
@@ -324,20 +201,11 @@ pub(crate) fn render_pair(
     } else {
         0
     };
-    // The environment lookup uses the heaviest key.
-    let (env_channel, env_filter) = environment.unwrap_or((channel, filter));
-    let env = keys
-        .iter()
-        .max_by(|a, b| a.weight.total_cmp(&b.weight))
-        .and_then(|k| {
-            if env_channel == channel {
-                return Some(k.cubes.radiance.clone());
-            }
-            rec.key_cubes_in(k.view, k.key, env_channel, &mut report.missing)
-                .map(|c| c.radiance)
-        });
-    let env_bilinear = env_filter == CubeFilter::Bilinear;
-    let bilinear = filter == CubeFilter::Bilinear;
+    let env = environment(rec, &keys, pass, report);
+    let (env_filter, bilinear) = (
+        pass.environment.map_or(pass.filter, |e| e.1),
+        pass.filter == CubeFilter::Bilinear,
+    );
     let shade = Shade {
         fast: &fast,
         tol,
@@ -345,20 +213,20 @@ pub(crate) fn render_pair(
         power_int,
         bilinear,
     };
-    let band = ROWS * w.max(1);
     let rows = Rows {
         basis: &basis,
         source: &source,
         slot_of: &slot_of,
         skipped: &skipped,
         env: env.as_deref(),
-        env_bilinear,
+        env_bilinear: env_filter == CubeFilter::Bilinear,
         width: w,
     };
+    let band = ROWS * w.max(1);
     // Sparse: the anchors' lookups first, at half resolution (sparse.rs), the mask
     // rasterized on the way (its depths become distances along the rays).
     let sparse = match &source {
-        MaskSource::Raster(tris) if sparse && fast.len() <= 16 => Some(tris),
+        MaskSource::Raster(tris) if pass.sparse && fast.len() <= 16 => Some(tris),
         _ => None,
     };
     let mut prims: Vec<u32> = Vec::new();
@@ -371,84 +239,12 @@ pub(crate) fn render_pair(
         };
         pass.run(&mut frame.depth, &mut frame.object, &mut prims)
     });
-    let interpolated = AtomicUsize::new(0);
-    // The second colour's band, where there is one.
-    let bands2 = if second.is_some() {
-        Either::Left(plane2.par_chunks_mut(band).map(Some))
-    } else {
-        Either::Right((0..n.div_ceil(band)).into_par_iter().map(|_| None))
+    let lookups = Lookups {
+        rows: &rows,
+        shade: &shade,
+        anchors: anchors.as_ref(),
     };
-    frame
-        .radiance
-        .par_chunks_mut(band)
-        .zip(frame.depth.par_chunks_mut(band))
-        .zip(frame.object.par_chunks_mut(band))
-        .zip(class.par_chunks_mut(band))
-        .zip(bands2)
-        .enumerate()
-        .for_each_init(
-            || (Scratch::default(), Scratch::default(), Vec::new()),
-            |(s, packed, xs), (i, ((((rad, dep), obj), cls), mut rad2))| {
-                let y0 = i * ROWS;
-                if let (MaskSource::Raster(tris), None) = (&source, &anchors) {
-                    // Camera-space depth into `dep`, object into `obj`.
-                    crate::raster::raster_band(tris, w, y0, dep, obj, None);
-                }
-                let mut between_count = 0;
-                let lines = rad
-                    .chunks_mut(w)
-                    .zip(dep.chunks_mut(w))
-                    .zip(obj.chunks_mut(w))
-                    .zip(cls.chunks_mut(w));
-                for (r, (((rad, dep), obj), cls)) in lines.enumerate() {
-                    let y = y0 + r;
-                    let mut row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
-                    if anchors.is_some() {
-                        s.slot.resize(w, NO_SLOT);
-                        rows.slots(&mut s.slot, y, obj, Some((rad, cls)));
-                    } else {
-                        rows.prepare(s, y, dep, obj, Some((rad, cls)));
-                    }
-                    // Each pixel's lookup, or the anchors' where they stand for it.
-                    xs.clear();
-                    for x in (0..w).filter(|&x| s.slot[x] != NO_SLOT) {
-                        let between = anchors
-                            .as_ref()
-                            .and_then(|a| a.interpolate(x, y, obj[x], dep[x], tol));
-                        match between {
-                            Some((c, c2)) => {
-                                // The anchors themselves are looked up, not interpolated.
-                                between_count += usize::from(x % 2 == 1 || y % 2 == 1);
-                                rad[x] = c;
-                                if let Some(row2) = row2.as_deref_mut() {
-                                    row2[x] = c2;
-                                }
-                                cls[x] = DIRECT;
-                            }
-                            None => xs.push(x),
-                        }
-                    }
-                    let lanes = if anchors.is_some() && !xs.is_empty() {
-                        packed.gather_rays(&basis, y, xs, dep, &s.slot);
-                        &mut *packed
-                    } else {
-                        &mut *s
-                    };
-                    lookup_some(&shade, lanes, anchors.is_some(), xs, obj, |_, x, c, c2| {
-                        if c.w > 0.0 {
-                            rad[x] = c.truncate() / c.w;
-                            if let Some(row2) = row2.as_deref_mut() {
-                                row2[x] = c2 / c.w;
-                            }
-                            cls[x] = DIRECT;
-                        } else {
-                            cls[x] = HOLE;
-                        }
-                    });
-                }
-                interpolated.fetch_add(between_count, Ordering::Relaxed);
-            },
-        );
+    let interpolated = lookups.run(&mut frame, &mut plane2, &mut class);
     report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
     let start = Instant::now();
     // The hit point of a pixel (for the fallbacks), as the pixel loop computed it.
@@ -460,33 +256,12 @@ pub(crate) fn render_pair(
             basis.position + dir * depth[j]
         }
     };
-    // Volume fallback where no lookup was accepted.
-    let misses: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
-    if !volumes.is_empty() && !misses.is_empty() {
-        let found: Vec<(usize, Vec3, Vec3)> = misses
-            .par_iter()
-            .filter_map(|&j| {
-                let (p, o) = (point(j), frame.object[j]);
-                let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-                for (base, w, index) in &volumes {
-                    // Both colours of the same samples, with the same weights.
-                    if let Some((c, c2, wt)) = index.lookup_pair(p - *base, o, tol * 3.0, second) {
-                        vs += c * wt * *w;
-                        vs2 += c2 * wt * *w;
-                        vw += wt * *w;
-                    }
-                }
-                (vw > 0.0).then(|| (j, vs / vw, vs2 / vw))
-            })
-            .collect();
-        for (j, c, c2) in found {
-            frame.radiance[j] = c;
-            if let Some(x) = plane2.get_mut(j) {
-                *x = c2;
-            }
-            class[j] = VOLUME;
-        }
-    }
+    let fallback = VolumeFallback {
+        volumes: &volumes,
+        tol,
+        second: pass.second,
+    };
+    fallback.run(&point, &mut frame, &mut plane2, &mut class);
     report.stage_ms.push(("volume".into(), ms(start)));
     let start = Instant::now();
     let slot = |o: u32| slot_of.get(o);
@@ -513,8 +288,390 @@ pub(crate) fn render_pair(
         second: plane2,
         environment: env.is_some(),
         triangles,
-        interpolated: interpolated.into_inner(),
+        interpolated,
     })
+}
+
+/// A base view's temporal volume: its position, its view-space weight and its index.
+type ViewVolume = (Vec3, f32, VolumeIndex);
+
+/// The keys of the weighted base `views` at `t` with their cubes and motions, and the views'
+/// temporal volumes; an error where no key can be read.
+fn read_keys(
+    rec: &Reconstructor,
+    proxy: &ProxyGeometry,
+    views: &[(usize, f32)],
+    t: f32,
+    pass: Pass<'_>,
+    report: &mut Report,
+) -> Result<(Vec<ViewKey>, Vec<ViewVolume>)> {
+    let ids = proxy.object_ids();
+    let inv_now: Vec<Affine3A> = ids
+        .iter()
+        .map(|&o| proxy.transform(o, t).inverse())
+        .collect();
+    let manifest = rec.pack().manifest();
+    let mut keys: Vec<ViewKey> = Vec::new();
+    let mut volumes: Vec<ViewVolume> = Vec::new();
+    for &(v, w) in views {
+        let bv = &manifest.base_views[v];
+        let Some(got) = view_keys(rec, v, t, pass, report) else {
+            continue;
+        };
+        let total: f32 = got.iter().map(|g| g.1).sum::<f32>().max(1e-9);
+        for (k, wt, (c, second)) in got {
+            let tau = bv.time_keys[k];
+            let motion = ids
+                .iter()
+                .zip(&inv_now)
+                .map(|(&o, inv)| proxy.transform(o, tau) * *inv)
+                .collect();
+            keys.push(ViewKey {
+                view: v,
+                key: k,
+                base: bv.position,
+                weight: w * wt / total,
+                packed: rec.packed_texels(v, k, pass.channel, &c),
+                cubes: c,
+                second,
+                motion,
+            });
+        }
+        if let Some(index) = VolumeIndex::build(rec, v, t, pass.channel, &mut report.missing) {
+            volumes.push((bv.position, w, index));
+        }
+    }
+    if keys.is_empty() {
+        return Err(Error::Unusable(format!(
+            "no readable range image near t = {t}: {}",
+            report.missing.join("; ")
+        )));
+    }
+    Ok((keys, volumes))
+}
+
+/// A key's cubes of the pass's channel, and its second channel's cube.
+type KeyRead = (KeyCubes, Option<Arc<CubeImage<Vec3>>>);
+
+/// Base view `v`'s readable keys at `t` with their time weights (not normalised): the
+/// bracketing keys, or where neither can be read the nearest readable key; `None` where no
+/// keys bracket `t`.
+fn view_keys(
+    rec: &Reconstructor,
+    v: usize,
+    t: f32,
+    pass: Pass<'_>,
+    report: &mut Report,
+) -> Option<Vec<(usize, f32, KeyRead)>> {
+    let bv = &rec.pack().manifest().base_views[v];
+    let (k0, k1, s) = bracketing(&bv.time_keys, t)?;
+    let mut pairs = vec![(k0, 1.0 - s)];
+    if k1 != k0 {
+        pairs.push((k1, s));
+    }
+    // A key's cubes, and its second channel's cube of the same size.
+    let mut read = |k: usize| {
+        let c = rec.key_cubes_in(v, k, pass.channel, &mut report.missing)?;
+        let Some(ch) = pass.second else {
+            return Some((c, None));
+        };
+        let s = rec.key_cubes_in(v, k, ch, &mut report.missing)?.radiance;
+        (s.face_size == c.ids.face_size).then_some((c, Some(s)))
+    };
+    let mut got = Vec::new();
+    for (k, wt) in pairs {
+        if let Some(c) = read(k) {
+            got.push((k, wt, c));
+        }
+    }
+    if got.is_empty() {
+        // Both bracketing keys unreadable: try the nearest readable key.
+        let mut order: Vec<usize> = (0..bv.time_keys.len()).collect();
+        order.sort_by(|&a, &b| {
+            (bv.time_keys[a] - t)
+                .abs()
+                .total_cmp(&(bv.time_keys[b] - t).abs())
+        });
+        if let Some((k, c)) = order
+            .into_iter()
+            .filter(|&k| k != k0 && k != k1)
+            .take(2)
+            .find_map(|k| read(k).map(|c| (k, c)))
+        {
+            got.push((k, 1.0, c));
+        }
+    }
+    Some(got)
+}
+
+/// The frame and the second colour's plane, cleared: black, at infinite depth, no object.
+/// They are filled in parallel (the first touch of their pages is a good part of the cost).
+fn blank_frame(camera: &Camera, second: bool) -> (Frame, Vec<Vec3>) {
+    let n = camera.width as usize * camera.height as usize;
+    let mut frame = Frame {
+        width: camera.width,
+        height: camera.height,
+        radiance: Vec::with_capacity(n),
+        depth: Vec::with_capacity(n),
+        object: Vec::with_capacity(n),
+    };
+    frame
+        .radiance
+        .par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
+    frame
+        .depth
+        .par_extend(rayon::iter::repeat_n(f32::INFINITY, n));
+    frame.object.par_extend(rayon::iter::repeat_n(0, n));
+    let mut plane2: Vec<Vec3> = Vec::new();
+    if second {
+        plane2.par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
+    }
+    (frame, plane2)
+}
+
+/// Flat views of the keys' cubes for the pixel loop, keys of negligible weight skipped;
+/// each marks the object slots whose lookup it shares with the key before it.
+fn fast_keys(keys: &[ViewKey], slots: usize) -> Vec<FastKey<'_>> {
+    let mut fast: Vec<FastKey<'_>> = keys
+        .iter()
+        .filter(|k| k.weight > 1e-4)
+        .map(|k| {
+            let second = k.second.as_deref();
+            FastKey::new(k.base, k.weight, &k.cubes, &k.packed, second, &k.motion)
+        })
+        .collect();
+    for i in 0..fast.len() {
+        let reuse = (0..slots)
+            .map(|s| {
+                i > 0
+                    && fast[i - 1].base == fast[i].base
+                    && fast[i - 1].face == fast[i].face
+                    && fast[i - 1].motion[s] == fast[i].motion[s]
+            })
+            .collect();
+        fast[i].reuse = reuse;
+    }
+    fast
+}
+
+/// The environment's cube, where no proxy is: the heaviest key's, of the pass's environment
+/// channel.
+fn environment(
+    rec: &Reconstructor,
+    keys: &[ViewKey],
+    pass: Pass<'_>,
+    report: &mut Report,
+) -> Option<Arc<CubeImage<Vec3>>> {
+    let env_channel = pass.environment.map_or(pass.channel, |e| e.0);
+    keys.iter()
+        .max_by(|a, b| a.weight.total_cmp(&b.weight))
+        .and_then(|k| {
+            if env_channel == pass.channel {
+                return Some(k.cubes.radiance.clone());
+            }
+            rec.key_cubes_in(k.view, k.key, env_channel, &mut report.missing)
+                .map(|c| c.radiance)
+        })
+}
+
+/// The pixel loop: parallel over bands of [`ROWS`] rows, each band's mask rasterized (unless
+/// the anchors' pass did) and then looked up a row at a time while it is in cache.
+struct Lookups<'a> {
+    rows: &'a Rows<'a>,
+    shade: &'a Shade<'a>,
+    /// The anchors' lookups of a sparse pass.
+    anchors: Option<&'a sparse::Anchors>,
+}
+
+/// One band of the frame's planes.
+struct Band<'b> {
+    /// Index of the band.
+    index: usize,
+    rad: &'b mut [Vec3],
+    dep: &'b mut [f32],
+    obj: &'b mut [u32],
+    cls: &'b mut [u8],
+    /// The second colour, where there is one.
+    rad2: Option<&'b mut [Vec3]>,
+}
+
+/// What a worker of the pixel loop keeps between bands: the row's scratch, the gathered
+/// pixels' scratch, and the pixels to look up.
+type Workspace = (Scratch, Scratch, Vec<usize>);
+
+impl Lookups<'_> {
+    /// Looks up every pixel of `frame` (and `plane2`, where not empty), classing each in
+    /// `class`; returns how many took their anchors' mean.
+    fn run(&self, frame: &mut Frame, plane2: &mut [Vec3], class: &mut [u8]) -> usize {
+        let w = self.rows.width;
+        let band = ROWS * w.max(1);
+        let n = frame.radiance.len();
+        let interpolated = AtomicUsize::new(0);
+        // The second colour's band, where there is one.
+        let bands2 = if !plane2.is_empty() {
+            Either::Left(plane2.par_chunks_mut(band).map(Some))
+        } else {
+            Either::Right((0..n.div_ceil(band)).into_par_iter().map(|_| None))
+        };
+        frame
+            .radiance
+            .par_chunks_mut(band)
+            .zip(frame.depth.par_chunks_mut(band))
+            .zip(frame.object.par_chunks_mut(band))
+            .zip(class.par_chunks_mut(band))
+            .zip(bands2)
+            .enumerate()
+            .for_each_init(
+                || (Scratch::default(), Scratch::default(), Vec::new()),
+                |work, (index, ((((rad, dep), obj), cls), rad2))| {
+                    let band = Band {
+                        index,
+                        rad,
+                        dep,
+                        obj,
+                        cls,
+                        rad2,
+                    };
+                    let between = self.band(work, band);
+                    interpolated.fetch_add(between, Ordering::Relaxed);
+                },
+            );
+        interpolated.into_inner()
+    }
+
+    /// Rasterizes (where needed) and looks up one band; returns how many of its pixels took
+    /// their anchors' mean.
+    fn band(&self, work: &mut Workspace, b: Band<'_>) -> usize {
+        let w = self.rows.width;
+        let y0 = b.index * ROWS;
+        if let (MaskSource::Raster(tris), None) = (self.rows.source, &self.anchors) {
+            // Camera-space depth into `dep`, object into `obj`.
+            crate::raster::raster_band(tris, w, y0, b.dep, b.obj, None);
+        }
+        let mut between_count = 0;
+        let mut rad2 = b.rad2;
+        let lines = b
+            .rad
+            .chunks_mut(w)
+            .zip(b.dep.chunks_mut(w))
+            .zip(b.obj.chunks_mut(w))
+            .zip(b.cls.chunks_mut(w));
+        for (r, (((rad, dep), obj), cls)) in lines.enumerate() {
+            let row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
+            between_count += self.row(work, y0 + r, rad, dep, obj, cls, row2);
+        }
+        between_count
+    }
+
+    /// Looks up row `y`: each pixel's lookup, or its anchors' mean where they stand for it;
+    /// returns how many took the anchors' mean.
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the row's planes, each borrowed apart"
+    )]
+    fn row(
+        &self,
+        (s, packed, xs): &mut Workspace,
+        y: usize,
+        rad: &mut [Vec3],
+        dep: &mut [f32],
+        obj: &mut [u32],
+        cls: &mut [u8],
+        mut row2: Option<&mut [Vec3]>,
+    ) -> usize {
+        let (w, tol, anchors) = (self.rows.width, self.shade.tol, self.anchors);
+        if anchors.is_some() {
+            s.slot.resize(w, NO_SLOT);
+            self.rows.slots(&mut s.slot, y, obj, Some((rad, cls)));
+        } else {
+            self.rows.prepare(s, y, dep, obj, Some((rad, cls)));
+        }
+        let mut between_count = 0;
+        xs.clear();
+        for x in (0..w).filter(|&x| s.slot[x] != NO_SLOT) {
+            let between = anchors.and_then(|a| a.interpolate(x, y, obj[x], dep[x], tol));
+            match between {
+                Some((c, c2)) => {
+                    // The anchors themselves are looked up, not interpolated.
+                    between_count += usize::from(x % 2 == 1 || y % 2 == 1);
+                    rad[x] = c;
+                    if let Some(row2) = row2.as_deref_mut() {
+                        row2[x] = c2;
+                    }
+                    cls[x] = DIRECT;
+                }
+                None => xs.push(x),
+            }
+        }
+        let gathered = anchors.is_some();
+        let lanes = if gathered && !xs.is_empty() {
+            packed.gather_rays(self.rows.basis, y, xs, dep, &s.slot);
+            packed
+        } else {
+            s
+        };
+        lookup_some(self.shade, lanes, gathered, xs, obj, |_, x, c, c2| {
+            if c.w > 0.0 {
+                rad[x] = c.truncate() / c.w;
+                if let Some(row2) = row2.as_deref_mut() {
+                    row2[x] = c2 / c.w;
+                }
+                cls[x] = DIRECT;
+            } else {
+                cls[x] = HOLE;
+            }
+        });
+        between_count
+    }
+}
+
+/// The temporal-volume fallback where no lookup was accepted.
+struct VolumeFallback<'a> {
+    volumes: &'a [ViewVolume],
+    /// The relative depth tolerance of the lookups.
+    tol: f32,
+    /// The pass's second channel.
+    second: Option<Channel>,
+}
+
+impl VolumeFallback<'_> {
+    /// Fills the pixels of `class` [`HOLE`] that the volumes' samples of the same object near
+    /// their `point` answer, both colours with the same samples and weights.
+    fn run(
+        &self,
+        point: &(impl Fn(usize) -> Vec3 + Sync),
+        frame: &mut Frame,
+        plane2: &mut [Vec3],
+        class: &mut [u8],
+    ) {
+        let misses: Vec<usize> = (0..class.len()).filter(|&j| class[j] == HOLE).collect();
+        if self.volumes.is_empty() || misses.is_empty() {
+            return;
+        }
+        let found: Vec<(usize, Vec3, Vec3)> = misses
+            .par_iter()
+            .filter_map(|&j| {
+                let (p, o) = (point(j), frame.object[j]);
+                let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
+                for (base, w, index) in self.volumes {
+                    let near = index.lookup_pair(p - *base, o, self.tol * 3.0, self.second);
+                    if let Some((c, c2, wt)) = near {
+                        vs += c * wt * *w;
+                        vs2 += c2 * wt * *w;
+                        vw += wt * *w;
+                    }
+                }
+                (vw > 0.0).then(|| (j, vs / vw, vs2 / vw))
+            })
+            .collect();
+        for (j, c, c2) in found {
+            frame.radiance[j] = c;
+            if let Some(x) = plane2.get_mut(j) {
+                *x = c2;
+            }
+            class[j] = VOLUME;
+        }
+    }
 }
 
 /// Rows per band of the pixel loop (a band is rasterized, then shaded, while in cache).

@@ -41,6 +41,7 @@
 //! non-diffuse cube, at cube resolution, except on marched surfaces.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
 
 use glam::Vec3;
 use plenoptic_pack::{ChunkKind, VolumeSample};
@@ -50,10 +51,11 @@ use crate::brdf::{Bsdf, DELTA_ROUGHNESS};
 use crate::camera::Camera;
 use crate::frame::{Frame, Report};
 use crate::geometry::{self, Layer, Pass};
-use crate::proxy::GeometryMask;
+use crate::proxy::{GeometryMask, ProxyGeometry};
 use crate::settings::{CubeFilter, Shading};
 use crate::specular::{self, Reflections};
-use crate::surface::{SharedRaster, SurfacePixel, Surfaces};
+use crate::sun::PlacedSun;
+use crate::surface::{PixelGeometry, SharedRaster, SurfacePixel, Surfaces};
 use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
@@ -106,114 +108,272 @@ pub(crate) fn render(
     layer: Layer<'_>,
     report: &mut Report,
 ) -> Result<Frame> {
-    let materials = rec.materials();
-    let radiance_only = |report: &mut Report| {
-        let pass = Pass::radiance(layer, rec.settings.cube_filter);
-        geometry::render(rec, camera, t, mask, pass, report)
-    };
-    let proxy = match rec.proxy() {
-        Some(p) if rec.settings.shading == Shading::Materials && !materials.is_empty() => p,
-        _ => return radiance_only(report),
-    };
-    let ids = proxy.object_ids();
-    let (lit, unlit): (Vec<u32>, Vec<u32>) =
-        ids.iter().partition(|&&o| materials.object(o).is_some());
-    // The lighting is smooth and at cube resolution: always filtered (seam-aware bilinear,
-    // restricted to texels of the same object and distance), whatever the radiance uses.
-    let pass = |channel, skip| Pass {
-        layer,
-        channel,
-        skip,
-        second: None,
-        environment: None,
-        sparse: false,
-        filter: if channel == Channel::Radiance {
-            rec.settings.cube_filter
-        } else {
-            CubeFilter::Bilinear
-        },
-    };
-    // The lighting and the non-diffuse radiance in one pass (the same lookups, weights and
-    // fallbacks for both). A pack v2 always has them; a damaged one is shown from its
-    // radiance instead.
-    let mut stages = Vec::new();
-    let mut side = Report::default();
-    let start = std::time::Instant::now();
-    // Where every object has a material, the radiance pass would only show the environment:
-    // this pass looks it up instead, in the radiance cube as that pass would.
-    let all_lit = unlit.is_empty();
-    let fused = Pass {
-        second: Some(Channel::NonDiffuse),
-        environment: all_lit.then_some((Channel::Radiance, rec.settings.cube_filter)),
-        sparse: rec.settings.sparse_lighting,
-        ..pass(Channel::Lighting, &unlit)
-    };
-    let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
-    stages.push((
-        "lighting_pass".to_string(),
-        start.elapsed().as_secs_f64() * 1e3,
-    ));
-    let (lighting, non_diffuse, environment, triangles) = match both {
-        Ok(pair) => {
-            report.interpolated_pixels += pair.interpolated;
-            (pair.frame, pair.second, pair.environment, pair.triangles)
-        }
-        Err(e) => {
-            report.missing.push(format!("materials not applied: {e}"));
-            return radiance_only(report);
-        }
-    };
-    let start = std::time::Instant::now();
-    // The lighting per pixel apart from the frame, or (`None`) in the frame itself: where
-    // every object has a material the lighting pass's frame becomes the frame, its pixels
-    // shaded in place (each read before it is written), the environment where nothing is and
-    // black on objects left unshaded, as the radiance pass would leave them.
-    let (mut frame, lighting, triangles) = if all_lit && environment {
-        report.base_views = side.base_views.clone();
-        (lighting, None, triangles)
-    } else {
-        let frame = geometry::render(rec, camera, t, mask, pass(Channel::Radiance, &lit), report)?;
-        // The same proxies rasterized the same way: the same objects per pixel.
-        debug_assert_eq!(frame.object, lighting.object);
-        (frame, Some(lighting.radiance), None)
-    };
-    stages.push((
-        "radiance_pass".to_string(),
-        start.elapsed().as_secs_f64() * 1e3,
-    ));
-    let mut timed = |name: &str, start: std::time::Instant| {
-        stages.push((name.to_string(), start.elapsed().as_secs_f64() * 1e3));
-    };
-    let start = std::time::Instant::now();
-    let sun = rec.runtime_sun().zip(rec.proxy_rays()).map(|(s, shadows)| {
-        let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
-        s.at(shadows, proxy, t, rays)
-    });
-    let glossy = specular::glossy_allowed(rec);
-    let runtime_emission = rec.pack().runtime_emission();
-    let with_footprint = sun.is_some();
-    let surfaces = Surfaces::new(
+    let shot = Shot {
         rec,
-        proxy,
-        materials,
         camera,
         t,
+        mask,
         layer,
-        with_footprint,
-        glossy,
-        // The lighting pass's raster where it made one with triangles and its frame is this
-        // one: the same proxies and pixels.
-        triangles.map(|(projected, prim)| SharedRaster {
-            projected,
-            prim,
-            object: &frame.object,
-            depth: &frame.depth,
-        }),
-    );
-    let (marched_pixels, unanswered) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    // Pixel `j` of surface `px` under `light`; its reflection marched through `reflections`
-    // where it is marched.
-    let shade = |j: usize, px: &SurfacePixel, light: Vec3, reflections: Option<&Reflections>| {
+    };
+    let materials = rec.materials();
+    let proxy = match rec.proxy() {
+        Some(p) if rec.settings.shading == Shading::Materials && !materials.is_empty() => p,
+        _ => return shot.radiance_only(report),
+    };
+    let mut stages = Vec::new();
+    let Some(passes) = shot.passes(proxy, report, &mut stages)? else {
+        return shot.radiance_only(report);
+    };
+    let Passes {
+        mut frame,
+        lit,
+        side,
+    } = passes;
+    let raster_ms = shot.shade(proxy, &mut frame, lit, report, &mut stages);
+    report.fallback = side.fallback;
+    for m in side.missing.into_iter().chain(materials.messages()) {
+        if !report.missing.contains(&m) {
+            report.missing.push(m);
+        }
+    }
+    stages.push(("albedo_raster".to_string(), raster_ms));
+    report.stage_ms = stages;
+    Ok(frame)
+}
+
+/// The frame a geometry-assisted render makes: the camera, the time, the mask computed
+/// beforehand if any, and the proxies rasterized.
+struct Shot<'a> {
+    rec: &'a Reconstructor,
+    camera: &'a Camera,
+    t: f32,
+    mask: Option<&'a GeometryMask>,
+    layer: Layer<'a>,
+}
+
+/// The geometry passes' results that the materials shade.
+struct Passes {
+    /// The frame: the radiance pass's, or the lighting pass's where it is the frame.
+    frame: Frame,
+    lit: Lit,
+    /// The lighting pass's report.
+    side: Report,
+}
+
+/// The lighting pass's colours per pixel.
+struct Lit {
+    /// The lighting apart from the frame, or (`None`) in the frame itself.
+    lighting: Option<Vec<Vec3>>,
+    non_diffuse: Vec<Vec3>,
+    /// The lighting pass's raster, where it made one with triangles and its frame is the
+    /// frame.
+    triangles: Option<(crate::raster::Projected, Vec<u32>)>,
+}
+
+/// Milliseconds since `start`.
+fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+impl Shot<'_> {
+    /// The frame from the radiance alone.
+    fn radiance_only(&self, report: &mut Report) -> Result<Frame> {
+        let pass = Pass::radiance(self.layer, self.rec.settings.cube_filter);
+        geometry::render(self.rec, self.camera, self.t, self.mask, pass, report)
+    }
+
+    /// A pass of `channel` skipping `skip`. The lighting is smooth and at cube resolution:
+    /// always filtered (seam-aware bilinear, restricted to texels of the same object and
+    /// distance), whatever the radiance uses.
+    fn pass<'b>(&'b self, channel: Channel, skip: &'b [u32]) -> Pass<'b> {
+        Pass {
+            layer: self.layer,
+            channel,
+            skip,
+            second: None,
+            environment: None,
+            sparse: false,
+            filter: if channel == Channel::Radiance {
+                self.rec.settings.cube_filter
+            } else {
+                CubeFilter::Bilinear
+            },
+        }
+    }
+
+    /// The lighting and the non-diffuse radiance in one pass (the same lookups, weights and
+    /// fallbacks for both), and the radiance pass for the objects without a material unless
+    /// the lighting pass's frame serves. A pack v2 always has them; a damaged one is shown
+    /// from its radiance instead (`None`).
+    fn passes(
+        &self,
+        proxy: &ProxyGeometry,
+        report: &mut Report,
+        stages: &mut Vec<(String, f64)>,
+    ) -> Result<Option<Passes>> {
+        let rec = self.rec;
+        let materials = rec.materials();
+        let (lit, unlit): (Vec<u32>, Vec<u32>) = proxy
+            .object_ids()
+            .iter()
+            .partition(|&&o| materials.object(o).is_some());
+        let mut side = Report::default();
+        let start = Instant::now();
+        // Where every object has a material, the radiance pass would only show the
+        // environment: this pass looks it up instead, in the radiance cube as that pass would.
+        let all_lit = unlit.is_empty();
+        let fused = Pass {
+            second: Some(Channel::NonDiffuse),
+            environment: all_lit.then_some((Channel::Radiance, rec.settings.cube_filter)),
+            sparse: rec.settings.sparse_lighting,
+            ..self.pass(Channel::Lighting, &unlit)
+        };
+        let (camera, t, mask) = (self.camera, self.t, self.mask);
+        let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
+        stages.push(("lighting_pass".to_string(), ms(start)));
+        let pair = match both {
+            Ok(pair) => pair,
+            Err(e) => {
+                report.missing.push(format!("materials not applied: {e}"));
+                return Ok(None);
+            }
+        };
+        report.interpolated_pixels += pair.interpolated;
+        let start = Instant::now();
+        // Where every object has a material the lighting pass's frame becomes the frame, its
+        // pixels shaded in place (each read before it is written), the environment where
+        // nothing is and black on objects left unshaded, as the radiance pass would leave
+        // them.
+        let (frame, lighting, triangles) = if all_lit && pair.environment {
+            report.base_views = side.base_views.clone();
+            (pair.frame, None, pair.triangles)
+        } else {
+            let radiance = self.pass(Channel::Radiance, &lit);
+            let frame = geometry::render(rec, camera, t, mask, radiance, report)?;
+            // The same proxies rasterized the same way: the same objects per pixel.
+            debug_assert_eq!(frame.object, pair.frame.object);
+            (frame, Some(pair.frame.radiance), None)
+        };
+        stages.push(("radiance_pass".to_string(), ms(start)));
+        let lit = Lit {
+            lighting,
+            non_diffuse: pair.second,
+            triangles,
+        };
+        Ok(Some(Passes { frame, lit, side }))
+    }
+
+    /// Shades `frame` with the materials: each pixel as soon as its surface is known, those
+    /// whose reflection is marched after the reflections' set-up, which only a frame that has
+    /// them pays for. Returns the surfaces' raster time, ms.
+    fn shade(
+        &self,
+        proxy: &ProxyGeometry,
+        frame: &mut Frame,
+        lit: Lit,
+        report: &mut Report,
+        stages: &mut Vec<(String, f64)>,
+    ) -> f64 {
+        let (rec, camera, t) = (self.rec, self.camera, self.t);
+        let start = Instant::now();
+        let sun = rec.runtime_sun().zip(rec.proxy_rays()).map(|(s, shadows)| {
+            let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
+            s.at(shadows, proxy, t, rays)
+        });
+        let glossy = specular::glossy_allowed(rec);
+        let with_footprint = sun.is_some();
+        let surfaces = Surfaces::new(
+            rec,
+            proxy,
+            rec.materials(),
+            camera,
+            t,
+            self.layer,
+            with_footprint,
+            glossy,
+            // The lighting pass's raster where it made one with triangles and its frame is
+            // this one: the same proxies and pixels.
+            lit.triangles.map(|(projected, prim)| SharedRaster {
+                projected,
+                prim,
+                object: &frame.object,
+                depth: &frame.depth,
+            }),
+        );
+        let shader = Shader {
+            sun: sun.as_ref(),
+            runtime_emission: rec.pack().runtime_emission(),
+            non_diffuse: &lit.non_diffuse,
+            marched_pixels: AtomicUsize::new(0),
+            unanswered: AtomicUsize::new(0),
+        };
+        let lighting = lit.lighting.as_deref();
+        let object = &frame.object;
+        let marched: Vec<(usize, SurfacePixel)> = frame
+            .radiance
+            .par_iter_mut()
+            .enumerate()
+            .filter_map(|(j, c)| {
+                let light = lighting.map_or(*c, |l| l[j]);
+                let px = surfaces.pixel(j).filter(|px| px.object == object[j]);
+                let Some(px) = px else {
+                    if lighting.is_none() && object[j] != 0 {
+                        *c = Vec3::ZERO;
+                    }
+                    return None;
+                };
+                if px.marched {
+                    return Some((j, px));
+                }
+                *c = shader.pixel(j, &px, light, None);
+                None
+            })
+            .collect();
+        stages.push(("albedo".to_string(), ms(start)));
+        let start = Instant::now();
+        let reflections = (!marched.is_empty())
+            .then(|| Reflections::new(rec, camera, t, sun.as_ref(), &mut report.missing));
+        let reflected: Vec<(usize, Vec3)> = marched
+            .par_iter()
+            .map(|(j, px)| {
+                let light = lighting.map_or(frame.radiance[*j], |l| l[*j]);
+                (*j, shader.pixel(*j, px, light, reflections.as_ref()))
+            })
+            .collect();
+        for (j, c) in reflected {
+            frame.radiance[j] = c;
+        }
+        report.reflections = (
+            shader.marched_pixels.into_inner(),
+            shader.unanswered.into_inner(),
+        );
+        stages.push(("reflections".to_string(), ms(start)));
+        surfaces.raster_ms
+    }
+}
+
+/// What shading a pixel needs beside its surface and its lighting.
+struct Shader<'a> {
+    sun: Option<&'a PlacedSun<'a>>,
+    /// Whether the pack leaves the emission to the runtime (pack 4).
+    runtime_emission: bool,
+    non_diffuse: &'a [Vec3],
+    /// Pixels whose reflection was marched, and those of them no view answered.
+    marched_pixels: AtomicUsize,
+    unanswered: AtomicUsize,
+}
+
+impl Shader<'_> {
+    /// Pixel `j` of surface `px` under `light`; its reflection marched through `reflections`
+    /// where it is marched.
+    #[inline]
+    fn pixel(
+        &self,
+        j: usize,
+        px: &SurfacePixel,
+        light: Vec3,
+        reflections: Option<&Reflections>,
+    ) -> Vec3 {
         // The BSDF only where the sun or a reflection needs it (there the pixel has its
         // geometry).
         let bsdf = px.geometry.as_ref().map(|g| {
@@ -221,99 +381,65 @@ pub(crate) fn render(
             (g, Bsdf::new(px.material, g.ng, g.ns, -g.view, front), front)
         });
         let marching = reflections.filter(|_| px.marched).zip(bsdf.as_ref());
-        let specular = marching.and_then(|(r, (g, bsdf, front))| {
-            let n = bsdf.normal();
-            let cos_o = -g.view.dot(n);
-            let dir = (g.view + n * (2.0 * cos_o)).normalize_or(n);
-            let alpha = px.material.roughness * px.material.roughness;
-            let eta = if *front {
-                px.material.ior
-            } else {
-                1.0 / px.material.ior
-            };
-            let delta = px.material.roughness < DELTA_ROUGHNESS;
-            let incoming = if delta {
-                r.incoming(g.position, dir, 0.0)
-                    .map(|l| specular::reflectance(&px.material, cos_o, eta) * l)
-            } else {
-                // A per-pixel turn of the lobe's directions (golden-ratio sequence).
-                let turn = (j as f32 * 0.618_034).fract();
-                r.lobe(g.position, bsdf, alpha, turn)
-            };
-            marched_pixels.fetch_add(1, Ordering::Relaxed);
-            if incoming.is_none() {
-                unanswered.fetch_add(1, Ordering::Relaxed);
-            }
-            // A glossy surface's lamps' highlights, which the march cannot see.
-            let highlights = if delta {
-                Vec3::ZERO
-            } else {
-                r.highlights(g.position, g.ng, bsdf)
-            };
-            Some(px.emission + incoming? + highlights)
-        });
+        let specular =
+            marching.and_then(|(r, (g, bsdf, front))| self.reflected(j, px, r, g, bsdf, *front));
         // Glass in the see-through layer that no view answers shows no reflection (its
         // baked radiance holds what it lets through, which is composited apart).
         let baked = if px.see_through {
             Vec3::ZERO
-        } else if runtime_emission {
+        } else if self.runtime_emission {
             // Pack 4: the emission at the pixel's UV, the specular part from the cubes.
-            non_diffuse[j] + px.emission
+            self.non_diffuse[j] + px.emission
         } else {
-            non_diffuse[j]
+            self.non_diffuse[j]
         };
         let mut c = px.material.albedo() * light + specular.unwrap_or(baked);
-        if let (Some(sun), Some((g, bsdf, _))) = (&sun, &bsdf) {
+        if let (Some(sun), Some((g, bsdf, _))) = (self.sun, &bsdf) {
             c += sun.radiance(g.position, g.ng, g.footprint, bsdf, j as u32);
         }
         c
-    };
-    // Each pixel shaded as soon as its surface is known; those whose reflection is marched
-    // wait for the reflections' set-up, which only a frame that has them pays for.
-    let object = &frame.object;
-    let marched: Vec<(usize, SurfacePixel)> = frame
-        .radiance
-        .par_iter_mut()
-        .enumerate()
-        .filter_map(|(j, c)| {
-            let light = lighting.as_ref().map_or(*c, |l| l[j]);
-            let px = surfaces.pixel(j).filter(|px| px.object == object[j]);
-            let Some(px) = px else {
-                if lighting.is_none() && object[j] != 0 {
-                    *c = Vec3::ZERO;
-                }
-                return None;
-            };
-            if px.marched {
-                return Some((j, px));
-            }
-            *c = shade(j, &px, light, None);
-            None
-        })
-        .collect();
-    timed("albedo", start);
-    let start = std::time::Instant::now();
-    let reflections = (!marched.is_empty())
-        .then(|| Reflections::new(rec, camera, t, sun.as_ref(), &mut report.missing));
-    let reflected: Vec<(usize, Vec3)> = marched
-        .par_iter()
-        .map(|(j, px)| {
-            let light = lighting.as_ref().map_or(frame.radiance[*j], |l| l[*j]);
-            (*j, shade(*j, px, light, reflections.as_ref()))
-        })
-        .collect();
-    for (j, c) in reflected {
-        frame.radiance[j] = c;
     }
-    report.reflections = (marched_pixels.into_inner(), unanswered.into_inner());
-    timed("reflections", start);
-    report.fallback = side.fallback;
-    for m in side.missing.into_iter().chain(materials.messages()) {
-        if !report.missing.contains(&m) {
-            report.missing.push(m);
+
+    /// The non-diffuse radiance of marched pixel `j`: its emission, the reflected ray's
+    /// radiance marched through `r` (`None` where no view answers), and a glossy surface's
+    /// lamps' highlights, which the march cannot see.
+    #[inline]
+    fn reflected(
+        &self,
+        j: usize,
+        px: &SurfacePixel,
+        r: &Reflections,
+        g: &PixelGeometry,
+        bsdf: &Bsdf,
+        front: bool,
+    ) -> Option<Vec3> {
+        let n = bsdf.normal();
+        let cos_o = -g.view.dot(n);
+        let dir = (g.view + n * (2.0 * cos_o)).normalize_or(n);
+        let alpha = px.material.roughness * px.material.roughness;
+        let eta = if front {
+            px.material.ior
+        } else {
+            1.0 / px.material.ior
+        };
+        let delta = px.material.roughness < DELTA_ROUGHNESS;
+        let incoming = if delta {
+            r.incoming(g.position, dir, 0.0)
+                .map(|l| specular::reflectance(&px.material, cos_o, eta) * l)
+        } else {
+            // A per-pixel turn of the lobe's directions (golden-ratio sequence).
+            let turn = (j as f32 * 0.618_034).fract();
+            r.lobe(g.position, bsdf, alpha, turn)
+        };
+        self.marched_pixels.fetch_add(1, Ordering::Relaxed);
+        if incoming.is_none() {
+            self.unanswered.fetch_add(1, Ordering::Relaxed);
         }
+        let highlights = if delta {
+            Vec3::ZERO
+        } else {
+            r.highlights(g.position, g.ng, bsdf)
+        };
+        Some(px.emission + incoming? + highlights)
     }
-    stages.push(("albedo_raster".to_string(), surfaces.raster_ms));
-    report.stage_ms = stages;
-    Ok(frame)
 }
