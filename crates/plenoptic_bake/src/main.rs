@@ -232,32 +232,7 @@ fn run(command: Command) -> Result<()> {
                 output,
                 volume_complex,
             };
-            // What the import could not take over (an unsupported feature, a value out of
-            // range), before the bake's minutes start: the author can stop and fix it.
-            let (recipe, scene) = plenoptic_bake::input::load_recipe(&recipe)?;
-            for w in &scene.warnings {
-                eprintln!("plenoptic: warning: {w}");
-            }
-            let report = plenoptic_bake::bake(&recipe, &scene, &options)?;
-            match (&report.output, shard) {
-                (Some(out), _) => out!(
-                    "wrote {} ({} items rendered, {} resumed)",
-                    out.display(),
-                    report.items_rendered,
-                    report.items_skipped
-                ),
-                (None, Some(s)) => out!(
-                    "shard {s}: {} items rendered, {} already done, of {} in the plan",
-                    report.items_rendered,
-                    report.items_skipped,
-                    report.items_total
-                ),
-                (None, None) => {}
-            }
-            for (phase, secs) in &report.timings {
-                out!("  {phase:>14}: {secs:.3} s");
-            }
-            Ok(())
+            cmd_bake(&recipe, &options)
         }
         Command::Merge {
             recipe,
@@ -292,50 +267,12 @@ fn run(command: Command) -> Result<()> {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
                 BakeError::Invalid(format!("mode '{mode}': expected image, volume or geometry"))
             })?;
-            let shading = match shading.to_ascii_lowercase().as_str() {
-                "materials" => plenoptic_recon::Shading::Materials,
-                "radiance" => plenoptic_recon::Shading::Radiance,
-                other => {
-                    return Err(BakeError::Invalid(format!(
-                        "shading '{other}': expected materials or radiance"
-                    )));
-                }
+            let look = Look {
+                shading: parse_shading(&shading)?,
+                shaded_reflections: parse_reflections(&reflections)?,
+                supersampling,
             };
-            let shaded_reflections = match reflections.to_ascii_lowercase().as_str() {
-                "shaded" => true,
-                "marched" => false,
-                other => {
-                    return Err(BakeError::Invalid(format!(
-                        "reflections '{other}': expected shaded or marched"
-                    )));
-                }
-            };
-            let render = || -> std::result::Result<_, plenoptic_eval::EvalError> {
-                let camera_path = plenoptic_recon::CameraPath::load(&path)?;
-                let mut rec = plenoptic_recon::Reconstructor::open(&pack)?;
-                rec.settings.shading = shading;
-                rec.settings.shaded_reflections = shaded_reflections;
-                rec.settings.supersampling = supersampling;
-                plenoptic_eval::tools::render_path_with(
-                    &rec,
-                    &camera_path,
-                    &out,
-                    &plenoptic_eval::tools::RenderOptions {
-                        mode,
-                        progress: true,
-                        ..Default::default()
-                    },
-                )
-            };
-            let summary = render().map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
-            out!(
-                "{} frames in {} ({:.1} ms per frame), report {}",
-                summary.frames,
-                out.display(),
-                summary.mean_ms,
-                summary.report_csv.display()
-            );
-            Ok(())
+            cmd_render(&pack, &path, mode, look, &out)
         }
         Command::Compare {
             reference,
@@ -343,37 +280,7 @@ fn run(command: Command) -> Result<()> {
             candidates,
             csv,
             plot,
-        } => {
-            let candidates: Vec<(String, PathBuf)> = candidates
-                .iter()
-                .map(|c| match c.split_once('=') {
-                    Some((label, dir)) => (label.to_owned(), PathBuf::from(dir)),
-                    None => {
-                        let dir = PathBuf::from(c);
-                        let label = dir
-                            .file_name()
-                            .map_or_else(|| c.clone(), |n| n.to_string_lossy().into_owned());
-                        (label, dir)
-                    }
-                })
-                .collect();
-            let comparison = plenoptic_eval::tools::compare_with(
-                &reference,
-                reference_b.as_deref(),
-                &candidates,
-                &csv,
-                &plot,
-            )
-            .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
-            print!("{}", comparison.table());
-            let plots: Vec<String> = comparison
-                .plots
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect();
-            out!("wrote {} and {}", csv.display(), plots.join(", "));
-            Ok(())
-        }
+        } => cmd_compare(&reference, reference_b.as_deref(), &candidates, &csv, &plot),
         Command::Reference {
             recipe,
             path,
@@ -384,6 +291,137 @@ fn run(command: Command) -> Result<()> {
             exposure,
         } => cmd_reference(&recipe, &path, &out, spp, seed, halves, exposure),
     }
+}
+
+/// Bakes the recipe (or one shard of it) and prints what was written and the time per phase.
+fn cmd_bake(recipe_path: &Path, options: &BakeOptions) -> Result<()> {
+    // What the import could not take over (an unsupported feature, a value out of range),
+    // before the bake's minutes start: the author can stop and fix it.
+    let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
+    for w in &scene.warnings {
+        eprintln!("plenoptic: warning: {w}");
+    }
+    let report = plenoptic_bake::bake(&recipe, &scene, options)?;
+    match (&report.output, options.shard) {
+        (Some(out), _) => out!(
+            "wrote {} ({} items rendered, {} resumed)",
+            out.display(),
+            report.items_rendered,
+            report.items_skipped
+        ),
+        (None, Some(s)) => out!(
+            "shard {s}: {} items rendered, {} already done, of {} in the plan",
+            report.items_rendered,
+            report.items_skipped,
+            report.items_total
+        ),
+        (None, None) => {}
+    }
+    for (phase, secs) in &report.timings {
+        out!("  {phase:>14}: {secs:.3} s");
+    }
+    Ok(())
+}
+
+/// How `plenoptic render` shows the frames (its `--shading`, `--reflections` and
+/// `--supersampling`).
+#[derive(Clone, Copy)]
+struct Look {
+    shading: plenoptic_recon::Shading,
+    shaded_reflections: bool,
+    supersampling: u32,
+}
+
+/// `--shading`: materials or radiance.
+fn parse_shading(shading: &str) -> Result<plenoptic_recon::Shading> {
+    match shading.to_ascii_lowercase().as_str() {
+        "materials" => Ok(plenoptic_recon::Shading::Materials),
+        "radiance" => Ok(plenoptic_recon::Shading::Radiance),
+        other => Err(BakeError::Invalid(format!(
+            "shading '{other}': expected materials or radiance"
+        ))),
+    }
+}
+
+/// `--reflections`: shaded (true) or marched (false).
+fn parse_reflections(reflections: &str) -> Result<bool> {
+    match reflections.to_ascii_lowercase().as_str() {
+        "shaded" => Ok(true),
+        "marched" => Ok(false),
+        other => Err(BakeError::Invalid(format!(
+            "reflections '{other}': expected shaded or marched"
+        ))),
+    }
+}
+
+/// Reconstructs the frames along the camera path at `path` from `pack` into `out`.
+fn cmd_render(
+    pack: &Path,
+    path: &Path,
+    mode: plenoptic_recon::Mode,
+    look: Look,
+    out: &Path,
+) -> Result<()> {
+    let render = || -> std::result::Result<_, plenoptic_eval::EvalError> {
+        let camera_path = plenoptic_recon::CameraPath::load(path)?;
+        let mut rec = plenoptic_recon::Reconstructor::open(pack)?;
+        rec.settings.shading = look.shading;
+        rec.settings.shaded_reflections = look.shaded_reflections;
+        rec.settings.supersampling = look.supersampling;
+        plenoptic_eval::tools::render_path_with(
+            &rec,
+            &camera_path,
+            out,
+            &plenoptic_eval::tools::RenderOptions {
+                mode,
+                progress: true,
+                ..Default::default()
+            },
+        )
+    };
+    let summary = render().map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
+    out!(
+        "{} frames in {} ({:.1} ms per frame), report {}",
+        summary.frames,
+        out.display(),
+        summary.mean_ms,
+        summary.report_csv.display()
+    );
+    Ok(())
+}
+
+/// Compares the candidate directories (`DIR` or `LABEL=DIR`) with the reference.
+fn cmd_compare(
+    reference: &Path,
+    reference_b: Option<&Path>,
+    candidates: &[String],
+    csv: &Path,
+    plot: &Path,
+) -> Result<()> {
+    let candidates: Vec<(String, PathBuf)> = candidates
+        .iter()
+        .map(|c| match c.split_once('=') {
+            Some((label, dir)) => (label.to_owned(), PathBuf::from(dir)),
+            None => {
+                let dir = PathBuf::from(c);
+                let label = dir
+                    .file_name()
+                    .map_or_else(|| c.clone(), |n| n.to_string_lossy().into_owned());
+                (label, dir)
+            }
+        })
+        .collect();
+    let comparison =
+        plenoptic_eval::tools::compare_with(reference, reference_b, &candidates, csv, plot)
+            .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
+    print!("{}", comparison.table());
+    let plots: Vec<String> = comparison
+        .plots
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    out!("wrote {} and {}", csv.display(), plots.join(", "));
+    Ok(())
 }
 
 fn cmd_plan(recipe_path: &Path, out: Option<PathBuf>, json: bool) -> Result<()> {
