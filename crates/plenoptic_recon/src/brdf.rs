@@ -3,8 +3,9 @@
 //! (`plenoptic_trace::material`: Lambert + GGX with separable Smith masking, the exact
 //! dielectric Fresnel for the IOR, Schlick's for metals, Walter et al. 2007's rough BTDF for
 //! transmission into a solid, the mirrored reflection lobe through a thin wall), evaluated
-//! only, not sampled. The runtime core does not depend on the tracer, so the formulas are repeated here; `tests/runtime_sun.rs` checks that both give
-//! the same value for random surfaces and directions.
+//! only, not sampled. The scalar terms (Fresnel, GGX, Smith) are `plenoptic_math::optics`,
+//! which the tracer evaluates too; `tests/runtime_sun.rs` checks that both BSDFs give the
+//! same value for random surfaces and directions.
 //!
 //! Everything is in world space: the model is isotropic, so only dot products with the
 //! shading normal matter and no tangent frame is built.
@@ -12,9 +13,8 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// Roughness below which the tracer's specular lobes are ideal (mirror, clear glass), which
-/// no light sample can reach.
-pub(crate) const DELTA_ROUGHNESS: f32 = 0.02;
+pub(crate) use plenoptic_math::optics::{DELTA_ROUGHNESS, fresnel_dielectric, fresnel_schlick};
+use plenoptic_math::optics::{ggx_d, smith_g1};
 
 /// A material at a surface point, as the tracer's `SurfaceProps` holds it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -199,39 +199,6 @@ impl Bsdf {
             Vec3::ZERO
         }
     }
-}
-
-/// Unpolarised Fresnel reflectance of a dielectric for `cos_i` and relative IOR `eta`.
-pub(crate) fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
-    let cos_i = cos_i.clamp(0.0, 1.0);
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_par * r_par + r_perp * r_perp)
-}
-
-pub(crate) fn fresnel_schlick(f0: Vec3, cos: f32) -> Vec3 {
-    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * m
-}
-
-fn ggx_d(alpha: f32, cos_h: f32) -> f32 {
-    if cos_h <= 0.0 {
-        return 0.0;
-    }
-    let a2 = alpha * alpha;
-    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
-    a2 / (PI * d * d)
-}
-
-fn smith_g1(alpha: f32, cos: f32) -> f32 {
-    let c = cos.abs();
-    let a2 = alpha * alpha;
-    2.0 * c / (c + (a2 + (1.0 - a2) * c * c).sqrt())
 }
 
 #[cfg(test)]

@@ -53,16 +53,10 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self> {
-        let forward = (target - eye).normalize_or_zero();
-        let right = forward.cross(up).normalize_or_zero();
-        if forward == Vec3::ZERO || right == Vec3::ZERO {
-            return Err(Error::Camera(
-                "look_at: eye equals target or up is parallel to the view".into(),
-            ));
-        }
-        let true_up = right.cross(forward);
-        let orientation = Quat::from_mat3(&glam::Mat3::from_cols(right, true_up, -forward));
-        Self::new(eye, orientation.normalize(), vfov, width, height)
+        let orientation = plenoptic_math::look_at_rotation(eye, target, up).ok_or_else(|| {
+            Error::Camera("look_at: eye equals target or up is parallel to the view".into())
+        })?;
+        Self::new(eye, orientation, vfov, width, height)
     }
 
     /// Checks the resolution (not empty), the pose (finite, a unit quaternion) and the field

@@ -81,16 +81,12 @@ impl PinholeCamera {
         width: u32,
         height: u32,
     ) -> Result<Self> {
-        let forward = (target - eye).normalize_or_zero();
-        let right = forward.cross(up).normalize_or_zero();
-        if forward == Vec3::ZERO || right == Vec3::ZERO {
-            return Err(TraceError::InvalidCamera(
+        let rotation = plenoptic_math::look_at_rotation(eye, target, up).ok_or_else(|| {
+            TraceError::InvalidCamera(
                 "look_at: eye equals target or up is parallel to the view".into(),
-            ));
-        }
-        let true_up = right.cross(forward);
-        let rotation = Quat::from_mat3(&glam::Mat3::from_cols(right, true_up, -forward));
-        Self::new(eye, rotation.normalize(), yfov, width, height)
+            )
+        })?;
+        Self::new(eye, rotation, yfov, width, height)
     }
 }
 

@@ -27,8 +27,8 @@ use crate::image::luminance;
 use crate::sampling::Frame;
 use crate::texture::{mesh_color, sample_opt};
 
-/// Perceptual roughness below which reflection and refraction are treated as ideal.
-pub const DELTA_ROUGHNESS: f32 = 0.02;
+pub use plenoptic_math::optics::{DELTA_ROUGHNESS, fresnel_dielectric};
+use plenoptic_math::optics::{fresnel_schlick, ggx_d, smith_g1};
 
 pub use crate::texture::sample_texture;
 
@@ -92,25 +92,6 @@ impl SurfaceProps {
     }
 }
 
-/// Fresnel reflectance of a dielectric interface; `cos_i` on the incident side, `eta` =
-/// n_transmitted / n_incident. Returns 1 under total internal reflection.
-pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
-    let cos_i = cos_i.clamp(0.0, 1.0);
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_par * r_par + r_perp * r_perp)
-}
-
-fn fresnel_schlick(f0: Vec3, cos: f32) -> Vec3 {
-    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * m
-}
-
 /// Refracts `wo` (pointing away, `wo·n > 0`) through the interface with normal `n`; `eta` =
 /// n_t / n_i. `None` under total internal reflection.
 pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
@@ -121,22 +102,6 @@ pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     }
     let cos_t = (1.0 - sin2_t).sqrt();
     Some((-wo / eta + n * (cos_i / eta - cos_t)).normalize())
-}
-
-fn ggx_d(alpha: f32, cos_h: f32) -> f32 {
-    if cos_h <= 0.0 {
-        return 0.0;
-    }
-    let a2 = alpha * alpha;
-    let c2 = cos_h * cos_h;
-    let d = c2 * (a2 - 1.0) + 1.0;
-    a2 / (PI * d * d)
-}
-
-fn smith_g1(alpha: f32, cos: f32) -> f32 {
-    let c = cos.abs();
-    let a2 = alpha * alpha;
-    2.0 * c / (c + (a2 + (1.0 - a2) * c * c).sqrt())
 }
 
 /// Samples a GGX microfacet normal in local space with density D(h)·cosθ_h.
