@@ -34,42 +34,9 @@ pub fn quad(size: Vec2) -> Mesh {
 /// the scene builder's box, so test scenes and glTF-built scenes share one mesh.
 pub use plenoptic_scene::builder::shapes::cuboid;
 
-/// A UV sphere of `radius` with `segments` around and `rings` from pole to pole, outward.
-pub fn uv_sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
-    let (segments, rings) = (segments.max(3), rings.max(2));
-    let mut mesh = Mesh::default();
-    for r in 0..=rings {
-        let theta = PI * r as f32 / rings as f32;
-        for s in 0..=segments {
-            let phi = 2.0 * PI * s as f32 / segments as f32;
-            let n = Vec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                -theta.sin() * phi.sin(),
-            );
-            mesh.positions.push(n * radius);
-            mesh.normals.push(n);
-            mesh.uvs.push(Vec2::new(
-                s as f32 / segments as f32,
-                r as f32 / rings as f32,
-            ));
-        }
-    }
-    let row = segments + 1;
-    for r in 0..rings {
-        for s in 0..segments {
-            let a = r * row + s;
-            let b = a + row;
-            if r != 0 {
-                mesh.triangles.push([a, b, a + 1]);
-            }
-            if r != rings - 1 {
-                mesh.triangles.push([a + 1, b, b + 1]);
-            }
-        }
-    }
-    mesh
-}
+/// A UV sphere of `radius` with `segments` around and `rings` from pole to pole, outward:
+/// the scene builder's sphere, so test scenes and glTF-built scenes share one mesh.
+pub use plenoptic_scene::builder::shapes::uv_sphere_with_rings as uv_sphere;
 
 /// The mesh turned inside out: winding and normals reversed.
 pub fn inverted(mut mesh: Mesh) -> Mesh {
@@ -256,143 +223,13 @@ pub const ROOM_ANIMATED_OBJECT: &str = "sliding_box";
 /// [`room_camera`].
 pub fn furnished_room() -> Scene {
     let mut b = SceneBuilder::default();
-    let white = b.material(plastic(Vec3::splat(0.75), 0.9));
-    let red = b.material(plastic(Vec3::new(0.7, 0.12, 0.1), 0.9));
-    let green = b.material(plastic(Vec3::new(0.15, 0.6, 0.15), 0.9));
-    let wood = b.material(plastic(Vec3::new(0.45, 0.28, 0.15), 0.6));
-    let blue = b.material(plastic(Vec3::new(0.2, 0.3, 0.7), 0.4));
-    let gold = b.material(metal(Vec3::new(0.95, 0.75, 0.4), 0.3));
-    let mirror = b.material(metal(Vec3::splat(0.9), 0.0));
-    let light = b.material(emitter(Vec3::new(12.0, 11.0, 9.5)));
-    let wall = |b: &mut SceneBuilder, name: &str, size: Vec2, pos: Vec3, n: Vec3, mat| {
-        b.object_trs(
-            name,
-            quad(size),
-            mat,
-            Trs {
-                translation: pos,
-                rotation: facing(n),
-                scale: Vec3::ONE,
-            },
-        );
-    };
-    wall(
-        &mut b,
-        "floor",
-        Vec2::new(4.0, 5.0),
-        Vec3::ZERO,
-        Vec3::Y,
-        white,
-    );
-    wall(
-        &mut b,
-        "ceiling",
-        Vec2::new(4.0, 5.0),
-        Vec3::new(0.0, 2.6, 0.0),
-        -Vec3::Y,
-        white,
-    );
-    // The quad's extent is (x, z) before rotation; for walls rotate it about the normal.
-    b.object_trs(
-        "back_wall",
-        quad(Vec2::new(4.0, 2.6)),
-        white,
-        Trs {
-            translation: Vec3::new(0.0, 1.3, -2.5),
-            rotation: facing(Vec3::Z),
-            scale: Vec3::ONE,
-        },
-    );
-    b.object_trs(
-        "front_wall",
-        quad(Vec2::new(4.0, 2.6)),
-        white,
-        Trs {
-            translation: Vec3::new(0.0, 1.3, 2.5),
-            rotation: facing(-Vec3::Z),
-            scale: Vec3::ONE,
-        },
-    );
-    b.object_trs(
-        "left_wall",
-        quad(Vec2::new(2.6, 5.0)),
-        red,
-        Trs {
-            translation: Vec3::new(-2.0, 1.3, 0.0),
-            rotation: facing(Vec3::X),
-            scale: Vec3::ONE,
-        },
-    );
-    b.object_trs(
-        "right_wall",
-        quad(Vec2::new(2.6, 5.0)),
-        green,
-        Trs {
-            translation: Vec3::new(2.0, 1.3, 0.0),
-            rotation: facing(-Vec3::X),
-            scale: Vec3::ONE,
-        },
-    );
-    wall(
-        &mut b,
-        "light_panel",
-        Vec2::new(1.0, 1.0),
-        Vec3::new(0.0, 2.59, -0.5),
-        -Vec3::Y,
-        light,
-    );
-    b.object(
-        "table_top",
-        cuboid(Vec3::new(1.6, 0.06, 0.9)),
-        wood,
-        Vec3::new(0.3, 0.75, -1.0),
-    );
-    for (dx, dz) in [(-0.72, -0.38), (0.72, -0.38), (-0.72, 0.38), (0.72, 0.38)] {
-        b.object(
-            "table_leg",
-            cuboid(Vec3::new(0.06, 0.72, 0.06)),
-            wood,
-            Vec3::new(0.3 + dx, 0.36, -1.0 + dz),
-        );
-    }
-    b.object_trs(
-        "tall_box",
-        cuboid(Vec3::new(0.5, 1.2, 0.5)),
-        white,
-        Trs {
-            translation: Vec3::new(-1.3, 0.6, -1.6),
-            rotation: Quat::from_rotation_y(0.35),
-            scale: Vec3::ONE,
-        },
-    );
-    b.object(
-        "blue_box",
-        cuboid(Vec3::new(0.4, 0.4, 0.4)),
-        blue,
-        Vec3::new(0.6, 0.98, -1.1),
-    );
-    b.object(
-        "plastic_sphere",
-        uv_sphere(0.3, 32, 16),
-        blue,
-        Vec3::new(-0.8, 0.3, 0.2),
-    );
-    b.object(
-        "gold_sphere",
-        uv_sphere(0.2, 32, 16),
-        gold,
-        Vec3::new(-0.1, 0.98, -0.9),
-    );
-    b.object(
-        "mirror_sphere",
-        uv_sphere(0.35, 32, 16),
-        mirror,
-        Vec3::new(1.3, 0.35, 0.3),
-    );
+    let m = RoomMaterials::add(&mut b);
+    room_shell(&mut b, &m);
+    room_furniture(&mut b, &m);
     let slider = b.object(
         ROOM_ANIMATED_OBJECT,
         cuboid(Vec3::splat(0.35)),
-        red,
+        m.red,
         Vec3::new(-0.5, 0.175, 1.0),
     );
     b.animate_translation(
@@ -404,6 +241,104 @@ pub fn furnished_room() -> Scene {
     );
     b.point_light(Vec3::new(1.2, 2.0, 1.5), Vec3::new(1.0, 0.9, 0.8), 1.5);
     b.build()
+}
+
+/// The materials of [`furnished_room`], as indices into its builder.
+struct RoomMaterials {
+    white: usize,
+    red: usize,
+    green: usize,
+    wood: usize,
+    blue: usize,
+    gold: usize,
+    mirror: usize,
+    light: usize,
+}
+
+impl RoomMaterials {
+    /// Adds the room's materials to `b`.
+    fn add(b: &mut SceneBuilder) -> Self {
+        Self {
+            white: b.material(plastic(Vec3::splat(0.75), 0.9)),
+            red: b.material(plastic(Vec3::new(0.7, 0.12, 0.1), 0.9)),
+            green: b.material(plastic(Vec3::new(0.15, 0.6, 0.15), 0.9)),
+            wood: b.material(plastic(Vec3::new(0.45, 0.28, 0.15), 0.6)),
+            blue: b.material(plastic(Vec3::new(0.2, 0.3, 0.7), 0.4)),
+            gold: b.material(metal(Vec3::new(0.95, 0.75, 0.4), 0.3)),
+            mirror: b.material(metal(Vec3::splat(0.9), 0.0)),
+            light: b.material(emitter(Vec3::new(12.0, 11.0, 9.5))),
+        }
+    }
+}
+
+/// The room's floor, ceiling, four walls and ceiling light panel: quads centred at a point,
+/// facing into the room. A quad's extent is (x, z) before it is turned to face its normal.
+fn room_shell(b: &mut SceneBuilder, m: &RoomMaterials) {
+    let panels = [
+        ("floor", [4.0, 5.0], [0.0, 0.0, 0.0], Vec3::Y, m.white),
+        ("ceiling", [4.0, 5.0], [0.0, 2.6, 0.0], -Vec3::Y, m.white),
+        ("back_wall", [4.0, 2.6], [0.0, 1.3, -2.5], Vec3::Z, m.white),
+        ("front_wall", [4.0, 2.6], [0.0, 1.3, 2.5], -Vec3::Z, m.white),
+        ("left_wall", [2.6, 5.0], [-2.0, 1.3, 0.0], Vec3::X, m.red),
+        ("right_wall", [2.6, 5.0], [2.0, 1.3, 0.0], -Vec3::X, m.green),
+        (
+            "light_panel",
+            [1.0, 1.0],
+            [0.0, 2.59, -0.5],
+            -Vec3::Y,
+            m.light,
+        ),
+    ];
+    for (name, size, translation, normal, material) in panels {
+        let trs = Trs {
+            translation: Vec3::from(translation),
+            rotation: facing(normal),
+            scale: Vec3::ONE,
+        };
+        b.object_trs(name, quad(Vec2::from(size)), material, trs);
+    }
+}
+
+/// The room's table (top and four legs), its two boxes and three spheres.
+fn room_furniture(b: &mut SceneBuilder, m: &RoomMaterials) {
+    b.object(
+        "table_top",
+        cuboid(Vec3::new(1.6, 0.06, 0.9)),
+        m.wood,
+        Vec3::new(0.3, 0.75, -1.0),
+    );
+    for (dx, dz) in [(-0.72, -0.38), (0.72, -0.38), (-0.72, 0.38), (0.72, 0.38)] {
+        b.object(
+            "table_leg",
+            cuboid(Vec3::new(0.06, 0.72, 0.06)),
+            m.wood,
+            Vec3::new(0.3 + dx, 0.36, -1.0 + dz),
+        );
+    }
+    b.object_trs(
+        "tall_box",
+        cuboid(Vec3::new(0.5, 1.2, 0.5)),
+        m.white,
+        Trs {
+            translation: Vec3::new(-1.3, 0.6, -1.6),
+            rotation: Quat::from_rotation_y(0.35),
+            scale: Vec3::ONE,
+        },
+    );
+    b.object(
+        "blue_box",
+        cuboid(Vec3::new(0.4, 0.4, 0.4)),
+        m.blue,
+        Vec3::new(0.6, 0.98, -1.1),
+    );
+    let spheres = [
+        ("plastic_sphere", 0.3, m.blue, Vec3::new(-0.8, 0.3, 0.2)),
+        ("gold_sphere", 0.2, m.gold, Vec3::new(-0.1, 0.98, -0.9)),
+        ("mirror_sphere", 0.35, m.mirror, Vec3::new(1.3, 0.35, 0.3)),
+    ];
+    for (name, radius, material, position) in spheres {
+        b.object(name, uv_sphere(radius, 32, 16), material, position);
+    }
 }
 
 /// A camera for [`furnished_room`] near the front wall looking at the table.

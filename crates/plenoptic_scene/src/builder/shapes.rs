@@ -66,8 +66,14 @@ pub fn plane(size: Vec2, subdivisions: u32) -> Mesh {
 /// `segments / 2` rings (at least 2): 2·segments·(rings − 1) triangles, so 320 segments give
 /// 101,760 triangles.
 pub fn uv_sphere(radius: f32, segments: u32) -> Mesh {
-    let segments = segments.max(3);
-    let rings = (segments / 2).max(2);
+    uv_sphere_with_rings(radius, segments, segments / 2)
+}
+
+/// A UV sphere of `radius` with `segments` around the equator (at least 3) and `rings` from
+/// pole to pole (at least 2): 2·segments·(rings − 1) triangles. Texture `u` runs around from
+/// +X towards +Z, `v` from the north (+Y) pole to the south.
+pub fn uv_sphere_with_rings(radius: f32, segments: u32, rings: u32) -> Mesh {
+    let (segments, rings) = (segments.max(3), rings.max(2));
     let mut mesh = Mesh::default();
     for r in 0..=rings {
         let theta = PI * r as f32 / rings as f32;
