@@ -18,7 +18,8 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
 use plenoptic_trace::glam::{Vec2, Vec3};
 use plenoptic_trace::sampling::{Sampler, uniform_sphere};
 use plenoptic_trace::*;
@@ -84,6 +85,19 @@ fn with_tmax(rays: &[Ray], tmax: f32) -> Vec<Ray> {
     rays.iter().map(|r| Ray { tmax, ..*r }).collect()
 }
 
+/// Benchmark `query/structure`: `hit` over every ray of `rays`, counting the hits.
+fn cast(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    query: &str,
+    structure: &str,
+    rays: &[Ray],
+    hit: impl Fn(&Ray) -> bool,
+) {
+    g.bench_function(format!("{query}/{structure}"), |b| {
+        b.iter(|| rays.iter().filter(|r| hit(r)).count())
+    });
+}
+
 fn rays(c: &mut Criterion) {
     let scene = big_scene();
     let accel = SceneAccel::new(&scene).unwrap();
@@ -127,35 +141,18 @@ fn rays(c: &mut Criterion) {
     g.throughput(Throughput::Elements(RAYS as u64));
     for (name, set) in &sets {
         let shadow = with_tmax(set, 3.0);
-        g.bench_function(format!("closest_{name}/ours"), |b| {
-            b.iter(|| {
-                set.iter()
-                    .filter(|r| black_box(placed.intersect(r)).is_some())
-                    .count()
-            })
+        let (closest, shadow_of) = (format!("closest_{name}"), format!("shadow_{name}"));
+        cast(&mut g, &closest, "ours", set, |r| {
+            black_box(placed.intersect(r)).is_some()
         });
-        g.bench_function(format!("closest_{name}/bare_obvhs"), |b| {
-            b.iter(|| {
-                set.iter()
-                    .filter(|r| black_box(flat.closest(r)).is_some())
-                    .count()
-            })
+        cast(&mut g, &closest, "bare_obvhs", set, |r| {
+            black_box(flat.closest(r)).is_some()
         });
-        g.bench_function(format!("shadow_{name}/ours"), |b| {
-            b.iter(|| {
-                shadow
-                    .iter()
-                    .filter(|r| black_box(placed.occluded(r)))
-                    .count()
-            })
+        cast(&mut g, &shadow_of, "ours", &shadow, |r| {
+            black_box(placed.occluded(r))
         });
-        g.bench_function(format!("shadow_{name}/bare_obvhs"), |b| {
-            b.iter(|| {
-                shadow
-                    .iter()
-                    .filter(|r| black_box(flat.occluded(r)))
-                    .count()
-            })
+        cast(&mut g, &shadow_of, "bare_obvhs", &shadow, |r| {
+            black_box(flat.occluded(r))
         });
     }
     g.finish();
@@ -172,16 +169,13 @@ fn renderers(c: &mut Criterion) {
     let accel = SceneAccel::new(&scene).unwrap();
     let placed = accel.at_time(1.0);
     let cam = shapes::room_camera(32, 24).unwrap();
-    let field = AmbientField::build(
-        &placed,
-        &AmbientSettings {
-            quality: 0.3,
-            rays_per_point: 64,
-            seed: 2,
-            ..AmbientSettings::low()
-        },
-    )
-    .unwrap();
+    let ambient = AmbientSettings {
+        quality: 0.3,
+        rays_per_point: 64,
+        seed: 2,
+        ..AmbientSettings::low()
+    };
+    let field = AmbientField::build(&placed, &ambient).unwrap();
     let pt = PathTracer::new(PathTracerSettings {
         samples_per_pixel: 1,
         max_depth: 16,
@@ -212,17 +206,9 @@ fn renderers(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("build_room_q0.3", |b| {
         b.iter(|| {
-            AmbientField::build(
-                &placed,
-                &AmbientSettings {
-                    quality: 0.3,
-                    rays_per_point: 64,
-                    seed: 2,
-                    ..AmbientSettings::low()
-                },
-            )
-            .unwrap()
-            .mean_irradiance()
+            AmbientField::build(&placed, &ambient)
+                .unwrap()
+                .mean_irradiance()
         })
     });
     g.finish();

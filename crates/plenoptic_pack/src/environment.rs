@@ -86,6 +86,40 @@ pub enum EnvironmentSource {
     },
 }
 
+impl EnvironmentSource {
+    /// Checks the sky's ranges, a finite non-negative colour or intensity and the image size.
+    fn validate(&self) -> std::result::Result<(), String> {
+        match self {
+            Self::None => Ok(()),
+            Self::Uniform { colour } => {
+                if colour.is_finite() && colour.min_element() >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "uniform colour {:?} is not finite and non-negative",
+                        colour.to_array()
+                    ))
+                }
+            }
+            Self::Sky { params } => params.validate().map_err(|e| format!("sky: {e}")),
+            Self::Image {
+                width,
+                height,
+                intensity,
+                rotation_deg,
+            } => {
+                check_image_size(*width, *height).map_err(|e| e.to_string())?;
+                if !(intensity.is_finite() && *intensity >= 0.0 && rotation_deg.is_finite()) {
+                    return Err(format!(
+                        "image intensity {intensity} or rotation {rotation_deg}° is not valid"
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 impl EnvironmentEntry {
     /// The entry for `environment` with the sun `sun` (the image's texels go in a chunk of
     /// their own: [`crate::PackWriter::add_environment_image`]).
@@ -131,34 +165,7 @@ impl EnvironmentEntry {
                 ));
             }
         }
-        match &self.source {
-            EnvironmentSource::None => Ok(()),
-            EnvironmentSource::Uniform { colour } => {
-                if colour.is_finite() && colour.min_element() >= 0.0 {
-                    Ok(())
-                } else {
-                    Err(format!(
-                        "uniform colour {:?} is not finite and non-negative",
-                        colour.to_array()
-                    ))
-                }
-            }
-            EnvironmentSource::Sky { params } => params.validate().map_err(|e| format!("sky: {e}")),
-            EnvironmentSource::Image {
-                width,
-                height,
-                intensity,
-                rotation_deg,
-            } => {
-                check_image_size(*width, *height).map_err(|e| e.to_string())?;
-                if !(intensity.is_finite() && *intensity >= 0.0 && rotation_deg.is_finite()) {
-                    return Err(format!(
-                        "image intensity {intensity} or rotation {rotation_deg}° is not valid"
-                    ));
-                }
-                Ok(())
-            }
-        }
+        self.source.validate()
     }
 
     /// The environment this entry describes, with `image` the decoded image chunk (needed for

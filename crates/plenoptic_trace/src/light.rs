@@ -297,20 +297,28 @@ fn weighted(bsdf: &Bsdf, wi: Vec3, f_all: Vec3, light_pdf: f32, strategies: &[Lo
     f
 }
 
+/// How [`estimate_direct`] samples direct light.
+#[derive(Debug, Clone, Copy)]
+pub struct LightSamples<'a> {
+    /// The part of the BSDF evaluated.
+    pub lobes: Lobes,
+    /// Which of the caller's BSDF strategies also find emitters and the environment.
+    pub competing: Competing<'a>,
+    /// Samples of the emissive triangles, and as many of the environment.
+    pub count: u32,
+}
+
 /// Direct light reflected by `bsdf` at `hit` towards its `wo`: every punctual light once plus
-/// `samples` samples of the emissive triangles and as many of the environment, each
-/// shadow-tested. `lobes` selects the part of the BSDF evaluated; `competing` says which of
-/// the caller's BSDF strategies also find emitters and the environment (see [`Competing`]).
+/// `light.count` samples of the emissive triangles and as many of the environment, each
+/// shadow-tested.
 pub fn estimate_direct(
     placed: &PlacedScene<'_>,
     hit: &Hit,
     bsdf: &Bsdf,
-    lobes: Lobes,
-    competing: Competing<'_>,
-    samples: u32,
+    light: LightSamples<'_>,
     sampler: &mut Sampler,
 ) -> Vec3 {
-    direct(placed, hit, bsdf, lobes, competing, samples, sampler, false).total
+    direct(placed, hit, bsdf, light, sampler, false).total
 }
 
 /// What [`estimate_direct_split`] returns: direct light and its Lambertian part.
@@ -334,12 +342,10 @@ pub fn estimate_direct_split(
     placed: &PlacedScene<'_>,
     hit: &Hit,
     bsdf: &Bsdf,
-    lobes: Lobes,
-    competing: Competing<'_>,
-    samples: u32,
+    light: LightSamples<'_>,
     sampler: &mut Sampler,
 ) -> DirectLight {
-    direct(placed, hit, bsdf, lobes, competing, samples, sampler, true)
+    direct(placed, hit, bsdf, light, sampler, true)
 }
 
 /// The Lambertian part of [`weighted`]`(bsdf, wi, f_all, light_pdf, strategies)` where `lobes`
@@ -361,17 +367,19 @@ fn diffuse_part(bsdf: &Bsdf, wi: Vec3, lobes: Lobes, light_pdf: f32, strategies:
     f_d * w
 }
 
-#[allow(clippy::too_many_arguments)]
 fn direct(
     placed: &PlacedScene<'_>,
     hit: &Hit,
     bsdf: &Bsdf,
-    lobes: Lobes,
-    competing: Competing<'_>,
-    samples: u32,
+    light: LightSamples<'_>,
     sampler: &mut Sampler,
     split: bool,
 ) -> DirectLight {
+    let LightSamples {
+        lobes,
+        competing,
+        count: samples,
+    } = light;
     let scene = placed.scene();
     let lights = placed.lights();
     let n = bsdf.normal();

@@ -10,7 +10,7 @@ use glam::Vec3;
 use crate::accel::{PlacedScene, Ray};
 use crate::camera::Camera;
 use crate::image::Image;
-use crate::light::{Competing, estimate_direct};
+use crate::light::{Competing, LightSamples, estimate_direct};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::render::{RadianceSample, render_camera};
 use crate::sampling::{Sampler, power_heuristic};
@@ -110,15 +110,17 @@ impl PathTracer {
                         placed,
                         &hit,
                         &bsdf,
-                        Lobes::All,
-                        Competing {
-                            emissive: &[Lobes::All],
-                            environment: self
-                                .settings
-                                .environment_sampling
-                                .then_some((Lobes::All, &[Lobes::All][..])),
+                        LightSamples {
+                            lobes: Lobes::All,
+                            competing: Competing {
+                                emissive: &[Lobes::All],
+                                environment: self
+                                    .settings
+                                    .environment_sampling
+                                    .then_some((Lobes::All, &[Lobes::All][..])),
+                            },
+                            count: 1,
                         },
-                        1,
                         sampler,
                     );
             }
@@ -149,11 +151,13 @@ impl PathTracer {
         placed: &PlacedScene<'_>,
         camera: &(impl Camera + ?Sized),
     ) -> Image<RadianceSample> {
-        render_camera(
-            camera,
-            self.settings.samples_per_pixel,
-            self.settings.seed,
-            |ray, s, _| self.radiance(placed, ray, s),
-        )
+        let PathTracerSettings {
+            samples_per_pixel,
+            seed,
+            ..
+        } = self.settings;
+        render_camera(camera, samples_per_pixel, seed, |ray, s, _| {
+            self.radiance(placed, ray, s)
+        })
     }
 }

@@ -76,17 +76,10 @@ impl RadianceSample {
             hit.shading_normal
         };
         Self {
-            radiance: Vec3::ZERO,
             distance: hit.distance,
             object: hit.object,
             normal: n,
-            diffuse: Vec3::ZERO,
-            albedo: Vec3::ZERO,
-            lighting_variance: 0.0,
-            sun: Vec3::ZERO,
-            sun_diffuse: Vec3::ZERO,
-            ambient: Vec3::ZERO,
-            emission: Vec3::ZERO,
+            ..Self::MISS
         }
     }
 }

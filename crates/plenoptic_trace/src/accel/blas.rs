@@ -10,6 +10,25 @@ use obvhs::{
 use plenoptic_scene::Mesh;
 use std::time::Duration;
 
+/// A CWBVH over `tris` (obvhs's medium-quality build) and its triangles in BVH order, each
+/// made by `triangle(index in tris, triangle)`.
+pub(crate) fn build_bvh<T>(
+    tris: &[Triangle],
+    triangle: impl Fn(u32, &Triangle) -> T,
+) -> (CwBvh, Vec<T>) {
+    let bvh = build_cwbvh_from_tris(
+        tris,
+        BvhBuildParams::medium_build(),
+        &mut Duration::default(),
+    );
+    let triangles = bvh
+        .primitive_indices
+        .iter()
+        .map(|&i| triangle(i, &tris[i as usize]))
+        .collect();
+    (bvh, triangles)
+}
+
 /// A triangle in BVH order with the index of the triangle it came from.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct BlasTriangle {
@@ -88,24 +107,12 @@ impl Blas {
                 v2: mesh.positions[t[2] as usize].into(),
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
-        let triangles = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| {
-                let t = &tris[i as usize];
-                BlasTriangle {
-                    v0: t.v0,
-                    e1: t.v1 - t.v0,
-                    e2: t.v2 - t.v0,
-                    index: i,
-                }
-            })
-            .collect();
+        let (bvh, triangles) = build_bvh(&tris, |i, t| BlasTriangle {
+            v0: t.v0,
+            e1: t.v1 - t.v0,
+            e2: t.v2 - t.v0,
+            index: i,
+        });
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for p in &mesh.positions {

@@ -3,13 +3,12 @@
 
 use glam::{Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams,
-    cwbvh::{CwBvh, builder::build_cwbvh_from_tris},
+    cwbvh::CwBvh,
     ray::{Ray as BvhRay, RayHit},
     triangle::Triangle,
 };
-use std::time::Duration;
 
+use super::blas::build_bvh;
 use super::{PlacedScene, Ray};
 
 /// A single obvhs CWBVH over the placed scene's triangles in world space.
@@ -33,16 +32,7 @@ impl FlatBvh {
                 tris.push(Triangle { v0, v1, v2 });
             }
         }
-        let bvh = build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
-        let triangles = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| tris[i as usize])
-            .collect();
+        let (bvh, triangles) = build_bvh(&tris, |_, t| *t);
         Self { bvh, triangles }
     }
 

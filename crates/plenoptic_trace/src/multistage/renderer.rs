@@ -37,7 +37,7 @@ use super::AmbientField;
 use crate::accel::{PlacedScene, Ray};
 use crate::camera::{Camera, CubeCamera};
 use crate::image::Image;
-use crate::light::{Competing, estimate_direct_split};
+use crate::light::{Competing, LightSamples, estimate_direct_split};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::render::{PixelFilter, RadianceSample, render_camera, render_camera_filtered};
 use crate::sampling::{Sampler, power_heuristic};
@@ -154,7 +154,12 @@ impl<'f> MultiStageRenderer<'f> {
                 emissive: &[Lobes::Specular],
                 environment: Some((Lobes::Specular, &[Lobes::Specular])),
             };
-            let direct = estimate_direct_split(placed, &hit, &bsdf, Lobes::All, competing, n, s);
+            let light = LightSamples {
+                lobes: Lobes::All,
+                competing,
+                count: n,
+            };
+            let direct = estimate_direct_split(placed, &hit, &bsdf, light, s);
             l += direct.total;
             diffuse += direct.diffuse;
             if let Some(out) = first.as_deref_mut() {

@@ -48,7 +48,7 @@ use super::layout::FieldLayout;
 use super::visibility::{Blocked, blocked_edges, visible_weights};
 use crate::accel::{PlacedScene, Ray};
 use crate::image::luminance;
-use crate::light::{Competing, estimate_direct};
+use crate::light::{Competing, LightSamples, estimate_direct};
 use crate::material::{Bsdf, Lobes, SurfaceProps};
 use crate::sampling::{Frame, Sampler, cosine_hemisphere, power_heuristic};
 
@@ -58,11 +58,15 @@ use crate::sampling::{Frame, Sampler, cosine_hemisphere, power_heuristic};
 /// about half.
 const INSIDE_FRACTION: u32 = 8;
 
-/// Direct light at gather hits: lights and emitters, not the environment, which reaches the
-/// hit's own field point (E of the hit includes it) and so enters through K.
-const LIGHTS_ONLY: Competing<'static> = Competing {
-    emissive: &[],
-    environment: None,
+/// Direct light at gather hits, one sample each: lights and emitters, not the environment,
+/// which reaches the hit's own field point (E of the hit includes it) and so enters through K.
+const LIGHTS_ONLY: LightSamples<'static> = LightSamples {
+    lobes: Lobes::All,
+    competing: Competing {
+        emissive: &[],
+        environment: None,
+    },
+    count: 1,
 };
 
 /// What one gather point's rays found.
@@ -189,8 +193,7 @@ fn trace_ray(
             return out;
         }
         if !bsdf.is_delta(Lobes::All) {
-            out.light +=
-                throughput * estimate_direct(placed, &hit, &bsdf, Lobes::All, LIGHTS_ONLY, 1, s);
+            out.light += throughput * estimate_direct(placed, &hit, &bsdf, LIGHTS_ONLY, s);
         }
         // One sample of the whole BSDF: a delta lobe carries the ray on; a non-delta lobe
         // ends it, its weight being a one-sample estimate of the non-delta albedo that
