@@ -558,7 +558,7 @@ fn spread_samples(path: &CameraPath, n: usize) -> Vec<PathSample> {
 #[cfg(feature = "bevy")]
 fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, BoxError> {
     use bevy_plenoptic::PlenopticSettings;
-    use bevy_plenoptic::streaming::schedule::{Lookahead, working_set};
+    use bevy_plenoptic::streaming::schedule::{BlockRef, KeyRef, Lookahead, working_set};
     use bevy_plenoptic::streaming::{key_bytes, volume_bytes};
 
     const MIB: f64 = 1024.0 * 1024.0;
@@ -570,6 +570,14 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
         seconds: settings.prefetch_seconds,
     };
     let usable = bevy_plenoptic::asset::usable_views(&reader);
+    // The decoded bytes of time keys and volume blocks (those the pack has).
+    let bytes = |keys: &[KeyRef], blocks: &[BlockRef]| -> u64 {
+        keys.iter().map(|&k| key_bytes(&reader, k)).sum::<u64>()
+            + blocks
+                .iter()
+                .filter_map(|&b| volume_bytes(&reader, b))
+                .sum::<u64>()
+    };
     let frames: Vec<PathSample> = path.frames().collect();
     let (mut needed_max, mut needed_sum, mut all_max) = (0u64, 0u64, 0u64);
     for (i, s) in frames.iter().enumerate() {
@@ -586,26 +594,8 @@ fn streaming_figures(pack: &Path, path: &CameraPath) -> Result<Option<String>, B
             direction,
             look,
         );
-        let needed: u64 = set
-            .needed
-            .iter()
-            .map(|&k| key_bytes(&reader, k))
-            .sum::<u64>()
-            + set
-                .volumes
-                .iter()
-                .filter_map(|&b| volume_bytes(&reader, b))
-                .sum::<u64>();
-        let prefetch: u64 = set
-            .prefetch
-            .iter()
-            .map(|&k| key_bytes(&reader, k))
-            .sum::<u64>()
-            + set
-                .volume_prefetch
-                .iter()
-                .filter_map(|&b| volume_bytes(&reader, b))
-                .sum::<u64>();
+        let needed = bytes(&set.needed, &set.volumes);
+        let prefetch = bytes(&set.prefetch, &set.volume_prefetch);
         needed_max = needed_max.max(needed);
         needed_sum += needed;
         all_max = all_max.max(needed + prefetch);

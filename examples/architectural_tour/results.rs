@@ -377,10 +377,10 @@ fn max(v: &[f64]) -> f64 {
 }
 
 /// A markdown row of one candidate's figures: corrected mean (best, worst), uncorrected
-/// mean, PSNR, SSIM, mean-luminance ratio range.
+/// mean, PSNR, SSIM, mean-luminance ratio range, low-frequency error mean (worst).
 fn metrics_row(m: &CandidateMetrics) -> String {
     format!(
-        "| {} | {:.3} ({:.3}, {:.3}) | {:.3} | {:.1} | {:.3} | {:.2}–{:.2} |",
+        "| {} | {:.3} ({:.3}, {:.3}) | {:.3} | {:.1} | {:.3} | {:.2}–{:.2} | {:.3} ({:.3}) |",
         m.label,
         m.mean_corrected_lrms(),
         min(&m.corrected_lrms),
@@ -389,13 +389,16 @@ fn metrics_row(m: &CandidateMetrics) -> String {
         m.mean_psnr(),
         m.mean_ssim(),
         min(&m.mean_ratio),
-        max(&m.mean_ratio)
+        max(&m.mean_ratio),
+        m.mean_low_frequency(),
+        max(&m.low_frequency)
     )
 }
 
 const METRICS_HEAD: &str = "| candidate | relative LRMS, variance-corrected: mean (best, worst) | \
-                            uncorrected mean | PSNR mean, dB | SSIM mean | mean-luminance ratio |\n\
-                            |---|---|---|---|---|---|";
+                            uncorrected mean | PSNR mean, dB | SSIM mean | mean-luminance ratio | \
+                            low-frequency error: mean (worst) |\n\
+                            |---|---|---|---|---|---|---|";
 
 /// The figures table (markdown).
 #[allow(
@@ -412,11 +415,60 @@ fn figures(
     comparison: &Comparison,
     crop: &Comparison,
 ) -> Result<String, BoxError> {
-    const MIB: f64 = 1024.0 * 1024.0;
     let reader = PackReader::open(pack)?;
     let manifest = reader.manifest();
-    let face = f64::from(manifest.bake.cube_face_size);
     let range_images: usize = manifest.base_views.iter().map(|v| v.time_keys.len()).sum();
+    let mut s = String::new();
+    writeln!(
+        s,
+        "Architectural tour: {} base views, {range_images} range images of 6 × {}², \
+         {} frames compared at {}×{} against a path-traced reference of two halves of {} spp \
+         each.\n",
+        manifest.base_views.len(),
+        f64::from(manifest.bake.cube_face_size),
+        samples.len(),
+        o.width,
+        o.height,
+        o.spp
+    )?;
+    let bake_total = bake_phases(&mut s, pack)?;
+    pack_size(&mut s, &reader, range_images)?;
+    errors(&mut s, path, o, timings, comparison, crop)?;
+    let speed_up = walkthrough(&mut s, path, o, reference, timings, bake_total)?;
+    if let Some(line) = crate::streaming_figures(pack, path)? {
+        writeln!(s, "\n{line}")?;
+    }
+    thesis_table(&mut s, comparison, speed_up)?;
+    Ok(s)
+}
+
+/// The bake's seconds per phase (from `<pack>.timings.json`) as a table; returns their total.
+fn bake_phases(s: &mut String, pack: &Path) -> Result<f64, BoxError> {
+    writeln!(s, "| bake phase | seconds |\n|---|---|")?;
+    let mut bake_total = 0.0;
+    let timings_file = PathBuf::from(format!("{}.timings.json", pack.display()));
+    match std::fs::read_to_string(&timings_file)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Map<String, serde_json::Value>>(&t).ok())
+    {
+        Some(map) => {
+            for (phase, v) in &map {
+                let secs = v.as_f64().unwrap_or(0.0);
+                bake_total += secs;
+                writeln!(s, "| {phase} | {secs:.1} |")?;
+            }
+            writeln!(s, "| total | {bake_total:.1} |\n")?;
+        }
+        None => writeln!(s, "| (no {} ) | |\n", timings_file.display())?,
+    }
+    Ok(bake_total)
+}
+
+/// The pack's size: the file, its range-image chunks stored and as texels, and the range
+/// images as rendered.
+fn pack_size(s: &mut String, reader: &PackReader, range_images: usize) -> std::fmt::Result {
+    const MIB: f64 = 1024.0 * 1024.0;
+    let face = f64::from(reader.manifest().bake.cube_face_size);
     // Every range-image cube: radiance, lighting and non-diffuse (pack 2.0), distance, id,
     // normal.
     let cube_chunks = |e: &&plenoptic_pack::ChunkEntry| e.kind.is_cube();
@@ -436,38 +488,6 @@ fn figures(
     // u32 id + RGB f32 normal.
     let raw = range_images as f64 * 6.0 * face * face * 56.0;
     let file = reader.file_length() as f64;
-
-    let mut s = String::new();
-    writeln!(
-        s,
-        "Architectural tour: {} base views, {range_images} range images of 6 × {face}², \
-         {} frames compared at {}×{} against a path-traced reference of two halves of {} spp \
-         each.\n",
-        manifest.base_views.len(),
-        samples.len(),
-        o.width,
-        o.height,
-        o.spp
-    )?;
-
-    writeln!(s, "| bake phase | seconds |\n|---|---|")?;
-    let mut bake_total = 0.0;
-    let timings_file = PathBuf::from(format!("{}.timings.json", pack.display()));
-    match std::fs::read_to_string(&timings_file)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Map<String, serde_json::Value>>(&t).ok())
-    {
-        Some(map) => {
-            for (phase, v) in &map {
-                let secs = v.as_f64().unwrap_or(0.0);
-                bake_total += secs;
-                writeln!(s, "| {phase} | {secs:.1} |")?;
-            }
-            writeln!(s, "| total | {bake_total:.1} |\n")?;
-        }
-        None => writeln!(s, "| (no {} ) | |\n", timings_file.display())?,
-    }
-
     writeln!(
         s,
         "Pack: {:.1} MiB; range-image chunks {:.1} MiB stored, {:.1} MiB as texels \
@@ -479,8 +499,19 @@ fn figures(
         texel_bytes as f64 / stored.max(1) as f64,
         raw / MIB,
         raw / stored.max(1) as f64
-    )?;
+    )
+}
 
+/// The errors along the tour and in the crop, the reference's noise floor, and the CPU
+/// time per frame of each mode.
+fn errors(
+    s: &mut String,
+    path: &CameraPath,
+    o: &ResultsOptions,
+    timings: &[ModeTiming],
+    comparison: &Comparison,
+    crop: &Comparison,
+) -> std::fmt::Result {
     writeln!(
         s,
         "Along the tour, against the mean of the two halves:\n\n{METRICS_HEAD}"
@@ -528,10 +559,19 @@ fn figures(
         s,
         "\nThe crop's noise floor: {:.3}.",
         crop.mean_noise_floor()
-    )?;
+    )
+}
 
-    // Walk-through construction vs path tracing every frame of the tour at the path's size.
-    // The reference took `seconds_per_frame` per half.
+/// Walk-through construction vs path tracing every frame of the tour at the path's size
+/// (the reference took `seconds_per_frame` per half); returns the speed-up.
+fn walkthrough(
+    s: &mut String,
+    path: &CameraPath,
+    o: &ResultsOptions,
+    reference: &plenoptic_bake::reference::ReferenceSummary,
+    timings: &[ModeTiming],
+    bake_total: f64,
+) -> Result<f64, std::fmt::Error> {
     let tour_frames = path.frame_count() as f64;
     let scale = f64::from(path.width * path.height) / f64::from(o.width * o.height);
     let path_traced = tour_frames * 2.0 * reference.seconds_per_frame * scale;
@@ -540,6 +580,7 @@ fn figures(
         .find(|t| t.name == "geometry")
         .map_or(0.0, |t| t.ms_full);
     let walkthrough = bake_total + tour_frames * geometry_ms / 1e3;
+    let speed_up = path_traced / walkthrough.max(1e-9);
     writeln!(
         s,
         "\nWalk-through of the whole tour ({tour_frames:.0} frames of {}×{}): bake {bake_total:.0} s \
@@ -553,13 +594,14 @@ fn figures(
         reference.seconds_per_frame,
         o.width,
         o.height,
-        path_traced / walkthrough.max(1e-9)
+        speed_up
     )?;
+    Ok(speed_up)
+}
 
-    if let Some(line) = crate::streaming_figures(pack, path)? {
-        writeln!(s, "\n{line}")?;
-    }
-
+/// Our figures beside the thesis's: the best spatial error, the temporal error and the
+/// walk-through speed-up.
+fn thesis_table(s: &mut String, comparison: &Comparison, speed_up: f64) -> std::fmt::Result {
     let geometry = comparison
         .candidates
         .iter()
@@ -584,7 +626,6 @@ fn figures(
             .fold(f64::INFINITY, f64::min),
         geometry.mean_corrected_lrms(),
         geometry.mean_lrms(),
-        path_traced / walkthrough.max(1e-9)
-    )?;
-    Ok(s)
+        speed_up
+    )
 }
