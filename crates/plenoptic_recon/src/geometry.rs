@@ -139,32 +139,49 @@ impl<'a> Pass<'a> {
     }
 }
 
-/// Renders one frame in geometry-assisted mode, from the proxies of `pass.layer` (a given
-/// `mask` is used whole).
-pub(crate) fn render(
-    rec: &Reconstructor,
-    camera: &Camera,
-    t: f32,
-    mask: Option<&GeometryMask>,
-    pass: Pass<'_>,
-    report: &mut Report,
-) -> Result<Frame> {
+/// The frame a geometry-assisted render makes: the reconstructor, the camera, the scene time
+/// and, where one was computed beforehand, the geometry mask (used whole).
+#[derive(Clone, Copy)]
+pub(crate) struct Shot<'a> {
+    pub rec: &'a Reconstructor,
+    pub camera: &'a Camera,
+    pub t: f32,
+    pub mask: Option<&'a GeometryMask>,
+}
+
+impl<'a> Shot<'a> {
+    /// The frame of `camera` at `t` reconstructed by `rec`, with `mask` if given.
+    pub fn new(
+        rec: &'a Reconstructor,
+        camera: &'a Camera,
+        t: f32,
+        mask: Option<&'a GeometryMask>,
+    ) -> Self {
+        Shot {
+            rec,
+            camera,
+            t,
+            mask,
+        }
+    }
+}
+
+/// Renders one frame in geometry-assisted mode, from the proxies of `pass.layer`.
+pub(crate) fn render(shot: Shot<'_>, pass: Pass<'_>, report: &mut Report) -> Result<Frame> {
     let pass = Pass {
         second: None,
         ..pass
     };
-    render_pair(rec, camera, t, mask, pass, report).map(|p| p.frame)
+    render_pair(shot, pass, report).map(|p| p.frame)
 }
 
 /// [`render`], with the colour of `pass.second` per pixel beside the frame.
 pub(crate) fn render_pair(
-    rec: &Reconstructor,
-    camera: &Camera,
-    t: f32,
-    mask: Option<&GeometryMask>,
+    shot: Shot<'_>,
     pass: Pass<'_>,
     report: &mut Report,
 ) -> Result<PairFrame> {
+    let Shot { rec, camera, t, .. } = shot;
     let start = Instant::now();
     let Some(proxy) = rec.proxy() else {
         return Err(Error::Unusable("no proxy geometry".into()));
@@ -177,42 +194,17 @@ pub(crate) fn render_pair(
     report.base_views = views;
     report.stage_ms.push(("setup".into(), ms(start)));
     let start = Instant::now();
-    // The mask: rasterized band by band inside the pixel loop, or given (computed
-    // beforehand, e.g. ray cast by plenoptic_eval).
-    let source = match mask {
-        None => MaskSource::Raster(match pass.layer {
-            Layer::All => proxy.project(camera, t),
-            Layer::Without(ids) => proxy.project_only(camera, t, |o| !ids.contains(&o)),
-            Layer::Only(ids) => proxy.project_only(camera, t, |o| ids.contains(&o)),
-        }),
-        Some(m) => MaskSource::Mask(m),
-    };
+    let source = mask_source(proxy, shot, pass.layer);
     report.stage_ms.push(("mask_setup".into(), ms(start)));
     let start = Instant::now();
     let (mut frame, mut plane2) = blank_frame(camera, pass.second.is_some());
     let fast = fast_keys(&keys, ids.len());
     let w = camera.width as usize;
-    let mut class = vec![HOLE; frame.radiance.len()];
     let basis = camera.basis();
     let tol = rec.settings.depth_tolerance;
-    let power = rec.settings.angular_power;
-    let power_int = if power.fract() == 0.0 && (1.0..=64.0).contains(&power) {
-        power as u32
-    } else {
-        0
-    };
+    let shade = shade(rec, &fast, pass.filter);
     let env = environment(rec, &keys, pass, report);
-    let (env_filter, bilinear) = (
-        pass.environment.map_or(pass.filter, |e| e.1),
-        pass.filter == CubeFilter::Bilinear,
-    );
-    let shade = Shade {
-        fast: &fast,
-        tol,
-        power,
-        power_int,
-        bilinear,
-    };
+    let env_filter = pass.environment.map_or(pass.filter, |e| e.1);
     let rows = Rows {
         basis: &basis,
         source: &source,
@@ -222,28 +214,15 @@ pub(crate) fn render_pair(
         env_bilinear: env_filter == CubeFilter::Bilinear,
         width: w,
     };
-    let band = ROWS * w.max(1);
-    // Sparse: the anchors' lookups first, at half resolution (sparse.rs), the mask
-    // rasterized on the way (its depths become distances along the rays).
-    let sparse = match &source {
-        MaskSource::Raster(tris) if pass.sparse && fast.len() <= 16 => Some(tris),
-        _ => None,
-    };
     let mut prims: Vec<u32> = Vec::new();
-    let anchors = sparse.map(|tris| {
-        let pass = sparse::AnchorPass {
-            tris,
-            rows: &rows,
-            shade: &shade,
-            band,
-        };
-        pass.run(&mut frame.depth, &mut frame.object, &mut prims)
-    });
+    let sparse = pass.sparse && fast.len() <= 16;
+    let anchors = anchor_pass(&rows, &shade, sparse, &mut frame, &mut prims);
     let lookups = Lookups {
         rows: &rows,
         shade: &shade,
         anchors: anchors.as_ref(),
     };
+    let mut class = vec![HOLE; frame.radiance.len()];
     let interpolated = lookups.run(&mut frame, &mut plane2, &mut class);
     report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
     let start = Instant::now();
@@ -290,6 +269,60 @@ pub(crate) fn render_pair(
         triangles,
         interpolated,
     })
+}
+
+/// Where a sparse pass rasterizes the proxies: the anchors' lookups, at half resolution
+/// (sparse.rs), with the mask rasterized on the way into `frame` (its depths become
+/// distances along the rays) and each pixel's triangle into `prims`.
+fn anchor_pass(
+    rows: &Rows<'_>,
+    shade: &Shade<'_>,
+    sparse: bool,
+    frame: &mut Frame,
+    prims: &mut Vec<u32>,
+) -> Option<sparse::Anchors> {
+    let MaskSource::Raster(tris) = rows.source else {
+        return None;
+    };
+    let pass = sparse::AnchorPass {
+        tris,
+        rows,
+        shade,
+        band: ROWS * rows.width.max(1),
+    };
+    sparse.then(|| pass.run(&mut frame.depth, &mut frame.object, prims))
+}
+
+/// The mask of `layer`: the proxies projected, to be rasterized band by band inside the
+/// pixel loop, or the shot's mask (computed beforehand, e.g. ray cast by plenoptic_eval).
+fn mask_source<'a>(proxy: &ProxyGeometry, shot: Shot<'a>, layer: Layer<'_>) -> MaskSource<'a> {
+    let (camera, t) = (shot.camera, shot.t);
+    match shot.mask {
+        None => MaskSource::Raster(match layer {
+            Layer::All => proxy.project(camera, t),
+            Layer::Without(ids) => proxy.project_only(camera, t, |o| !ids.contains(&o)),
+            Layer::Only(ids) => proxy.project_only(camera, t, |o| ids.contains(&o)),
+        }),
+        Some(m) => MaskSource::Mask(m),
+    }
+}
+
+/// How the pixel loop weighs and reads the `fast` keys: the settings' depth tolerance and
+/// angular power (as an integer power where it is one, which is faster), and the filter.
+fn shade<'a>(rec: &Reconstructor, fast: &'a [FastKey<'a>], filter: CubeFilter) -> Shade<'a> {
+    let power = rec.settings.angular_power;
+    let power_int = if power.fract() == 0.0 && (1.0..=64.0).contains(&power) {
+        power as u32
+    } else {
+        0
+    };
+    Shade {
+        fast,
+        tol: rec.settings.depth_tolerance,
+        power,
+        power_int,
+        bilinear: filter == CubeFilter::Bilinear,
+    }
 }
 
 /// A base view's temporal volume: its position, its view-space weight and its index.

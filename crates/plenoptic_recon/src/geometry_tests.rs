@@ -8,7 +8,7 @@ use common::{Materials, PackSpec, open_room, room, write_pack};
 use glam::Vec3;
 
 use crate::frame::Report;
-use crate::geometry::{self, Layer, Pass};
+use crate::geometry::{self, Layer, Pass, Shot};
 use crate::settings::CubeFilter;
 use crate::shading::Channel;
 use crate::{Camera, Reconstructor};
@@ -58,10 +58,7 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
         };
         let mut report = Report::default();
         let pair = geometry::render_pair(
-            &rec,
-            &camera,
-            0.6,
-            None,
+            Shot::new(&rec, &camera, 0.6, None),
             pass(Channel::Lighting, Some(Channel::NonDiffuse)),
             &mut report,
         )
@@ -69,7 +66,8 @@ fn a_pass_with_a_second_channel_gives_what_two_passes_give() {
         let (lighting, non_diffuse) = (pair.frame, pair.second);
         let alone = |channel| {
             let mut report = Report::default();
-            geometry::render(&rec, &camera, 0.6, None, pass(channel, None), &mut report)
+            let shot = Shot::new(&rec, &camera, 0.6, None);
+            geometry::render(shot, pass(channel, None), &mut report)
                 .unwrap()
                 .radiance
         };
@@ -108,10 +106,7 @@ fn a_pass_shows_the_environment_of_the_channel_asked_for() {
     for filter in [CubeFilter::Nearest, CubeFilter::Bilinear] {
         let mut report = Report::default();
         let pair = geometry::render_pair(
-            &rec,
-            &camera,
-            0.6,
-            None,
+            Shot::new(&rec, &camera, 0.6, None),
             Pass {
                 layer: Layer::All,
                 channel: Channel::Lighting,
@@ -126,10 +121,7 @@ fn a_pass_shows_the_environment_of_the_channel_asked_for() {
         .unwrap();
         assert!(pair.environment);
         let radiance = geometry::render(
-            &rec,
-            &camera,
-            0.6,
-            None,
+            Shot::new(&rec, &camera, 0.6, None),
             Pass {
                 skip: &all,
                 ..Pass::radiance(Layer::All, filter)
@@ -179,7 +171,8 @@ fn sparse_lighting_agrees_with_every_pixel() {
             sparse,
         };
         let mut report = Report::default();
-        let pair = geometry::render_pair(&rec, &camera, 0.6, None, pass, &mut report).unwrap();
+        let shot = Shot::new(&rec, &camera, 0.6, None);
+        let pair = geometry::render_pair(shot, pass, &mut report).unwrap();
         (pair, report.fallback)
     };
     let ((dense, dense_fallback), (sparse, sparse_fallback)) = (render(false), render(true));

@@ -44,7 +44,7 @@ use glam::Vec3;
 
 use crate::background::{self, Coverage};
 use crate::frame::{Frame, Report};
-use crate::geometry::Layer;
+use crate::geometry::{Layer, Shot};
 use crate::shading;
 use crate::shadow::ShadowScene;
 use crate::{Camera, Reconstructor, Result};
@@ -89,7 +89,8 @@ pub(crate) fn render(
     report: &mut Report,
 ) -> Result<Frame> {
     let ids: Vec<u32> = glazing.iter().map(|g| g.0).collect();
-    let mut behind = shading::render(rec, camera, t, None, Layer::Without(&ids), report)?;
+    let shot = Shot::new(rec, camera, t, None);
+    let mut behind = shading::render(shot, Layer::Without(&ids), report)?;
     background::apply(
         &rec.environment().at(t),
         camera,
@@ -98,7 +99,7 @@ pub(crate) fn render(
     );
     let start = std::time::Instant::now();
     let mut front_report = Report::default();
-    let front = shading::render(rec, camera, t, None, Layer::Only(&ids), &mut front_report)?;
+    let front = shading::render(shot, Layer::Only(&ids), &mut front_report)?;
     let crossings = rec.proxy().map(|proxy| {
         let scene = ShadowScene::of_objects(proxy, |id| ids.contains(&id));
         let placed = scene.at(proxy, t);

@@ -17,7 +17,7 @@ use crate::background::{self, Coverage, PackEnvironment};
 use crate::cache::{Cache, Cached};
 use crate::camera::Camera;
 use crate::frame::{FallbackReport, Frame, Mode, Report};
-use crate::geometry::Layer;
+use crate::geometry::{Layer, Shot};
 use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
 pub use crate::settings::{CubeFilter, ReconSettings, Shading};
@@ -452,7 +452,7 @@ impl Reconstructor {
                 return Ok((frame, report));
             }
             Mode::GeometryAssisted if self.proxy.is_some() => {
-                crate::shading::render(self, camera, t, None, Layer::All, &mut report)?
+                crate::shading::render(Shot::new(self, camera, t, None), Layer::All, &mut report)?
             }
             Mode::GeometryAssisted => {
                 report
@@ -496,8 +496,11 @@ impl Reconstructor {
             missing: self.proxy_missing.clone(),
             ..Report::default()
         };
-        let mut frame =
-            crate::shading::render(self, camera, t, Some(mask), Layer::All, &mut report)?;
+        let mut frame = crate::shading::render(
+            Shot::new(self, camera, t, Some(mask)),
+            Layer::All,
+            &mut report,
+        )?;
         let env = self.environment.at(t);
         background::apply(&env, camera, Coverage::Mask(mask), &mut frame);
         Ok((frame, report))

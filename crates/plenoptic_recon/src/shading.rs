@@ -47,16 +47,15 @@ use glam::Vec3;
 use plenoptic_pack::{ChunkKind, VolumeSample};
 use rayon::prelude::*;
 
+use crate::Result;
 use crate::brdf::{Bsdf, DELTA_ROUGHNESS};
-use crate::camera::Camera;
 use crate::frame::{Frame, Report};
-use crate::geometry::{self, Layer, Pass};
-use crate::proxy::{GeometryMask, ProxyGeometry};
+use crate::geometry::{self, Layer, Pass, Shot};
+use crate::proxy::ProxyGeometry;
 use crate::settings::{CubeFilter, Shading};
 use crate::specular::{self, Reflections};
 use crate::sun::PlacedSun;
 use crate::surface::{PixelGeometry, SharedRaster, SurfacePixel, Surfaces};
-use crate::{Reconstructor, Result};
 
 /// Which colour a geometry-assisted pass looks up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -100,21 +99,9 @@ impl Channel {
 
 /// Renders a geometry-assisted frame of the proxies of `layer`: with materials as the module
 /// doc says when the settings ask for it and the pack has materials, else from the radiance.
-pub(crate) fn render(
-    rec: &Reconstructor,
-    camera: &Camera,
-    t: f32,
-    mask: Option<&GeometryMask>,
-    layer: Layer<'_>,
-    report: &mut Report,
-) -> Result<Frame> {
-    let shot = Shot {
-        rec,
-        camera,
-        t,
-        mask,
-        layer,
-    };
+pub(crate) fn render(shot: Shot<'_>, layer: Layer<'_>, report: &mut Report) -> Result<Frame> {
+    let rec = shot.rec;
+    let shot = Layered { shot, layer };
     let materials = rec.materials();
     let proxy = match rec.proxy() {
         Some(p) if rec.settings.shading == Shading::Materials && !materials.is_empty() => p,
@@ -141,13 +128,9 @@ pub(crate) fn render(
     Ok(frame)
 }
 
-/// The frame a geometry-assisted render makes: the camera, the time, the mask computed
-/// beforehand if any, and the proxies rasterized.
-struct Shot<'a> {
-    rec: &'a Reconstructor,
-    camera: &'a Camera,
-    t: f32,
-    mask: Option<&'a GeometryMask>,
+/// A frame of the proxies of `layer`.
+struct Layered<'a> {
+    shot: Shot<'a>,
     layer: Layer<'a>,
 }
 
@@ -175,11 +158,11 @@ fn ms(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 
-impl Shot<'_> {
+impl Layered<'_> {
     /// The frame from the radiance alone.
     fn radiance_only(&self, report: &mut Report) -> Result<Frame> {
-        let pass = Pass::radiance(self.layer, self.rec.settings.cube_filter);
-        geometry::render(self.rec, self.camera, self.t, self.mask, pass, report)
+        let pass = Pass::radiance(self.layer, self.shot.rec.settings.cube_filter);
+        geometry::render(self.shot, pass, report)
     }
 
     /// A pass of `channel` skipping `skip`. The lighting is smooth and at cube resolution:
@@ -194,7 +177,7 @@ impl Shot<'_> {
             environment: None,
             sparse: false,
             filter: if channel == Channel::Radiance {
-                self.rec.settings.cube_filter
+                self.shot.rec.settings.cube_filter
             } else {
                 CubeFilter::Bilinear
             },
@@ -211,7 +194,7 @@ impl Shot<'_> {
         report: &mut Report,
         stages: &mut Vec<(String, f64)>,
     ) -> Result<Option<Passes>> {
-        let rec = self.rec;
+        let rec = self.shot.rec;
         let materials = rec.materials();
         let (lit, unlit): (Vec<u32>, Vec<u32>) = proxy
             .object_ids()
@@ -228,8 +211,7 @@ impl Shot<'_> {
             sparse: rec.settings.sparse_lighting,
             ..self.pass(Channel::Lighting, &unlit)
         };
-        let (camera, t, mask) = (self.camera, self.t, self.mask);
-        let both = geometry::render_pair(rec, camera, t, mask, fused, &mut side);
+        let both = geometry::render_pair(self.shot, fused, &mut side);
         stages.push(("lighting_pass".to_string(), ms(start)));
         let pair = match both {
             Ok(pair) => pair,
@@ -249,7 +231,7 @@ impl Shot<'_> {
             (pair.frame, None, pair.triangles)
         } else {
             let radiance = self.pass(Channel::Radiance, &lit);
-            let frame = geometry::render(rec, camera, t, mask, radiance, report)?;
+            let frame = geometry::render(self.shot, radiance, report)?;
             // The same proxies rasterized the same way: the same objects per pixel.
             debug_assert_eq!(frame.object, pair.frame.object);
             (frame, Some(pair.frame.radiance), None)
@@ -274,7 +256,7 @@ impl Shot<'_> {
         report: &mut Report,
         stages: &mut Vec<(String, f64)>,
     ) -> f64 {
-        let (rec, camera, t) = (self.rec, self.camera, self.t);
+        let Shot { rec, camera, t, .. } = self.shot;
         let start = Instant::now();
         let sun = rec.runtime_sun().zip(rec.proxy_rays()).map(|(s, shadows)| {
             let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
