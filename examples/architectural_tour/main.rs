@@ -332,9 +332,8 @@ fn run(options: &Options) -> Result<(), BoxError> {
     render_headless(options, &pack)
 }
 
-/// Opens the window (the `window` feature), exposed like the headless frames.
-#[cfg(feature = "window")]
-fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
+/// The tour's camera path, at the frame size the options ask for.
+fn tour_path(options: &Options) -> Result<CameraPath, BoxError> {
     let mut path = CameraPath::load(assets().join("tour_path.json"))?;
     if let Some(w) = options.width {
         path.width = w;
@@ -342,6 +341,13 @@ fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
     if let Some(h) = options.height {
         path.height = h;
     }
+    Ok(path)
+}
+
+/// Opens the window (the `window` feature), exposed like the headless frames.
+#[cfg(feature = "window")]
+fn windowed(options: &Options, pack: &Path) -> Result<(), BoxError> {
+    let path = tour_path(options)?;
     // The exposure of the first frame shown, from a small CPU reconstruction.
     let start = path.sample(if options.screenshot.is_some() {
         options.screenshot_at
@@ -434,13 +440,7 @@ fn print_plan(recipe_path: &Path) -> Result<(), BoxError> {
 
 /// Renders the camera path with the CPU reconstruction into PNG frames and `tour.gif`.
 fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
-    let mut path = CameraPath::load(assets().join("tour_path.json"))?;
-    if let Some(w) = options.width {
-        path.width = w;
-    }
-    if let Some(h) = options.height {
-        path.height = h;
-    }
+    let path = tour_path(options)?;
     let (start, end) = path.time_range();
     let samples: Vec<PathSample> = match options.frames {
         None => path.frames().collect(),

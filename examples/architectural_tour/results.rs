@@ -245,14 +245,7 @@ pub fn run(
     }
 
     // 3. Errors and the plot, against the mean of the halves.
-    let comparison = compare_with(
-        &ref_a,
-        Some(&ref_b),
-        &candidates,
-        &dir.join("tour_error.csv"),
-        &dir.join("tour_error.png"),
-    )?;
-    print!("{}", comparison.table());
+    let comparison = compare(&ref_a, &ref_b, &candidates, dir, "tour_error")?;
 
     // 4. The montage.
     montage(
@@ -291,14 +284,7 @@ pub fn run(
         crop_ref.exposure,
         o.supersampling,
     )?;
-    let crop = compare_with(
-        &crop_a,
-        Some(&crop_b),
-        &crop_candidates,
-        &crop_dir.join("crop_error.csv"),
-        &crop_dir.join("crop_error.png"),
-    )?;
-    print!("{}", crop.table());
+    let crop = compare(&crop_a, &crop_b, &crop_candidates, &crop_dir, "crop_error")?;
     montage(&crop_a, &crop_candidates, samples, &dir.join("crop.png"))?;
 
     // 6. Figures.
@@ -399,6 +385,27 @@ const METRICS_HEAD: &str = "| candidate | relative LRMS, variance-corrected: mea
                             uncorrected mean | PSNR mean, dB | SSIM mean | mean-luminance ratio | \
                             low-frequency error: mean (worst) |\n\
                             |---|---|---|---|---|---|---|";
+
+/// Compares `candidates` with the mean of the reference halves `a` and `b`, writes
+/// `<stem>.csv` and the plot `<stem>.png` in `dir`, and prints the table.
+fn compare(
+    a: &Path,
+    b: &Path,
+    candidates: &[(String, PathBuf)],
+    dir: &Path,
+    stem: &str,
+) -> Result<Comparison, BoxError> {
+    let csv = dir.join(format!("{stem}.csv"));
+    let comparison = compare_with(
+        a,
+        Some(b),
+        candidates,
+        &csv,
+        &dir.join(format!("{stem}.png")),
+    )?;
+    print!("{}", comparison.table());
+    Ok(comparison)
+}
 
 /// The figures table (markdown).
 #[allow(
