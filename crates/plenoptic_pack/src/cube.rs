@@ -24,6 +24,9 @@ use glam::{Vec2, Vec3};
 
 /// Maps a direction (need not be unit length, must be non-zero) to `(face, u, v)`.
 /// A zero or non-finite direction maps to face 0 centre.
+///
+/// Inlined into callers in other crates: the reconstruction's per-pixel loops call it.
+#[inline(always)]
 pub fn direction_to_face_uv(dir: Vec3) -> (usize, f32, f32) {
     let a = dir.abs();
     let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
@@ -52,17 +55,24 @@ pub fn direction_to_face_uv(dir: Vec3) -> (usize, f32, f32) {
 /// Maps `(face, u, v)` to the unit direction through that point of the face. Faces ≥ 6 are
 /// taken modulo 6.
 pub fn face_uv_to_direction(face: usize, u: f32, v: f32) -> Vec3 {
+    face_plane_direction(face % 6, u, v).normalize()
+}
+
+/// The direction through `(u, v)` on the plane of face `face` (at distance 1 from the
+/// centre), not normalized; `u` and `v` may lie outside [0, 1], which reaches beyond the
+/// face's edges (as seamless filtering does). Faces ≥ 5 are −Z.
+#[inline]
+pub fn face_plane_direction(face: usize, u: f32, v: f32) -> Vec3 {
     let sc = 2.0 * u - 1.0;
     let tc = 2.0 * v - 1.0;
-    let d = match face % 6 {
+    match face {
         0 => Vec3::new(1.0, -tc, -sc),
         1 => Vec3::new(-1.0, -tc, sc),
         2 => Vec3::new(sc, 1.0, tc),
         3 => Vec3::new(sc, -1.0, -tc),
         4 => Vec3::new(sc, -tc, 1.0),
         _ => Vec3::new(-sc, -tc, -1.0),
-    };
-    d.normalize()
+    }
 }
 
 /// Unit direction through the centre of texel `index` (as laid out in a cube of face size `n`).
@@ -79,6 +89,9 @@ pub fn texel_direction(face_size: u32, index: usize) -> Vec3 {
 }
 
 /// Index of the texel of a cube of face size `n` that direction `dir` falls in.
+///
+/// Inlined into callers in other crates: the reconstruction's per-pixel loops call it.
+#[inline(always)]
 pub fn direction_to_texel(face_size: u32, dir: Vec3) -> usize {
     let n = face_size.max(1) as usize;
     let (face, u, v) = direction_to_face_uv(dir);

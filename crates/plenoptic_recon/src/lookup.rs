@@ -606,9 +606,9 @@ fn powi4(mut c: Vec4, mut k: u32) -> Vec4 {
     }
 }
 
-/// Cube texel addressing four directions at a time: [`sample::texel`] with selects instead
+/// Cube texel addressing four directions at a time: [`cube::direction_to_texel`] with selects instead
 /// of branches, and the index computed in f32 (exact for cubes of fewer than 2²³ texels, face
-/// size ≤ 1182; larger cubes take [`sample::texel`] lane by lane).
+/// size ≤ 1182; larger cubes take [`cube::direction_to_texel`] lane by lane).
 struct CubeLanes {
     face_size: u32,
     n: Vec4,
@@ -645,7 +645,7 @@ impl CubeLanes {
         if !self.exact {
             let (x, y, z) = (x.to_array(), y.to_array(), z.to_array());
             let t = std::array::from_fn(|i| {
-                sample::texel(self.face_size, Vec3::new(x[i], y[i], z[i])) as u32
+                cube::direction_to_texel(self.face_size, Vec3::new(x[i], y[i], z[i])) as u32
             });
             return (t, none.0, none.1, none.2);
         }
@@ -677,7 +677,7 @@ impl CubeLanes {
         (t, first, s - i0, r - j0)
     }
 
-    /// `(face, u, v)` of directions (x, y, z), as [`sample::face_uv`] computes them.
+    /// `(face, u, v)` of directions (x, y, z), as [`cube::direction_to_face_uv`] computes them.
     #[inline(always)]
     fn face_uv(&self, x: Vec4, y: Vec4, z: Vec4) -> (Vec4, Vec4, Vec4) {
         let sel = Vec4::select;

@@ -1,9 +1,5 @@
-//! Cube lookups for the per-pixel loops, in the pack's cube convention
+//! Seamless bilinear cube lookups for the per-pixel loops, in the pack's cube convention
 //! ([`plenoptic_pack::cube`]: KTX2/Vulkan face order and face selection).
-//!
-//! [`face_uv`] and [`texel`] compute exactly what `cube::direction_to_face_uv` and
-//! `cube::direction_to_texel` compute, but inline into the callers' loops (the pack's functions
-//! are not inlined across crates).
 //!
 //! [`bilinear_taps`] is the seamless bilinear filter: the four texels around a direction and
 //! their weights, where a tap that falls off the face is taken from the neighbouring face
@@ -13,52 +9,14 @@
 
 use glam::Vec3;
 use plenoptic_pack::CubeImage;
-
-/// `(face, u, v)` of a direction; the same arithmetic as `cube::direction_to_face_uv` (a zero or
-/// non-finite direction maps to face 0 centre).
-#[inline(always)]
-pub(crate) fn face_uv(dir: Vec3) -> (usize, f32, f32) {
-    let a = dir.abs();
-    let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
-        if dir.x >= 0.0 {
-            (0, -dir.z, -dir.y, a.x)
-        } else {
-            (1, dir.z, -dir.y, a.x)
-        }
-    } else if a.y >= a.z {
-        if dir.y >= 0.0 {
-            (2, dir.x, dir.z, a.y)
-        } else {
-            (3, dir.x, -dir.z, a.y)
-        }
-    } else if dir.z >= 0.0 {
-        (4, dir.x, -dir.y, a.z)
-    } else {
-        (5, -dir.x, -dir.y, a.z)
-    };
-    if !(ma > 0.0 && ma.is_finite()) {
-        return (0, 0.5, 0.5);
-    }
-    (face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0))
-}
-
-/// Index of the texel of a cube of face size `n` that `dir` falls in; equals
-/// `cube::direction_to_texel(n, dir)`.
-#[inline(always)]
-pub(crate) fn texel(face_size: u32, dir: Vec3) -> usize {
-    let n = face_size.max(1) as usize;
-    let (face, u, v) = face_uv(dir);
-    let i = ((u * n as f32) as usize).min(n - 1);
-    let j = ((v * n as f32) as usize).min(n - 1);
-    face * n * n + j * n + i
-}
+use plenoptic_pack::cube::{direction_to_face_uv, direction_to_texel, face_plane_direction};
 
 /// The four texels of a cube of face size `n` around direction `dir` and their bilinear
 /// weights (summing to 1), seamless across faces (module docs).
 pub(crate) fn bilinear_taps(face_size: u32, dir: Vec3) -> [(usize, f32); 4] {
     let n = face_size.max(1) as i64;
     let nf = n as f32;
-    let (face, u, v) = face_uv(dir);
+    let (face, u, v) = direction_to_face_uv(dir);
     let (s, t) = (u * nf - 0.5, v * nf - 0.5);
     let (i0, j0) = (s.floor(), t.floor());
     let (fx, fy) = (s - i0, t - j0);
@@ -80,8 +38,8 @@ pub(crate) fn bilinear_taps(face_size: u32, dir: Vec3) -> [(usize, f32); 4] {
             face * (n * n) as usize + (j * n + i) as usize
         } else if in_i || in_j {
             // Off one edge: the neighbouring face's texel in the tap's direction.
-            let d = face_uv_direction(face, (i as f32 + 0.5) / nf, (j as f32 + 0.5) / nf);
-            texel(face_size, d)
+            let d = face_plane_direction(face, (i as f32 + 0.5) / nf, (j as f32 + 0.5) / nf);
+            direction_to_texel(face_size, d)
         } else {
             continue; // a cube corner: no fourth texel
         };
@@ -93,23 +51,14 @@ pub(crate) fn bilinear_taps(face_size: u32, dir: Vec3) -> [(usize, f32); 4] {
             t.1 /= total;
         }
     } else {
-        taps = [(texel(face_size, dir), 1.0), (0, 0.0), (0, 0.0), (0, 0.0)];
+        taps = [
+            (direction_to_texel(face_size, dir), 1.0),
+            (0, 0.0),
+            (0, 0.0),
+            (0, 0.0),
+        ];
     }
     taps
-}
-
-/// The direction through `(u, v)` on face `face`'s plane, `u`, `v` not limited to [0, 1] (the
-/// inverse of [`face_uv`]; not normalized).
-fn face_uv_direction(face: usize, u: f32, v: f32) -> Vec3 {
-    let (sc, tc) = (2.0 * u - 1.0, 2.0 * v - 1.0);
-    match face {
-        0 => Vec3::new(1.0, -tc, -sc),
-        1 => Vec3::new(-1.0, -tc, sc),
-        2 => Vec3::new(sc, 1.0, tc),
-        3 => Vec3::new(sc, -1.0, -tc),
-        4 => Vec3::new(sc, -tc, 1.0),
-        _ => Vec3::new(-sc, -tc, -1.0),
-    }
 }
 
 /// Seamless bilinear lookup of a radiance cube in direction `dir`.
@@ -123,45 +72,10 @@ pub(crate) fn bilinear(cube: &CubeImage<Vec3>, dir: Vec3) -> Vec3 {
     c
 }
 
-/// The same as `cube::face_uv_to_direction` for faces 0..6 up to normalization (checked in
-/// the tests).
-#[cfg(test)]
-fn reference_direction(face: usize, u: f32, v: f32) -> Vec3 {
-    plenoptic_pack::cube::face_uv_to_direction(face, u, v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use plenoptic_pack::cube;
-
-    #[test]
-    fn texel_agrees_with_the_reference() {
-        let mut s = 12345u32;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s as f32 / u32::MAX as f32 * 2.0 - 1.0
-        };
-        for _ in 0..20000 {
-            let d = Vec3::new(rnd(), rnd(), rnd());
-            for n in [1, 16, 128] {
-                assert_eq!(texel(n, d), cube::direction_to_texel(n, d), "{d}");
-            }
-            assert_eq!(face_uv(d), cube::direction_to_face_uv(d));
-        }
-        assert_eq!(
-            texel(8, Vec3::ZERO),
-            cube::direction_to_texel(8, Vec3::ZERO)
-        );
-        for f in 0..6 {
-            for (u, v) in [(0.1, 0.7), (0.5, 0.5), (0.93, 0.02)] {
-                let d = face_uv_direction(f, u, v).normalize();
-                assert!(d.abs_diff_eq(reference_direction(f, u, v), 1e-6));
-            }
-        }
-    }
 
     /// The smooth function of direction the test cubes hold.
     fn smooth(d: Vec3) -> Vec3 {

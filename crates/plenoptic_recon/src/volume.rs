@@ -70,7 +70,7 @@ impl BlockBins {
         let bin: Vec<usize> = block
             .samples
             .iter()
-            .map(|s| crate::sample::texel(BIN_FACE, s.direction))
+            .map(|s| cube::direction_to_texel(BIN_FACE, s.direction))
             .collect();
         let mut offsets = vec![0u32; bins + 1];
         for &b in &bin {
@@ -194,7 +194,7 @@ impl VolumeIndex {
             return None;
         }
         let dir = d / dist;
-        let b = crate::sample::texel(BIN_FACE, dir);
+        let b = cube::direction_to_texel(BIN_FACE, dir);
         let bin_angle = 2.0 / BIN_FACE as f32;
         let (mut sum, mut sum2, mut ws) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         for bins in &self.blocks {

@@ -131,7 +131,7 @@ impl Rows<'_> {
                 rad[x] = if self.env_bilinear {
                     sample::bilinear(env, dir)
                 } else {
-                    env.texels[sample::texel(env.face_size, dir)]
+                    env.texels[plenoptic_pack::cube::direction_to_texel(env.face_size, dir)]
                 };
             }
         }
