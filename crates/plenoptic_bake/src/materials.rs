@@ -199,26 +199,19 @@ fn stored_image(t: &plenoptic_scene::Texture, space: ColourSpace) -> Result<Text
 /// The UVs and tangents of every proxy mesh whose mesh has UVs (see the module doc); object
 /// ids as the proxies'.
 pub fn proxy_attributes(scene: &Scene) -> Vec<ProxyAttributes> {
-    scene
-        .objects
-        .iter()
-        .enumerate()
-        .filter_map(|(i, o)| {
-            let mesh = scene.meshes.get(o.mesh)?;
-            let n = mesh.positions.len();
-            if mesh.triangles.is_empty() || mesh.uvs.len() != n {
-                return None;
-            }
-            let tangents = if mesh.tangents.len() == n {
+    crate::write::proxied_objects(scene)
+        .filter(|(_, mesh)| mesh.uvs.len() == mesh.positions.len())
+        .map(|(object_id, mesh)| {
+            let tangents = if mesh.tangents.len() == mesh.positions.len() {
                 mesh.tangents.clone()
             } else {
                 mesh.uv_tangents()
             };
-            Some(ProxyAttributes {
-                object_id: crate::render::pack_object_id(i as u32),
+            ProxyAttributes {
+                object_id,
                 uvs: mesh.uvs.clone(),
                 tangents,
-            })
+            }
         })
         .collect()
 }

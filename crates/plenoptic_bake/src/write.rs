@@ -29,7 +29,7 @@ use plenoptic_pack::{
     encode_connectivity, encode_distance, encode_normal, encode_object_id, encode_radiance,
     encode_volume_block,
 };
-use plenoptic_scene::Scene;
+use plenoptic_scene::{Mesh, Scene};
 use plenoptic_trace::SceneAccel;
 
 use crate::error::{BakeError, Result};
@@ -182,23 +182,23 @@ pub fn object_coverage(scene: &Scene, index: usize) -> Option<f32> {
     (mean < 0.999).then_some(mean.max(1e-3))
 }
 
+/// Every object with a proxy: its pack object id and its mesh, which has triangles.
+pub(crate) fn proxied_objects(scene: &Scene) -> impl Iterator<Item = (u32, &Mesh)> {
+    scene.objects.iter().enumerate().filter_map(|(i, o)| {
+        let mesh = scene.meshes.get(o.mesh)?;
+        let id = crate::render::pack_object_id(i as u32);
+        (!mesh.triangles.is_empty()).then_some((id, mesh))
+    })
+}
+
 /// The proxy mesh of every object with triangles (object-space positions, indices, normals).
 pub fn proxy_meshes(scene: &Scene) -> Vec<ProxyMesh> {
-    scene
-        .objects
-        .iter()
-        .enumerate()
-        .filter_map(|(i, o)| {
-            let mesh = scene.meshes.get(o.mesh)?;
-            if mesh.triangles.is_empty() {
-                return None;
-            }
-            Some(ProxyMesh {
-                object_id: crate::render::pack_object_id(i as u32),
-                positions: mesh.positions.clone(),
-                indices: mesh.triangles.iter().flatten().copied().collect(),
-                normals: (mesh.normals.len() == mesh.positions.len()).then(|| mesh.normals.clone()),
-            })
+    proxied_objects(scene)
+        .map(|(object_id, mesh)| ProxyMesh {
+            object_id,
+            positions: mesh.positions.clone(),
+            indices: mesh.triangles.iter().flatten().copied().collect(),
+            normals: (mesh.normals.len() == mesh.positions.len()).then(|| mesh.normals.clone()),
         })
         .collect()
 }

@@ -148,14 +148,12 @@ impl<'s> RayCastMask<'s> {
     /// The geometry mask of `camera` over already placed proxies.
     pub fn mask_placed(&self, placed: &PlacedScene<'_>, camera: &Camera) -> GeometryMask {
         let b = camera.basis();
-        let (w, h) = (camera.width as usize, camera.height as usize);
-        let mut object = vec![0u32; w * h];
-        let mut position = vec![Vec3::ZERO; w * h];
-        let mut depth = vec![f32::INFINITY; w * h];
-        object
+        let w = camera.width as usize;
+        let mut mask = GeometryMask::empty(camera.width, camera.height);
+        mask.object
             .par_chunks_mut(w)
-            .zip(position.par_chunks_mut(w))
-            .zip(depth.par_chunks_mut(w))
+            .zip(mask.position.par_chunks_mut(w))
+            .zip(mask.depth.par_chunks_mut(w))
             .enumerate()
             .for_each(|(y, ((o, p), d))| {
                 for x in 0..w {
@@ -167,13 +165,7 @@ impl<'s> RayCastMask<'s> {
                     }
                 }
             });
-        GeometryMask {
-            width: camera.width,
-            height: camera.height,
-            object,
-            position,
-            depth,
-        }
+        mask
     }
 }
 

@@ -249,3 +249,17 @@ pub struct GeometryMask {
     /// Distance from the eye along the ray (∞ where none).
     pub depth: Vec<f32>,
 }
+
+impl GeometryMask {
+    /// A `width` × `height` mask in which no pixel sees proxy geometry.
+    pub fn empty(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            width,
+            height,
+            object: vec![0; n],
+            position: vec![Vec3::ZERO; n],
+            depth: vec![f32::INFINITY; n],
+        }
+    }
+}

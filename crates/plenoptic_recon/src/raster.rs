@@ -247,15 +247,13 @@ pub(crate) fn rasterize(
     objects: &[(u32, Affine3A, &TriangleMesh)],
 ) -> GeometryMask {
     let b = camera.basis();
-    let (w, h) = (camera.width as usize, camera.height as usize);
+    let w = camera.width as usize;
     let tris = project(camera, objects);
-    let mut object = vec![0u32; w * h];
-    let mut depth = vec![f32::INFINITY; w * h];
-    let mut position = vec![Vec3::ZERO; w * h];
-    object
+    let mut mask = GeometryMask::empty(camera.width, camera.height);
+    mask.object
         .par_chunks_mut(w * BAND)
-        .zip(depth.par_chunks_mut(w * BAND))
-        .zip(position.par_chunks_mut(w * BAND))
+        .zip(mask.depth.par_chunks_mut(w * BAND))
+        .zip(mask.position.par_chunks_mut(w * BAND))
         .enumerate()
         .for_each(|(band, ((obj, dep), pos))| {
             let y0 = band * BAND;
@@ -270,13 +268,7 @@ pub(crate) fn rasterize(
                 }
             }
         });
-    GeometryMask {
-        width: camera.width,
-        height: camera.height,
-        object,
-        position,
-        depth,
-    }
+    mask
 }
 
 /// Per pixel of `camera`'s image: the nearest of `tris`' objects (0: none), its triangle's
