@@ -606,9 +606,9 @@ fn powi4(mut c: Vec4, mut k: u32) -> Vec4 {
     }
 }
 
-/// Cube texel addressing four directions at a time: [`cube::direction_to_texel`] with selects instead
-/// of branches, and the index computed in f32 (exact for cubes of fewer than 2²³ texels, face
-/// size ≤ 1182; larger cubes take [`cube::direction_to_texel`] lane by lane).
+/// Cube texel addressing four directions at a time: [`cube::direction_to_texel`] with
+/// selects instead of branches, and the index computed in f32 (exact for cubes of fewer than
+/// 2²³ texels, face size ≤ 1182; larger cubes take [`cube::direction_to_texel`] lane by lane).
 struct CubeLanes {
     face_size: u32,
     n: Vec4,
