@@ -462,6 +462,115 @@ impl StreamCache {
             self.next_slot - 1
         })
     }
+
+    /// Marks `unit` of `pack` used this frame if it is resident; whether it is.
+    fn touch(&mut self, pack: AssetId<RadiancePack>, unit: Unit) -> bool {
+        let frame = self.frame;
+        let last_used = match unit {
+            Unit::Key(k) => self
+                .resident
+                .get_mut(&(pack, k.0, k.1))
+                .map(|r| &mut r.last_used),
+            Unit::Volume(b) => self
+                .volumes
+                .get_mut(&(pack, b.0, b.1))
+                .map(|r| &mut r.last_used),
+        };
+        let Some(last_used) = last_used else {
+            return false;
+        };
+        *last_used = frame;
+        true
+    }
+
+    /// Marks the resident units of `set` (of `pack`, read through `reader`) used this frame,
+    /// counts the needed ones found resident and missing in `residency`, and appends every
+    /// unit of `set` to `wanted`: the needed keys and volume blocks, then the prefetched
+    /// ones. Returns whether every needed unit is resident.
+    fn touch_working_set(
+        &mut self,
+        pack: AssetId<RadiancePack>,
+        reader: &Arc<PackReader>,
+        set: &schedule::WorkingSet,
+        residency: &mut Residency,
+        wanted: &mut Vec<Wanted>,
+    ) -> bool {
+        let needed = set
+            .needed
+            .iter()
+            .map(|&k| Unit::Key(k))
+            .chain(set.volumes.iter().map(|&b| Unit::Volume(b)))
+            .map(|unit| (unit, true));
+        let prefetch = set
+            .prefetch
+            .iter()
+            .map(|&k| Unit::Key(k))
+            .chain(set.volume_prefetch.iter().map(|&b| Unit::Volume(b)))
+            .map(|unit| (unit, false));
+        let mut complete = true;
+        for (unit, is_needed) in needed.chain(prefetch) {
+            let resident = self.touch(pack, unit);
+            if is_needed && resident {
+                residency.hits += 1;
+            } else if is_needed {
+                residency.misses += 1;
+                complete = false;
+            }
+            wanted.push((pack, reader.clone(), unit, is_needed));
+        }
+        complete
+    }
+
+    /// Whether `unit` of `pack` is resident or being read.
+    fn is_present(&self, pack: AssetId<RadiancePack>, unit: Unit) -> bool {
+        match unit {
+            Unit::Key((a, b)) => {
+                self.resident.contains_key(&(pack, a, b))
+                    || self.in_flight.contains_key(&(pack, a, b))
+            }
+            Unit::Volume((a, b)) => {
+                self.volumes.contains_key(&(pack, a, b))
+                    || self.volumes_in_flight.contains_key(&(pack, a, b))
+            }
+        }
+    }
+
+    /// Starts reading and decoding `unit` of `pack` on the [`IoTaskPool`] with `bytes`
+    /// reserved for it (a key also takes a slot); `cpu`: decode a key for `plenoptic_recon`.
+    fn spawn_read(
+        &mut self,
+        pack: AssetId<RadiancePack>,
+        reader: Arc<PackReader>,
+        unit: Unit,
+        bytes: u64,
+        cpu: bool,
+    ) {
+        let pool = IoTaskPool::get();
+        match unit {
+            Unit::Key(k) => {
+                let slot = self.alloc_slot();
+                let task = pool.spawn(async move {
+                    let start = Instant::now();
+                    let r = if cpu {
+                        decode_cpu_key(&reader, k)
+                    } else {
+                        decode_key(&reader, k)
+                    };
+                    (r, start.elapsed())
+                });
+                self.in_flight.insert((pack, k.0, k.1), (bytes, slot, task));
+            }
+            Unit::Volume(v) => {
+                let task = pool.spawn(async move {
+                    let start = Instant::now();
+                    let r = decode_volume(&reader, v);
+                    (r, start.elapsed())
+                });
+                self.volumes_in_flight
+                    .insert((pack, v.0, v.1), (bytes, task));
+            }
+        }
+    }
 }
 
 fn collect_finished(
@@ -542,6 +651,19 @@ fn collect_finished(
 /// Most reads in flight at once.
 const MAX_IN_FLIGHT: usize = 8;
 
+/// A unit some camera's working set asks for this frame: its pack, the pack's reader, the
+/// unit and whether it is needed now (else prefetched).
+type Wanted = (AssetId<RadiancePack>, Arc<PackReader>, Unit, bool);
+
+/// Needed keys and volume blocks found resident and missing this frame, over every camera.
+#[derive(Debug, Default)]
+struct Residency {
+    hits: u64,
+    misses: u64,
+    /// Whether some camera missed a needed unit.
+    stalled: bool,
+}
+
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn schedule_reads(
     mut cache: ResMut<StreamCache>,
@@ -556,119 +678,116 @@ fn schedule_reads(
     // The CPU backend's keys are decoded for plenoptic_recon, in the same budget.
     let cpu = backend.is_some_and(|b| b.0 == crate::Backend::Cpu);
     cache.frame += 1;
-    let frame = cache.frame;
     let budget = settings.memory_budget_bytes;
-    let (mut hits, mut misses, mut stalled) = (0u64, 0u64, false);
-    let mut wanted: Vec<(AssetId<RadiancePack>, Arc<PackReader>, Unit, bool)> = Vec::new();
+    let mut residency = Residency::default();
+    let mut wanted: Vec<Wanted> = Vec::new();
     for (cam, mut state, transform) in &mut cameras {
         let Some(pack) = packs.get(&cam.pack) else {
             continue;
         };
-        let id = cam.pack.id();
-        let position = transform.translation();
-        let dt = time.delta_secs();
-        let velocity = match state.last_position {
-            Some(p) if dt > 0.0 => (position - p) / dt,
-            _ => Vec3::ZERO,
-        };
-        state.last_position = Some(position);
-        let speed = match cam.playback {
-            crate::Playback::Clock { speed, .. } => speed,
-            crate::Playback::Manual => 0.0,
-        };
-        let mut set = working_set(
-            pack.reader.manifest(),
-            &pack.usable_views,
-            position,
-            velocity,
-            cam.time,
-            speed,
-            Lookahead {
-                settings: &cam.settings,
-                seconds: settings.prefetch_seconds,
-            },
+        let set = camera_working_set(
+            cam,
+            &mut state,
+            transform.translation(),
+            time.delta_secs(),
+            pack,
+            &settings,
         );
-        if cam.mode == crate::camera::ReconMode::Image {
-            // Image mode blends each view's keys with Bézier weights over up to four keys
-            // (`plenoptic_recon::temporal::bezier_weights`), not just the bracketing two.
-            let m = pack.reader.manifest();
-            let mut views: Vec<u32> = set.needed.iter().map(|k| k.0).collect();
-            views.dedup();
-            for v in views {
-                let times = &m.base_views[v as usize].time_keys;
-                for (k, _) in plenoptic_recon::temporal::bezier_weights(times, cam.time) {
-                    let key = (v, k as u32);
-                    if !set.needed.contains(&key) {
-                        set.needed.push(key);
-                    }
-                    set.prefetch.retain(|p| *p != key);
-                }
-            }
-        }
-        // Volume blocks are optional: only those the pack has.
-        let has = |b: &BlockRef| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some();
-        set.volumes.retain(has);
-        set.volume_prefetch.retain(has);
-        let mut complete = true;
-        for &k in &set.needed {
-            match cache.resident.get_mut(&(id, k.0, k.1)) {
-                Some(r) => {
-                    r.last_used = frame;
-                    hits += 1;
-                }
-                None => {
-                    misses += 1;
-                    complete = false;
-                }
-            }
-            wanted.push((id, pack.reader.clone(), Unit::Key(k), true));
-        }
-        for &b in &set.volumes {
-            match cache.volumes.get_mut(&(id, b.0, b.1)) {
-                Some(r) => {
-                    r.last_used = frame;
-                    hits += 1;
-                }
-                None => {
-                    misses += 1;
-                    complete = false;
-                }
-            }
-            wanted.push((id, pack.reader.clone(), Unit::Volume(b), true));
-        }
-        for &k in &set.prefetch {
-            if let Some(r) = cache.resident.get_mut(&(id, k.0, k.1)) {
-                r.last_used = frame;
-            }
-            wanted.push((id, pack.reader.clone(), Unit::Key(k), false));
-        }
-        for &b in &set.volume_prefetch {
-            if let Some(r) = cache.volumes.get_mut(&(id, b.0, b.1)) {
-                r.last_used = frame;
-            }
-            wanted.push((id, pack.reader.clone(), Unit::Volume(b), false));
-        }
-        stalled |= !complete;
+        let complete = cache.touch_working_set(
+            cam.pack.id(),
+            &pack.reader,
+            &set,
+            &mut residency,
+            &mut wanted,
+        );
+        residency.stalled |= !complete;
         state.complete = complete;
         state.working_set = set;
     }
-    // Needed keys and blocks first, then prefetch, each in the camera's priority order.
+    start_reads(&mut cache, &mut stats, wanted, cpu, budget);
+    report_residency(&cache, &mut stats, &mut diagnostics, &residency, budget);
+}
+
+/// This frame's working set of camera `cam` at `position` (its velocity estimated from
+/// `state`'s last position and the frame time `dt`): the bracketing keys, in image mode
+/// every key of the Bézier segments, and only the volume blocks the pack has.
+fn camera_working_set(
+    cam: &PlenopticCamera,
+    state: &mut StreamState,
+    position: Vec3,
+    dt: f32,
+    pack: &RadiancePack,
+    settings: &PlenopticSettings,
+) -> schedule::WorkingSet {
+    let velocity = match state.last_position {
+        Some(p) if dt > 0.0 => (position - p) / dt,
+        _ => Vec3::ZERO,
+    };
+    state.last_position = Some(position);
+    let speed = match cam.playback {
+        crate::Playback::Clock { speed, .. } => speed,
+        crate::Playback::Manual => 0.0,
+    };
+    let mut set = working_set(
+        pack.reader.manifest(),
+        &pack.usable_views,
+        position,
+        velocity,
+        cam.time,
+        speed,
+        Lookahead {
+            settings: &cam.settings,
+            seconds: settings.prefetch_seconds,
+        },
+    );
+    if cam.mode == crate::camera::ReconMode::Image {
+        need_bezier_keys(&mut set, pack, cam.time);
+    }
+    // Volume blocks are optional: only those the pack has.
+    let has = |b: &BlockRef| pack.reader.find(ChunkKind::VolumeBlock, b.0, b.1).is_some();
+    set.volumes.retain(has);
+    set.volume_prefetch.retain(has);
+    set
+}
+
+/// Image mode blends each view's keys with Bézier weights over up to four keys
+/// (`plenoptic_recon::temporal::bezier_weights`), not just the bracketing two: those at
+/// `time` become needed (and leave the prefetch list).
+fn need_bezier_keys(set: &mut schedule::WorkingSet, pack: &RadiancePack, time: f32) {
+    let m = pack.reader.manifest();
+    let mut views: Vec<u32> = set.needed.iter().map(|k| k.0).collect();
+    views.dedup();
+    for v in views {
+        let times = &m.base_views[v as usize].time_keys;
+        for (k, _) in plenoptic_recon::temporal::bezier_weights(times, time) {
+            let key = (v, k as u32);
+            if !set.needed.contains(&key) {
+                set.needed.push(key);
+            }
+            set.prefetch.retain(|p| *p != key);
+        }
+    }
+}
+
+/// Starts reads of the wanted units that are neither resident, in flight nor failed, needed
+/// ones first (each group in the cameras' priority order), while fewer than
+/// [`MAX_IN_FLIGHT`] are in flight. Each read's bytes are reserved first, evicting the least
+/// recently used units outside every working set to fit the budget; a unit that cannot fit
+/// is skipped.
+fn start_reads(
+    cache: &mut StreamCache,
+    stats: &mut StreamingStats,
+    mut wanted: Vec<Wanted>,
+    cpu: bool,
+    budget: u64,
+) {
     wanted.sort_by_key(|w| !w.3);
     let protected: Vec<_> = wanted.iter().map(|w| (w.0, w.2)).collect();
-    let pool = IoTaskPool::get();
     for (id, reader, unit, _) in wanted {
-        let (Unit::Key((a, b)) | Unit::Volume((a, b))) = unit;
-        let is_volume = matches!(unit, Unit::Volume(_));
-        let key = (id, a, b);
         if cache.in_flight.len() + cache.volumes_in_flight.len() >= MAX_IN_FLIGHT {
             break;
         }
-        let present = if is_volume {
-            cache.volumes.contains_key(&key) || cache.volumes_in_flight.contains_key(&key)
-        } else {
-            cache.resident.contains_key(&key) || cache.in_flight.contains_key(&key)
-        };
-        if present || cache.failed.contains_key(&(id, unit)) {
+        if cache.is_present(id, unit) || cache.failed.contains_key(&(id, unit)) {
             continue;
         }
         let bytes = match unit {
@@ -679,42 +798,30 @@ fn schedule_reads(
         if bytes > budget {
             continue;
         }
-        // Evict least recently used keys and blocks outside every working set until it fits.
-        while cache.committed_bytes() + bytes > budget && cache.evict_one(&protected, &mut stats) {}
+        while cache.committed_bytes() + bytes > budget && cache.evict_one(&protected, stats) {}
         if cache.committed_bytes() + bytes > budget {
             continue;
         }
-        match unit {
-            Unit::Key(k) => {
-                let slot = cache.alloc_slot();
-                let task = pool.spawn(async move {
-                    let start = Instant::now();
-                    let r = if cpu {
-                        decode_cpu_key(&reader, k)
-                    } else {
-                        decode_key(&reader, k)
-                    };
-                    (r, start.elapsed())
-                });
-                cache.in_flight.insert(key, (bytes, slot, task));
-            }
-            Unit::Volume(v) => {
-                let task = pool.spawn(async move {
-                    let start = Instant::now();
-                    let r = decode_volume(&reader, v);
-                    (r, start.elapsed())
-                });
-                cache.volumes_in_flight.insert(key, (bytes, task));
-            }
-        }
+        cache.spawn_read(id, reader, unit, bytes, cpu);
     }
+}
+
+/// Adds this frame's residency to the cumulative stats and the diagnostics.
+fn report_residency(
+    cache: &StreamCache,
+    stats: &mut StreamingStats,
+    diagnostics: &mut Diagnostics,
+    residency: &Residency,
+    budget: u64,
+) {
     let committed = cache.committed_bytes();
     debug_assert!(committed <= budget, "budget exceeded");
     stats.resident_bytes = committed;
     stats.peak_resident_bytes = stats.peak_resident_bytes.max(committed);
-    stats.hits += hits;
-    stats.misses += misses;
-    stats.stalls += stalled as u64;
+    stats.hits += residency.hits;
+    stats.misses += residency.misses;
+    stats.stalls += residency.stalled as u64;
+    let (hits, misses, stalled) = (residency.hits, residency.misses, residency.stalled);
     diagnostics.add_measurement(&RESIDENT_BYTES, || committed as f64);
     diagnostics.add_measurement(&HITS, || hits as f64);
     diagnostics.add_measurement(&MISSES, || misses as f64);
