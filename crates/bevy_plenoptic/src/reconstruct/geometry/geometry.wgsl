@@ -325,6 +325,30 @@ fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
     return rgb9e5_decode(texel.x);
 }
 
+// Lookup k of a point: where in its key the point is looked up.
+struct Lookup {
+    // Whether the point is away from the key's centre (else the lookup has no direction).
+    ok: bool,
+    // From the key's centre to the point carried to the key's time.
+    d: vec3<f32>,
+    // |d|.
+    dist: f32,
+    // The key texel in direction d: (column, row, face).
+    t: vec3<u32>,
+}
+
+// Lookup k of the point whose `object_point` is `local`, in keys of face size `n`.
+fn lookup_of(local: vec4<f32>, k: u32, n: u32) -> Lookup {
+    var l: Lookup;
+    l.d = carried(local, k) - cam.base[k].xyz;
+    l.dist = length(l.d);
+    l.ok = !(l.dist <= 1e-6);
+    if l.ok {
+        l.t = cube_texel(l.d, n);
+    }
+    return l;
+}
+
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
 fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let count = u32(cam.header.x);
@@ -332,17 +356,17 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let tol = cam.tuning.x;
     let power = cam.tuning.y;
     let to_eye = normalize(eye - p);
+    let local = object_point(p);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
-    let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = carried(local, k);
-        let d = q - cam.base[k].xyz;
-        let dist = length(d);
-        if dist <= 1e-6 {
+        let l = lookup_of(local, k, n);
+        if !l.ok {
             continue;
         }
-        let t = cube_texel(d, n);
+        let d = l.d;
+        let dist = l.dist;
+        let t = l.t;
         let layer = u32(cam.base[k].w) + t.z;
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0);
         if texel.z != object {
@@ -395,19 +419,18 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·colour, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
-    let count = u32(cam.header.x);
-    let n = u32(cam.header.y);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
+    let count = u32(cam.header.x);
+    let n = u32(cam.header.y);
     let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let q = carried(local, k);
-        let d = q - cam.base[k].xyz;
-        let dist = length(d);
-        if dist <= 1e-6 {
+        let l = lookup_of(local, k, n);
+        if !l.ok {
             continue;
         }
-        let t = cube_texel(d, n);
+        let dist = l.dist;
+        let t = l.t;
         let layer0 = u32(cam.base[k].w);
         var best = NO_TEXEL;
         var best_c = t;

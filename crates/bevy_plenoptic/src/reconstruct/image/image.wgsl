@@ -129,9 +129,15 @@ fn clear(@builtin(global_invocation_id) id: vec3<u32>) {
     splat_texels[j] = EMPTY;
 }
 
-// Pass 1: the nearest splat depth per (view, pixel).
-@compute @workgroup_size(64)
-fn splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+// The three splat passes.
+const PASS_DEPTH: u32 = 0u;
+const PASS_CENTRE: u32 = 1u;
+const PASS_TEXEL: u32 = 2u;
+
+// Splat pass `which` over the footprint of texel id.x of view id.y: PASS_DEPTH keeps the
+// nearest splat depth per (view, pixel); PASS_CENTRE, among the splats of the nearest surface
+// (within params.splat.x), the nearest centre; PASS_TEXEL writes the winning texel.
+fn splat_pass(id: vec3<u32>, which: u32) {
     let v = id.y;
     if v >= params.size.w {
         return;
@@ -145,58 +151,40 @@ fn splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var y = b.y; y <= b.w; y++) {
         for (var x = b.x; x <= b.z; x++) {
             let j = base + u32(y) * params.size.x + u32(x);
-            atomicMin(&splat_keys[2u * j], bitcast<u32>(s.z));
+            if which == PASS_DEPTH {
+                atomicMin(&splat_keys[2u * j], bitcast<u32>(s.z));
+                continue;
+            }
+            let zmin = bitcast<f32>(atomicLoad(&splat_keys[2u * j]));
+            if !(s.z <= zmin * (1.0 + params.splat.x)) {
+                continue;
+            }
+            let key = centre_key(s, x, y);
+            if which == PASS_CENTRE {
+                atomicMin(&splat_keys[2u * j + 1u], key);
+            } else if atomicLoad(&splat_keys[2u * j + 1u]) == key {
+                splat_texels[j] = id.x;
+            }
         }
     }
+}
+
+// Pass 1: the nearest splat depth per (view, pixel).
+@compute @workgroup_size(64)
+fn splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+    splat_pass(id, PASS_DEPTH);
 }
 
 // Pass 2: among the splats of the nearest surface (within params.splat.x), the nearest centre.
 @compute @workgroup_size(64)
 fn splat_centre(@builtin(global_invocation_id) id: vec3<u32>) {
-    let v = id.y;
-    if v >= params.size.w {
-        return;
-    }
-    let s = splat_of(v, id.x);
-    if !s.ok {
-        return;
-    }
-    let b = splat_bounds(s);
-    let base = v * pixel_count();
-    for (var y = b.y; y <= b.w; y++) {
-        for (var x = b.x; x <= b.z; x++) {
-            let j = base + u32(y) * params.size.x + u32(x);
-            let zmin = bitcast<f32>(atomicLoad(&splat_keys[2u * j]));
-            if s.z <= zmin * (1.0 + params.splat.x) {
-                atomicMin(&splat_keys[2u * j + 1u], centre_key(s, x, y));
-            }
-        }
-    }
+    splat_pass(id, PASS_CENTRE);
 }
 
 // Pass 3: the winning texel per (view, pixel).
 @compute @workgroup_size(64)
 fn splat_texel(@builtin(global_invocation_id) id: vec3<u32>) {
-    let v = id.y;
-    if v >= params.size.w {
-        return;
-    }
-    let s = splat_of(v, id.x);
-    if !s.ok {
-        return;
-    }
-    let b = splat_bounds(s);
-    let base = v * pixel_count();
-    for (var y = b.y; y <= b.w; y++) {
-        for (var x = b.x; x <= b.z; x++) {
-            let j = base + u32(y) * params.size.x + u32(x);
-            let zmin = bitcast<f32>(atomicLoad(&splat_keys[2u * j]));
-            if s.z <= zmin * (1.0 + params.splat.x)
-                && atomicLoad(&splat_keys[2u * j + 1u]) == centre_key(s, x, y) {
-                splat_texels[j] = id.x;
-            }
-        }
-    }
+    splat_pass(id, PASS_TEXEL);
 }
 
 // Radiance of texel `i` of view `v`: its keys blended with their weights.
