@@ -478,19 +478,13 @@ fn pack_size(s: &mut String, reader: &PackReader, range_images: usize) -> std::f
     let face = f64::from(reader.manifest().bake.cube_face_size);
     // Every range-image cube: radiance, lighting and non-diffuse (pack 2.0), distance, id,
     // normal.
-    let cube_chunks = |e: &&plenoptic_pack::ChunkEntry| e.kind.is_cube();
-    let stored: u64 = reader
+    let (stored, texel_bytes) = reader
         .entries()
         .iter()
-        .filter(cube_chunks)
-        .map(|e| e.length)
-        .sum();
-    let texel_bytes: u64 = reader
-        .entries()
-        .iter()
-        .filter(cube_chunks)
-        .map(|e| e.uncompressed_length)
-        .sum();
+        .filter(|e| e.kind.is_cube())
+        .fold((0u64, 0u64), |(s, t), e| {
+            (s + e.length, t + e.uncompressed_length)
+        });
     // A range image as rendered: RGB f32 radiance, lighting and non-diffuse + f32 distance +
     // u32 id + RGB f32 normal.
     let raw = range_images as f64 * 6.0 * face * face * 56.0;
