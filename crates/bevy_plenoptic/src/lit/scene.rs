@@ -61,7 +61,7 @@ use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
-use crate::reconstruct::geometry::frame::ObjectShading;
+use crate::reconstruct::geometry::frame::{self, ObjectShading};
 use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
 use crate::reconstruct::geometry::view::ViewBuffer;
 use crate::reconstruct::geometry::volume::VolumeBuffers;
@@ -475,23 +475,33 @@ fn update_lit_materials(
         let Ok((cam, view)) = cameras.get(object.camera) else {
             continue;
         };
-        let (Some(pack), Some(mat)) = (packs.get(cam.pack.id()), materials.get(&handle.0)) else {
+        let Some(pack) = packs.get(cam.pack.id()) else {
             continue;
         };
-        let ext = &mat.extension;
-        let params = ObjectShading {
-            id: object.id,
-            coverage: ext.coverage,
-            factors: ext.factors.as_ref(),
+        frame::rebind(&mut materials, &handle.0, object.id, (cam, pack), view);
+    }
+}
+
+impl frame::BindsView for LitMaterial {
+    fn shading(&self, id: u32) -> ObjectShading<'_> {
+        let e = &self.extension;
+        ObjectShading {
+            id,
+            coverage: e.coverage,
+            factors: e.factors.as_ref(),
         }
-        .params(cam, pack);
-        if (ext.params != params || ext.bindings != view.bindings || ext.view != view.buffer)
-            && let Some(mut mat) = materials.get_mut(&handle.0)
-        {
-            mat.extension.params = params;
-            mat.extension.bindings = view.bindings;
-            mat.extension.view = view.buffer.clone();
-        }
+    }
+
+    fn bound(&self) -> (&ObjectParams, u64, &Handle<ShaderBuffer>) {
+        let e = &self.extension;
+        (&e.params, e.bindings, &e.view)
+    }
+
+    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>) {
+        let e = &mut self.extension;
+        e.params = params;
+        e.bindings = bindings;
+        e.view = view;
     }
 }
 

@@ -10,6 +10,7 @@
 //! ([`plenoptic_recon::temporal::bracketing`]), over the keys that are resident and uploaded.
 
 use bevy::prelude::*;
+use bevy::render::storage::ShaderBuffer;
 use plenoptic_recon::temporal::bracketing;
 
 use super::view::{ViewParams, motion_slot};
@@ -160,6 +161,38 @@ impl ObjectShading<'_> {
             }
         }
         params
+    }
+}
+
+/// A material that binds one object's uniform and its camera's view buffer: the proxies'
+/// [`super::PlenopticMaterial`] and the lit meshes' material.
+pub(crate) trait BindsView {
+    /// Object `id` with the coverage and material this material was given.
+    fn shading(&self, id: u32) -> ObjectShading<'_>;
+    /// The object's uniform, the camera bindings' generation and the view buffer it binds.
+    fn bound(&self) -> (&ObjectParams, u64, &Handle<ShaderBuffer>);
+    /// Binds them.
+    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>);
+}
+
+/// Binds material `handle` to object `id`'s uniform as camera `cam` shows it from `pack` and
+/// to the camera's view `view`, writing the asset only when one of them changed: a written
+/// asset's bind group is prepared again (and `materials` is only marked changed then).
+pub(crate) fn rebind<M: Asset + BindsView>(
+    materials: &mut ResMut<Assets<M>>,
+    handle: &Handle<M>,
+    id: u32,
+    (cam, pack): (&PlenopticCamera, &RadiancePack),
+    view: &view::ViewBuffer,
+) {
+    let Some(m) = materials.get(handle) else {
+        return;
+    };
+    let params = m.shading(id).params(cam, pack);
+    let (bound, bindings, buffer) = m.bound();
+    let stale = *bound != params || bindings != view.bindings || *buffer != view.buffer;
+    if stale && let Some(mut m) = materials.get_mut(handle) {
+        m.bind(params, view.bindings, view.buffer.clone());
     }
 }
 

@@ -100,23 +100,30 @@ pub(crate) fn update_materials(
         let Ok((cam, view)) = cameras.get(scene.camera) else {
             continue;
         };
-        let (Some(pack), Some(mat)) = (packs.get(cam.pack.id()), materials.get(&handle.0)) else {
-            continue;
-        };
-        // Coverage and material were looked up in the manifest once, when the material was
-        // attached.
-        let params = frame::ObjectShading {
-            id: of.id,
-            coverage: mat.coverage,
-            factors: mat.albedo.as_ref(),
+        if let Some(pack) = packs.get(cam.pack.id()) {
+            frame::rebind(&mut materials, &handle.0, of.id, (cam, pack), view);
         }
-        .params(cam, pack);
-        if (mat.params != params || mat.bindings != view.bindings || mat.view != view.buffer)
-            && let Some(mut mat) = materials.get_mut(&handle.0)
-        {
-            mat.params = params;
-            mat.bindings = view.bindings;
-            mat.view = view.buffer.clone();
+    }
+}
+
+impl frame::BindsView for PlenopticMaterial {
+    /// Coverage and material were looked up in the manifest once, when the material was
+    /// attached.
+    fn shading(&self, id: u32) -> frame::ObjectShading<'_> {
+        frame::ObjectShading {
+            id,
+            coverage: self.coverage,
+            factors: self.albedo.as_ref(),
         }
+    }
+
+    fn bound(&self) -> (&ObjectParams, u64, &Handle<ShaderBuffer>) {
+        (&self.params, self.bindings, &self.view)
+    }
+
+    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>) {
+        self.params = params;
+        self.bindings = bindings;
+        self.view = view;
     }
 }
