@@ -1,4 +1,5 @@
-//! Writes `docs/results/benchmarks.md` from criterion's results.
+//! Writes the benchmarks' table (by default `docs/results/benchmarks` + `.md`) from criterion's
+//! results.
 //!
 //! Criterion keeps each benchmark's last run under `target/criterion/<id>/new/`
 //! (`benchmark.json`: its group and name; `estimates.json`: the mean and its 95 % confidence
@@ -7,7 +8,7 @@
 //!
 //! ```sh
 //! cargo bench --no-default-features --bench recon     # any benches, as many as wanted
-//! cargo run --no-default-features --example bench_report   # writes docs/results/benchmarks.md
+//! cargo run --no-default-features --example bench_report   # writes the table
 //! cargo run --no-default-features --example bench_report -- --criterion DIR --out FILE
 //! ```
 
