@@ -121,18 +121,23 @@ mod tests {
         }
     }
 
-    fn mean_luminance(image: &Image<Vec3>) -> f32 {
-        image.pixels.iter().map(|&c| luminance(c)).sum::<f32>() / image.pixels.len() as f32
+    /// `image` with every pixel replaced by `f(x, y, colour)`.
+    fn map_pixels(image: &Image<Vec3>, f: impl Fn(u32, u32, Vec3) -> Vec3) -> Image<Vec3> {
+        let w = image.width;
+        Image {
+            pixels: (0u32..)
+                .zip(&image.pixels)
+                .map(|(i, &c)| f(i % w, i / w, c))
+                .collect(),
+            ..image.clone()
+        }
     }
 
     #[test]
     fn a_mean_offset_of_five_percent_scores_five_percent() {
         let r = reference(160, 90);
-        let offset = 0.05 * mean_luminance(&r);
-        let t = Image {
-            pixels: r.pixels.iter().map(|&c| c + Vec3::splat(offset)).collect(),
-            ..r.clone()
-        };
+        let offset = 0.05 * r.mean_luminance() as f32;
+        let t = map_pixels(&r, |_, _, c| c + Vec3::splat(offset));
         let e = low_frequency_error(&t, &r);
         assert!((e - 0.05).abs() < 1e-4, "{e}");
         assert!(low_frequency_error(&r, &r).abs() < 1e-12);
@@ -141,39 +146,20 @@ mod tests {
     #[test]
     fn pixel_noise_is_blurred_away_and_a_blotch_is_not() {
         let r = reference(160, 90);
-        let mean = mean_luminance(&r);
+        let mean = r.mean_luminance() as f32;
         // ±30 % of the mean per pixel, zero-mean over every 2 × 2 block.
-        let noisy = Image {
-            pixels: r
-                .pixels
-                .iter()
-                .enumerate()
-                .map(|(i, &c)| {
-                    let (x, y) = (i % 160, i / 160);
-                    let s = if (x + y) % 2 == 0 { 0.3 } else { -0.3 };
-                    c + Vec3::splat(s * mean)
-                })
-                .collect(),
-            ..r.clone()
-        };
+        let noisy = map_pixels(&r, |x, y, c| {
+            c + Vec3::splat(if (x + y) % 2 == 0 { 0.3 } else { -0.3 } * mean)
+        });
         let per_pixel = plenoptic_trace::metrics::relative_lrms(&noisy, &r);
         let low = low_frequency_error(&noisy, &r);
         assert!(per_pixel > 0.25, "{per_pixel}");
         assert!(low < 0.01, "{low}");
         // A blotch 16 pixels across, 30 % brighter: it stays.
-        let blotch = Image {
-            pixels: r
-                .pixels
-                .iter()
-                .enumerate()
-                .map(|(i, &c)| {
-                    let (x, y) = (i % 160, i / 160);
-                    let inside = (100..116).contains(&x) && (50..66).contains(&y);
-                    if inside { c * 1.3 } else { c }
-                })
-                .collect(),
-            ..r.clone()
-        };
+        let blotch = map_pixels(&r, |x, y, c| {
+            let inside = (100..116).contains(&x) && (50..66).contains(&y);
+            if inside { c * 1.3 } else { c }
+        });
         let per_pixel = plenoptic_trace::metrics::relative_lrms(&blotch, &r);
         let low = low_frequency_error(&blotch, &r);
         assert!(low > 0.5 * per_pixel, "{low} against {per_pixel}");
