@@ -11,7 +11,7 @@ use crate::many_cameras::{Eye, assert_each_matches, cpu_frame, plugin_cameras, s
 use crate::pack::{PackSpec, room, write_pack};
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
-use bevy_plenoptic::reconstruct::PlenopticMaterial;
+use bevy_plenoptic::reconstruct::geometry::PlenopticMaterial;
 use bevy_plenoptic::reconstruct::geometry::view::ViewBuffer;
 
 /// What happened to the camera's materials and view buffer, frame by frame.

@@ -15,7 +15,7 @@ use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
 
 use super::PlenopticCamera;
-use crate::PlenopticSettings;
+use crate::settings::PlenopticSettings;
 
 /// The render layer of a [`PlenopticCamera`]'s own proxies, background and sun (see the
 /// module doc), from [`PlenopticSettings::first_render_layer`] up, the lowest free pair (the

@@ -7,9 +7,8 @@ use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::prelude::*;
 pub use plenoptic_recon::ReconSettings;
 
-use crate::PlenopticSystems;
 use crate::asset::RadiancePack;
-use crate::streaming::StreamState;
+use crate::settings::PlenopticSystems;
 
 /// Adds playback of [`PlenopticCamera`]s.
 #[derive(Debug, Default)]
@@ -37,7 +36,7 @@ pub const EV100_UNIT: f32 = -0.263_034_4;
 ///
 /// Requires a [`Camera3d`] (the proxy geometry is rasterised by it) with a
 /// [`DepthPrepass`] (the GPU reconstruction's hole fill reads the depth of neighbouring
-/// pixels), and carries the per-camera streaming state.
+/// pixels). The streaming layer adds its per-camera state to it as a required component.
 ///
 /// Any number of plenoptic cameras may render in one app, each with its own pack, time and
 /// mode: each draws its own proxy geometry on a render layer of its own, which the plugin
@@ -48,7 +47,7 @@ pub const EV100_UNIT: f32 = -0.263_034_4;
 /// camera's `Tonemapping` then applies as to any other mesh. Bevy's default exposure (EV100
 /// 9.7, "Blender") suits physical light levels; see [`EV100_UNIT`] for packs without them.
 #[derive(Component, Debug, Clone)]
-#[require(Camera3d, DepthPrepass, StreamState)]
+#[require(Camera3d, DepthPrepass)]
 pub struct PlenopticCamera {
     /// The pack shown.
     pub pack: Handle<RadiancePack>,

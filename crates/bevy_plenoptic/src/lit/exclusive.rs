@@ -22,9 +22,9 @@ use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
 
 use super::scene::PlenopticLit;
-use crate::PlenopticSystems;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
+use crate::settings::PlenopticSystems;
 
 /// Adds the systems (part of [`super::PlenopticLitPlugin`]).
 pub(super) fn build(app: &mut App) {

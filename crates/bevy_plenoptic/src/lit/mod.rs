@@ -55,8 +55,8 @@ use plenoptic_recon::temporal::bracketing;
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::settings::{PlenopticSettings, PlenopticSystems};
 use crate::streaming::{DecodedKey, StreamCache};
-use crate::{PlenopticSettings, PlenopticSystems};
 
 /// Smallest and largest face of the source cubemap (it is resampled to a power of two in
 /// this range, the nearest above the pack's face).

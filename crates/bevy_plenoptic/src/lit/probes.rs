@@ -34,9 +34,9 @@ use plenoptic_pack::cube::{direction_to_texel, texel_direction};
 use plenoptic_recon::temporal::bracketing;
 
 use super::{Source, source_face, source_image, texel_map};
-use crate::PlenopticSettings;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::settings::PlenopticSettings;
 
 /// Largest face of a probe's radiance (a power of two).
 pub const PROBE_FACE: u32 = 64;

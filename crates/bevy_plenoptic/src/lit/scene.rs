@@ -60,16 +60,18 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
-use crate::reconstruct::cpu::{CpuFrameMaterial, CpuFrames};
+use crate::reconstruct::cpu::CpuFrameMaterial;
+use crate::reconstruct::environment::EnvironmentImages;
+use crate::reconstruct::frames::{CpuFrameImage, ImageFrame};
 use crate::reconstruct::geometry::frame::{self, ObjectShading};
 use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
 use crate::reconstruct::geometry::view::ViewBuffer;
 use crate::reconstruct::geometry::volume::VolumeBuffers;
-use crate::reconstruct::{
-    KeyTextures, MaterialFactors, ObjectParams, ReconstructSystems, ResolvedBackend, background,
-    image, material_factors, object_coverage,
+use crate::reconstruct::geometry::{
+    MaterialFactors, ObjectParams, material_factors, object_coverage,
 };
-use crate::{Backend, PlenopticSystems};
+use crate::reconstruct::{KeyTextures, ReconstructSystems};
+use crate::settings::{Backend, PlenopticSystems, ResolvedBackend};
 
 /// Lights the meshes under this entity (a `WorldAssetRoot`, or any ancestor of them) with the
 /// pack of a plenoptic camera at that camera's time (see the module doc).
@@ -181,8 +183,7 @@ pub(super) fn build(app: &mut App) {
             )
                 .chain()
                 .after(PlenopticSystems::Streaming)
-                .after(ReconstructSystems::Materials)
-                .after(crate::reconstruct::cpu::run_cpu_frames),
+                .after(ReconstructSystems::Materials),
         );
 }
 
@@ -283,13 +284,12 @@ fn hide_scene_lights(
 fn attach_cpu_frames(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
-    frames: Res<CpuFrames>,
     roots: Query<(Entity, &PlenopticLit)>,
     children: Query<&Children>,
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    cameras: Query<&PlenopticCamera>,
+    cameras: Query<(&PlenopticCamera, &CpuFrameImage)>,
     packs: Res<Assets<RadiancePack>>,
     mut materials: ResMut<Assets<CpuFrameMaterial>>,
 ) {
@@ -297,7 +297,7 @@ fn attach_cpu_frames(
         return;
     }
     for (root, scene) in &roots {
-        let (Ok(cam), Some(frame)) = (cameras.get(scene.camera), frames.image(scene.camera)) else {
+        let Ok((cam, CpuFrameImage(frame))) = cameras.get(scene.camera) else {
             continue;
         };
         let Some(pack) = packs.get(cam.pack.id()) else {
@@ -351,16 +351,11 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    cameras: Query<(
-        &PlenopticCamera,
-        &image::ImageFrame,
-        &CameraRays,
-        &ViewBuffer,
-    )>,
+    cameras: Query<(&PlenopticCamera, &ImageFrame, &CameraRays, &ViewBuffer)>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
     mut lit: ResMut<Assets<LitMaterial>>,
-    mut env_images: ResMut<background::EnvironmentImages>,
+    mut env_images: ResMut<EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
     (mut pack_rays, mut buffers): (ResMut<PackRays>, ResMut<Assets<ShaderBuffer>>),
 ) {
@@ -408,7 +403,7 @@ fn attach_lit_materials(
                     params: ObjectParams::default(),
                     volume_samples: vol.samples.clone(),
                     volume_bins: vol.bins.clone(),
-                    image_frame: image_frame.0.clone(),
+                    image_frame: image_frame.image.clone(),
                     shading_cubes: tex.shading.clone(),
                     view: view.buffer.clone(),
                     environment_image: env_images.get(id, pack, &mut images),

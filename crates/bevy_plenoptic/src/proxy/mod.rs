@@ -16,7 +16,7 @@ use bevy::prelude::*;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
-use crate::{PlenopticEvent, PlenopticSystems};
+use crate::settings::{PlenopticEvent, PlenopticSystems};
 
 /// Spawns and animates the proxy geometry of every [`PlenopticCamera`].
 #[derive(Debug, Default)]

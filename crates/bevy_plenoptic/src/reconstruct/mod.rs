@@ -25,19 +25,18 @@
 
 pub mod background;
 pub mod cpu;
+pub mod environment;
+pub mod frames;
 pub mod geometry;
 pub mod image;
 pub mod upload;
-pub mod volume;
 
 use std::collections::{HashMap, HashSet};
 
 use bevy::prelude::*;
 
 use crate::asset::RadiancePack;
-use crate::{Backend, PlenopticSettings, PlenopticSystems};
-pub use geometry::{MaterialFactors, ObjectParams, PlenopticMaterial};
-pub(crate) use geometry::{material_factors, object_coverage};
+use crate::settings::{GpuSupport, PlenopticSystems};
 
 /// Most lookups (view × key) per fragment.
 pub const MAX_LOOKUPS: usize = 16;
@@ -47,6 +46,8 @@ const MAX_LAYERS: u32 = 2046;
 /// The order of the reconstruction's main-world systems each frame, after streaming.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ReconstructSystems {
+    /// Resident keys uploaded to the key textures.
+    Upload,
     /// Keys and volume blocks uploaded; every camera given its frame, view buffer and ray
     /// placements.
     Resources,
@@ -60,7 +61,9 @@ pub enum ReconstructSystems {
     Materials,
 }
 
-/// Adds the GPU reconstruction: its features' plugins and what they share.
+/// Adds what the GPU reconstruction's features share: the key textures, the environment's
+/// textures, the shader libraries and the order of their systems. The features' own plugins
+/// are added beside it ([`crate::PlenopticPlugin`]).
 #[derive(Debug, Default)]
 pub struct PlenopticReconstructPlugin;
 
@@ -72,10 +75,12 @@ impl Plugin for PlenopticReconstructPlugin {
         bevy::shader::load_shader_library!(app, "environment.wgsl");
         upload::build(app);
         app.init_resource::<KeyTextures>()
-            .init_resource::<ResolvedBackend>()
+            .init_resource::<environment::EnvironmentImages>()
+            .add_message::<frames::FrameReplaced>()
             .configure_sets(
                 Update,
                 (
+                    ReconstructSystems::Upload,
                     ReconstructSystems::Resources,
                     ReconstructSystems::Attach,
                     ReconstructSystems::Jobs,
@@ -85,18 +90,9 @@ impl Plugin for PlenopticReconstructPlugin {
                     .chain()
                     .after(PlenopticSystems::Streaming),
             )
-            .add_plugins((
-                geometry::GeometryAssistedPlugin,
-                image::WarpPlugin,
-                volume::VolumeModePlugin,
-                background::BackgroundPlugin,
-            ))
-            .add_systems(PreUpdate, resolve_backend)
             .add_systems(
                 Update,
-                upload::upload_keys
-                    .in_set(ReconstructSystems::Resources)
-                    .before(geometry::volume::upload_volumes),
+                upload::upload_keys.in_set(ReconstructSystems::Upload),
             );
     }
     fn finish(&self, app: &mut App) {
@@ -117,30 +113,6 @@ impl Plugin for PlenopticReconstructPlugin {
             );
         }
         app.insert_resource(GpuSupport(supported));
-    }
-}
-
-/// Whether the device supports the GPU reconstruction (decided in `Plugin::finish`).
-#[derive(Resource, Debug, Clone, Copy)]
-pub struct GpuSupport(pub bool);
-
-/// The backend in use: [`PlenopticSettings::backend`] with `Auto` resolved.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct ResolvedBackend(pub Backend);
-
-fn resolve_backend(
-    settings: Res<PlenopticSettings>,
-    support: Option<Res<GpuSupport>>,
-    mut resolved: ResMut<ResolvedBackend>,
-) {
-    let gpu = support.is_some_and(|s| s.0);
-    let b = match settings.backend {
-        Backend::Auto if gpu => Backend::Gpu,
-        Backend::Auto => Backend::Cpu,
-        b => b,
-    };
-    if resolved.0 != b {
-        resolved.0 = b;
     }
 }
 

@@ -21,9 +21,9 @@ use bevy::render::texture::GpuImage;
 use bevy::render::{MainWorld, Render, RenderApp, RenderSystems};
 
 use super::{KeyTexture, KeyTextures, MAX_LAYERS};
-use crate::PlenopticSettings;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::settings::PlenopticSettings;
 use crate::streaming::{DecodedKey, StreamCache, key_bytes};
 
 /// Bytes per texel of the key texture (`Rgba32Uint`).

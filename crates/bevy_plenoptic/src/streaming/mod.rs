@@ -38,7 +38,7 @@ use plenoptic_recon::streamed::{CUBE_KINDS, StreamedCube, read_cube};
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
-use crate::{PlenopticEvent, PlenopticSettings, PlenopticSystems};
+use crate::settings::{PlenopticEvent, PlenopticSettings, PlenopticSystems};
 use schedule::{BlockRef, KeyRef, Lookahead, working_set};
 
 /// Bytes of decoded cube data resident (and reserved for reads in flight).
@@ -61,6 +61,8 @@ impl Plugin for PlenopticStreamingPlugin {
         for path in [RESIDENT_BYTES, HITS, MISSES, STALLS, DECODE_MS] {
             app.register_diagnostic(Diagnostic::new(path));
         }
+        // The camera layer does not know streaming: its state is required from here.
+        app.register_required_components::<PlenopticCamera, StreamState>();
         app.init_resource::<StreamCache>()
             .init_resource::<StreamingStats>()
             .add_systems(
@@ -669,14 +671,14 @@ fn schedule_reads(
     mut cache: ResMut<StreamCache>,
     mut stats: ResMut<StreamingStats>,
     settings: Res<PlenopticSettings>,
-    backend: Option<Res<crate::reconstruct::ResolvedBackend>>,
+    backend: Option<Res<crate::settings::ResolvedBackend>>,
     packs: Res<Assets<RadiancePack>>,
     time: Res<Time>,
     mut cameras: Query<(&PlenopticCamera, &mut StreamState, &GlobalTransform)>,
     mut diagnostics: Diagnostics,
 ) {
     // The CPU backend's keys are decoded for plenoptic_recon, in the same budget.
-    let cpu = backend.is_some_and(|b| b.0 == crate::Backend::Cpu);
+    let cpu = backend.is_some_and(|b| b.0 == crate::settings::Backend::Cpu);
     cache.frame += 1;
     let budget = settings.memory_budget_bytes;
     let mut residency = Residency::default();
@@ -725,8 +727,8 @@ fn camera_working_set(
     };
     state.last_position = Some(position);
     let speed = match cam.playback {
-        crate::Playback::Clock { speed, .. } => speed,
-        crate::Playback::Manual => 0.0,
+        crate::camera::Playback::Clock { speed, .. } => speed,
+        crate::camera::Playback::Manual => 0.0,
     };
     let mut set = working_set(
         pack.reader.manifest(),

@@ -29,17 +29,19 @@ use bevy::shader::ShaderRef;
 use bevy::render::render_resource::{
     Extent3d, TextureDimension, TextureFormat, TextureViewDescriptor, TextureViewDimension,
 };
-use plenoptic_recon::background::{Environment, PlacedEnvironment};
+use plenoptic_recon::background::PlacedEnvironment;
 
-use super::geometry::view::ViewBuffer;
-use super::{KeyTextures, ReconstructSystems, ResolvedBackend};
-use crate::Backend;
+use super::environment::{EnvironmentImages, EnvironmentUniform};
+use super::frames::{CpuFrameImage, FrameReplaced, ImageFrame, ViewDisplay};
+use super::{KeyTextures, ReconstructSystems};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
+use crate::settings::Backend;
+use crate::settings::ResolvedBackend;
 
-/// The background behind the proxies: its material, and one background per GPU camera kept
-/// at the camera's time (part of [`super::PlenopticReconstructPlugin`]).
+/// The background behind the proxies: its material, and one background per camera kept at
+/// the camera's time (the GPU backend) or showing its CPU frame (the CPU backend).
 #[derive(Debug, Default)]
 pub struct BackgroundPlugin;
 
@@ -47,12 +49,12 @@ impl Plugin for BackgroundPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "background.wgsl");
         app.add_plugins(MaterialPlugin::<PlenopticBackgroundMaterial>::default())
-            .init_resource::<EnvironmentImages>()
             .add_systems(
                 Update,
                 (
                     spawn_backgrounds.in_set(ReconstructSystems::Attach),
-                    update_backgrounds.in_set(ReconstructSystems::Materials),
+                    spawn_cpu_backgrounds.in_set(ReconstructSystems::Views),
+                    (update_backgrounds, rebind_frames).in_set(ReconstructSystems::Materials),
                 ),
             );
     }
@@ -67,8 +69,8 @@ pub struct PlenopticBackgroundMaterial {
     /// Which key to show.
     #[uniform(1)]
     pub params: BackgroundParams,
-    /// The image-mode frame ([`super::image::ImageFrame`]), shown while the camera is in
-    /// image mode.
+    /// The camera's displayed frame: its [`ImageFrame`] (shown while the camera is in image
+    /// or volume mode) or its [`CpuFrameImage`].
     #[texture(2, sample_type = "float", filterable = false)]
     pub image_frame: Handle<Image>,
     /// The pack's environment at the camera's time.
@@ -77,104 +79,6 @@ pub struct PlenopticBackgroundMaterial {
     /// The pack's environment image (`Rgba32Float`; 1 × 1 black when it has none).
     #[texture(4, sample_type = "float", filterable = false)]
     pub environment_image: Handle<Image>,
-}
-
-/// The environment of a [`PlenopticBackgroundMaterial`] at one time (see `background.wgsl`).
-#[derive(ShaderType, Debug, Clone, Default, PartialEq)]
-pub struct EnvironmentUniform {
-    /// x: kind (0 none: show the key's cube, 1 uniform, 2 sky, 3 image), y: image
-    /// intensity, z and w: cosine and sine of the image's turn about +Y.
-    pub kind: Vec4,
-    /// Uniform colour (xyz).
-    pub colour: Vec4,
-    /// The sky's 27 Hosek–Wilkie coefficients (A–I of R, G, B), four per vector.
-    pub sky: [Vec4; 7],
-    /// The sky's radiance scale per channel (xyz).
-    pub sky_radiance: Vec4,
-    /// Unit direction towards the sun (xyz).
-    pub sun: Vec4,
-    /// The sky's radiance below the horizon: its ground (xyz; zero without one).
-    pub ground: Vec4,
-}
-
-impl EnvironmentUniform {
-    /// The uniform for `env` (an environment placed at a time).
-    pub fn new(env: &PlacedEnvironment) -> Self {
-        let mut u = EnvironmentUniform::default();
-        match env {
-            PlacedEnvironment::None => {}
-            PlacedEnvironment::Uniform(c) => {
-                u.kind.x = 1.0;
-                u.colour = c.extend(0.0);
-            }
-            PlacedEnvironment::Sky(sky) => {
-                let c = sky.coefficients();
-                u.kind.x = 2.0;
-                for (i, p) in c.params.iter().enumerate() {
-                    u.sky[i / 4][i % 4] = *p;
-                }
-                u.sky_radiance = Vec3::from_array(c.radiances).extend(0.0);
-                u.sun = c.sun.extend(0.0);
-                u.ground = Vec3::from_array(c.ground).extend(0.0);
-            }
-            PlacedEnvironment::Image {
-                intensity,
-                to_image,
-                ..
-            } => {
-                // `to_image` turns about +Y only: its angle, sign from the axis.
-                let (axis, angle) = to_image.to_axis_angle();
-                let angle = angle * axis.y.signum();
-                u.kind = Vec4::new(3.0, *intensity, angle.cos(), angle.sin());
-            }
-        }
-        u
-    }
-}
-
-/// The environment image of each pack as a texture (`Rgba32Float`, row 0 at +Y), and the
-/// 1 × 1 black texture of packs without one.
-#[derive(Resource, Debug, Default)]
-pub struct EnvironmentImages {
-    images: std::collections::HashMap<AssetId<RadiancePack>, Handle<Image>>,
-}
-
-impl EnvironmentImages {
-    /// The texture of `pack`'s environment image, made on first use.
-    pub(crate) fn get(
-        &mut self,
-        id: AssetId<RadiancePack>,
-        pack: &RadiancePack,
-        images: &mut Assets<Image>,
-    ) -> Handle<Image> {
-        self.images
-            .entry(id)
-            .or_insert_with(|| {
-                let (w, h, texels): (u32, u32, Vec<Vec3>) = match &pack.environment.environment {
-                    Environment::Image { image, .. } => {
-                        (image.width, image.height, image.texels.clone())
-                    }
-                    _ => (1, 1, vec![Vec3::ZERO]),
-                };
-                let data = texels
-                    .iter()
-                    .flat_map(|t| [t.x, t.y, t.z, 1.0])
-                    .flat_map(f32::to_le_bytes)
-                    .collect();
-                images.add(Image::new(
-                    Extent3d {
-                        width: w,
-                        height: h,
-                        depth_or_array_layers: 1,
-                    },
-                    TextureDimension::D2,
-                    data,
-                    TextureFormat::Rgba32Float,
-                    RenderAssetUsages::RENDER_WORLD,
-                ))
-            })
-            .clone()
-    }
 }
 
 /// The uniform of a [`PlenopticBackgroundMaterial`].
@@ -261,11 +165,10 @@ fn spawn_background(
 /// environment: it shows the CPU frame (`frame`: the pack's displayed CPU frame, if any)
 /// where no proxy is, so that the sky `plenoptic_recon` put there is seen.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
-pub(super) fn spawn_cpu_backgrounds(
+fn spawn_cpu_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
-    frames: Res<super::cpu::CpuFrames>,
-    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer)>,
+    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer, &CpuFrameImage)>,
     existing: Query<&PlenopticBackground>,
     packs: Res<Assets<RadiancePack>>,
     mut images: ResMut<Assets<Image>>,
@@ -275,11 +178,11 @@ pub(super) fn spawn_cpu_backgrounds(
     if backend.0 != Backend::Cpu {
         return;
     }
-    for (entity, cam, layer) in &cameras {
+    for (entity, cam, layer, frame) in &cameras {
         if existing.iter().any(|b| b.camera == entity) {
             continue;
         }
-        let (Some(pack), Some(frame)) = (packs.get(cam.pack.id()), frames.image(entity)) else {
+        let Some(pack) = packs.get(cam.pack.id()) else {
             continue;
         };
         if pack.environment.is_none() {
@@ -313,7 +216,7 @@ pub(super) fn spawn_cpu_backgrounds(
             params: BackgroundParams {
                 key: Vec4::new(0.0, 1.0, 0.0, 1.0),
             },
-            image_frame: frame,
+            image_frame: frame.0.clone(),
             environment: EnvironmentUniform::default(),
             environment_image: images.add(black),
         });
@@ -328,12 +231,7 @@ pub(super) fn spawn_backgrounds(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
-    cameras: Query<(
-        Entity,
-        &PlenopticCamera,
-        &ViewLayer,
-        &super::image::ImageFrame,
-    )>,
+    cameras: Query<(Entity, &PlenopticCamera, &ViewLayer, &ImageFrame)>,
     existing: Query<&PlenopticBackground>,
     packs: Res<Assets<RadiancePack>>,
     mut env_images: ResMut<EnvironmentImages>,
@@ -355,7 +253,7 @@ pub(super) fn spawn_backgrounds(
         let material = materials.add(PlenopticBackgroundMaterial {
             cubes: tex.image.clone(),
             params: BackgroundParams::default(),
-            image_frame: image_frame.0.clone(),
+            image_frame: image_frame.image.clone(),
             environment: EnvironmentUniform::default(),
             environment_image,
         });
@@ -409,7 +307,7 @@ pub(super) fn set_background(
 pub(super) fn update_backgrounds(
     keys: Res<KeyTextures>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<(&PlenopticCamera, &ViewBuffer)>,
+    cameras: Query<(&PlenopticCamera, &ViewDisplay)>,
     backgrounds: Query<(
         &PlenopticBackground,
         &MeshMaterial3d<PlenopticBackgroundMaterial>,
@@ -417,7 +315,7 @@ pub(super) fn update_backgrounds(
     mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
 ) {
     for (bg, handle) in &backgrounds {
-        let Ok((cam, view)) = cameras.get(bg.camera) else {
+        let Ok((cam, display)) = cameras.get(bg.camera) else {
             continue;
         };
         if bg.cpu {
@@ -425,7 +323,7 @@ pub(super) fn update_backgrounds(
         }
         let id = cam.pack.id();
         let face = keys.0.get(&id).map_or(1, |t| t.face);
-        let layer = view.lookups.heaviest_layer();
+        let layer = display.heaviest_layer;
         let env = packs
             .get(id)
             .map(|p| p.environment.at(cam.time))
@@ -436,7 +334,28 @@ pub(super) fn update_backgrounds(
             &env,
             layer,
             face,
-            view.params().fill.z == 1.0,
+            display.image_mode,
         );
+    }
+}
+
+/// Marks the backgrounds that show a replaced frame texture modified, so that Bevy prepares
+/// their bind groups again with the new texture.
+fn rebind_frames(
+    mut replaced: MessageReader<FrameReplaced>,
+    mut materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
+) {
+    for FrameReplaced(image) in replaced.read() {
+        let users: Vec<_> = materials
+            .iter()
+            .filter(|(_, m)| m.image_frame.id() == *image)
+            .map(|(id, _)| id)
+            .collect();
+        for id in users {
+            // A bare `get_mut` marks the asset modified only once dereferenced mutably.
+            if let Some(m) = materials.get_mut(id) {
+                m.into_inner();
+            }
+        }
     }
 }

@@ -24,12 +24,13 @@ use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 use plenoptic_pack::ChunkKind;
 use plenoptic_recon::{Camera as ReconCamera, Frame, KeySource, Reconstructor, StreamedCube};
 
-use super::ResolvedBackend;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::reconstruct::ReconstructSystems;
+use crate::reconstruct::frames::{CpuFrameImage, FrameReplaced};
+use crate::settings::{Backend, PlenopticEvent, ResolvedBackend};
 use crate::streaming::StreamCache;
-use crate::{Backend, PlenopticEvent, PlenopticSystems};
 
 /// Adds the CPU backend.
 #[derive(Debug, Default)]
@@ -43,12 +44,9 @@ impl Plugin for PlenopticCpuPlugin {
             .add_systems(
                 Update,
                 (
-                    attach_cpu_materials,
-                    super::background::spawn_cpu_backgrounds,
-                    run_cpu_frames,
-                )
-                    .chain()
-                    .after(PlenopticSystems::Streaming),
+                    attach_cpu_materials.in_set(ReconstructSystems::Attach),
+                    run_cpu_frames.in_set(ReconstructSystems::Jobs),
+                ),
             );
     }
 }
@@ -192,6 +190,9 @@ fn attach_cpu_materials(
                 done: 0,
             }
         });
+        commands
+            .entity(scene.camera)
+            .try_insert(CpuFrameImage(frame.image.clone()));
         let m = materials.add(CpuFrameMaterial {
             frame: frame.image.clone(),
         });
@@ -208,7 +209,7 @@ pub(crate) fn run_cpu_frames(
     cameras: Query<(&PlenopticCamera, &Camera, &Projection, &GlobalTransform)>,
     mut images: ResMut<Assets<Image>>,
     mut materials: ResMut<Assets<CpuFrameMaterial>>,
-    mut backgrounds: ResMut<Assets<super::background::PlenopticBackgroundMaterial>>,
+    mut replaced: MessageWriter<FrameReplaced>,
     mut events: MessageWriter<PlenopticEvent>,
 ) {
     frames.0.retain(|camera, _| cameras.contains(*camera));
@@ -250,16 +251,7 @@ pub(crate) fn run_cpu_frames(
                             m.frame = f.image.clone();
                         }
                     }
-                    let users: Vec<_> = backgrounds
-                        .iter()
-                        .filter(|(_, m)| m.image_frame == f.image)
-                        .map(|(id, _)| id)
-                        .collect();
-                    for m in users {
-                        if let Some(mut m) = backgrounds.get_mut(m) {
-                            m.image_frame = f.image.clone();
-                        }
-                    }
+                    replaced.write(FrameReplaced(f.image.id()));
                     f.done += 1;
                 }
                 Err(reason) => {

@@ -17,7 +17,8 @@ use super::view::{ViewParams, motion_slot};
 use super::{MaterialFactors, ObjectParams, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
-use crate::reconstruct::{KeyTexture, MAX_LOOKUPS, background};
+use crate::reconstruct::environment::EnvironmentUniform;
+use crate::reconstruct::{KeyTexture, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
 
 /// One lookup of a frame: a resident, uploaded (base view, time key).
@@ -225,7 +226,7 @@ impl CameraFrame<'_> {
                 0.0,
                 0.0,
             ),
-            environment: background::EnvironmentUniform::new(&pack.environment.at(cam.time)),
+            environment: EnvironmentUniform::new(&pack.environment.at(cam.time)),
             ..default()
         };
         let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();

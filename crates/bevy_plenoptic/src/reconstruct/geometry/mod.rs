@@ -67,7 +67,7 @@ use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 
 /// Geometry-assisted reconstruction on the GPU: the proxy material, its view buffers and
-/// fallbacks (part of [`super::PlenopticReconstructPlugin`]).
+/// fallbacks.
 #[derive(Debug, Default)]
 pub struct GeometryAssistedPlugin;
 
@@ -118,7 +118,7 @@ pub struct PlenopticMaterial {
     /// Their bin offsets ([`volume::PackVolumes::bins`]).
     #[storage(3, read_only)]
     pub volume_bins: Handle<ShaderBuffer>,
-    /// The camera's image-mode frame ([`crate::reconstruct::image::ImageFrame`]), shown
+    /// The camera's image-mode frame ([`crate::reconstruct::frames::ImageFrame`]), shown
     /// instead of the lookups while the camera is in [`ReconMode::Image`] or
     /// [`ReconMode::Volume`].
     #[texture(4, sample_type = "float", filterable = false)]

@@ -9,11 +9,13 @@ use bevy::render::storage::ShaderBuffer;
 use super::{
     ObjectParams, PlenopticMaterial, frame, material_factors, object_coverage, rays, view, volume,
 };
-use crate::Backend;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
-use crate::reconstruct::{KeyTextures, ResolvedBackend, background, image};
+use crate::reconstruct::KeyTextures;
+use crate::reconstruct::environment::EnvironmentImages;
+use crate::reconstruct::frames::ImageFrame;
+use crate::settings::{Backend, ResolvedBackend};
 
 /// Gives every proxy of a camera on the GPU backend its proxy material.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
@@ -22,12 +24,12 @@ pub(super) fn attach_materials(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
-    cameras: Query<(&image::ImageFrame, &rays::CameraRays, &view::ViewBuffer)>,
+    cameras: Query<(&ImageFrame, &rays::CameraRays, &view::ViewBuffer)>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
     mut materials: ResMut<Assets<PlenopticMaterial>>,
-    mut env_images: ResMut<background::EnvironmentImages>,
+    mut env_images: ResMut<EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
     (mut pack_rays, mut buffers): (ResMut<rays::PackRays>, ResMut<Assets<ShaderBuffer>>),
 ) {
@@ -58,7 +60,7 @@ pub(super) fn attach_materials(
             params: ObjectParams::default(),
             volume_samples: vol.samples.clone(),
             volume_bins: vol.bins.clone(),
-            image_frame: image_frame.0.clone(),
+            image_frame: image_frame.image.clone(),
             shading_cubes: tex.shading.clone(),
             base_colour_texture: factors.as_ref().and_then(|f| f.base_colour.clone()),
             metallic_roughness_texture: factors.as_ref().and_then(|f| f.metallic_roughness.clone()),

@@ -32,7 +32,9 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconSettings;
-use crate::reconstruct::{KeyTextures, MAX_LOOKUPS, background, image};
+use crate::reconstruct::environment::EnvironmentUniform;
+use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
+use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 
@@ -73,7 +75,7 @@ pub struct ViewParams {
     pub volume_range: [UVec4; volume::MAX_VOLUMES],
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see.
-    pub environment: background::EnvironmentUniform,
+    pub environment: EnvironmentUniform,
     /// `M_o(τ)` of each lookup per animated object: entry `slot · MAX_LOOKUPS + k` for the
     /// object in motion slot `slot` (its index among the pack's animated objects) and lookup `k`.
     #[shader(size(runtime))]
@@ -116,7 +118,7 @@ fn shader_buffer(params: &ViewParams) -> ShaderBuffer {
     b
 }
 
-/// Gives every plenoptic camera its view buffer.
+/// Gives every plenoptic camera its view buffer and its [`ViewDisplay`].
 pub(super) fn add_view_buffers(
     mut commands: Commands,
     cameras: Query<Entity, (With<PlenopticCamera>, Without<ViewBuffer>)>,
@@ -127,16 +129,20 @@ pub(super) fn add_view_buffers(
             motion: vec![Mat4::IDENTITY],
             ..default()
         };
-        commands.entity(camera).insert(ViewBuffer {
-            buffer: buffers.add(shader_buffer(&params)),
-            params,
-            lookups: FrameLookups::default(),
-            bindings: 0,
-        });
+        commands.entity(camera).insert((
+            ViewBuffer {
+                buffer: buffers.add(shader_buffer(&params)),
+                params,
+                lookups: FrameLookups::default(),
+                bindings: 0,
+            },
+            ViewDisplay::default(),
+        ));
     }
 }
 
-/// Fills each camera's view buffer for this frame (rewritten only when it changed).
+/// Fills each camera's view buffer for this frame (rewritten only when it changed) and says
+/// what it shows in its [`ViewDisplay`].
 pub(super) fn update_view_buffers(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
@@ -145,14 +151,14 @@ pub(super) fn update_view_buffers(
     mut cameras: Query<(
         &PlenopticCamera,
         &GlobalTransform,
-        &image::ImageJob,
-        &image::ImageFrame,
+        &ImageFrame,
         &mut ViewBuffer,
+        &mut ViewDisplay,
     )>,
     images: Res<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (cam, transform, job, frame, mut view) in &mut cameras {
+    for (cam, transform, frame, mut view, mut display) in &mut cameras {
         let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
@@ -173,7 +179,7 @@ pub(super) fn update_view_buffers(
             tex,
             volumes: pack_volumes,
             lookups: &lookups,
-            image_mode: warped(cam.mode) && job.0.is_some(),
+            image_mode: warped(cam.mode) && frame.active,
         };
         let params = ctx.view_params();
         let view = view.as_mut();
@@ -185,12 +191,19 @@ pub(super) fn update_view_buffers(
         {
             b.set_data(params.clone());
         }
+        let shown = ViewDisplay {
+            heaviest_layer: lookups.heaviest_layer(),
+            image_mode: params.fill.z == 1.0,
+        };
+        if *display != shown {
+            *display = shown;
+        }
         view.params = params;
         view.lookups = lookups;
         let mut h = std::collections::hash_map::DefaultHasher::new();
         view.buffer.id().hash(&mut h);
         pack_volumes.map(|v| v.generation).hash(&mut h);
-        images.get(&frame.0).map(Image::size).hash(&mut h);
+        images.get(&frame.image).map(Image::size).hash(&mut h);
         let bindings = h.finish();
         if view.bindings != bindings {
             view.bindings = bindings;

@@ -6,63 +6,49 @@
 use bevy::prelude::*;
 use plenoptic_recon::temporal::bezier_weights;
 
-use super::{
-    ImageFrame, ImageJob, ImageParams, ImageWork, KEYS_PER_VIEW, MAX_IMAGE_VIEWS, frame_image,
-};
-use crate::Backend;
+use super::volume::VolumeCubes;
+use super::{ImageJob, ImageParams, ImageWork, KEYS_PER_VIEW, MAX_IMAGE_VIEWS, frame_image};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode};
-use crate::reconstruct::background::{PlenopticBackground, PlenopticBackgroundMaterial};
-use crate::reconstruct::volume::VolumeCubes;
-use crate::reconstruct::{KeyTextures, ResolvedBackend};
+use crate::reconstruct::KeyTextures;
+use crate::reconstruct::frames::{FrameReplaced, ImageFrame};
+use crate::settings::{Backend, ResolvedBackend};
 use crate::streaming::StreamCache;
 
-/// A camera in image or volume mode: the components [`prepare_jobs`] reads.
+/// A camera in image or volume mode: the components [`prepare_jobs`] reads for its job.
 type WarpCamera<'a> = (
-    Entity,
     &'a PlenopticCamera,
     &'a Camera,
     &'a Projection,
     &'a GlobalTransform,
-    &'a ImageFrame,
     Option<&'a VolumeCubes>,
 );
 
 /// Fills each camera's [`ImageJob`] (warping its [`VolumeCubes`] in volume mode) and resizes
-/// its [`ImageFrame`] to it.
-#[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
+/// its [`ImageFrame`] to it (a [`FrameReplaced`] message tells the materials that bind it).
 pub fn prepare_jobs(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     cache: Res<StreamCache>,
     packs: Res<Assets<RadiancePack>>,
-    mut cameras: Query<(WarpCamera, &mut ImageJob)>,
+    mut cameras: Query<(WarpCamera, &mut ImageFrame, &mut ImageJob)>,
     mut images: ResMut<Assets<Image>>,
-    backgrounds: Query<(
-        &PlenopticBackground,
-        &MeshMaterial3d<PlenopticBackgroundMaterial>,
-    )>,
-    mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
+    mut replaced: MessageWriter<FrameReplaced>,
 ) {
-    for (camera, mut job) in &mut cameras {
-        let work = job_for(&backend, &keys, &cache, &packs, camera);
-        let (entity, frame) = (camera.0, camera.5);
+    for (camera, mut frame, mut job) in &mut cameras {
+        let work = job_for(&backend, &keys, &cache, &packs, camera, &frame.image);
         if let Some(w) = &work {
             let size = UVec2::new(w.params.size.x, w.params.size.y);
-            if images.get(&frame.0).is_some_and(|i| i.size() != size) {
-                images.insert(&frame.0, frame_image(size.x, size.y)).ok();
-                // Touch the camera's background so that its bind group takes the new texture
-                // (the proxies and lit meshes see it in their camera's
-                // `view::ViewBuffer::bindings`).
-                for (bg, handle) in &backgrounds {
-                    if bg.camera == entity
-                        && let Some(m) = background_materials.get_mut(&handle.0)
-                    {
-                        // Marks it modified (a bare `get_mut` does not).
-                        m.into_inner();
-                    }
-                }
+            if images.get(&frame.image).is_some_and(|i| i.size() != size) {
+                images
+                    .insert(&frame.image, frame_image(size.x, size.y))
+                    .ok();
+                replaced.write(FrameReplaced(frame.image.id()));
             }
+        }
+        let active = work.is_some();
+        if frame.active != active {
+            frame.active = active;
         }
         job.0 = work;
     }
@@ -74,7 +60,8 @@ fn job_for(
     keys: &KeyTextures,
     cache: &StreamCache,
     packs: &Assets<RadiancePack>,
-    (_, cam, camera, projection, transform, frame, volume): WarpCamera,
+    (cam, camera, projection, transform, volume): WarpCamera,
+    frame: &Handle<Image>,
 ) -> Option<ImageWork> {
     if backend.0 != Backend::Gpu || !matches!(cam.mode, ReconMode::Image | ReconMode::Volume) {
         return None;
@@ -121,7 +108,7 @@ fn job_for(
         params.size.w = volume.views.len() as u32;
         return Some(ImageWork {
             cubes: image,
-            output: frame.0.clone(),
+            output: frame.clone(),
             params,
         });
     }
@@ -173,7 +160,7 @@ fn job_for(
     params.size.w = n as u32;
     Some(ImageWork {
         cubes: tex.image.clone(),
-        output: frame.0.clone(),
+        output: frame.clone(),
         params,
     })
 }

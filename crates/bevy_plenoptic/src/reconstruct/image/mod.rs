@@ -19,7 +19,7 @@
 //!
 //! The frame is written to the camera's [`ImageFrame`], an `Rgba32Float` storage texture
 //! which the camera's proxy materials and background show in screen space while it is in
-//! image mode (volume mode: [`super::volume`] supplies each view's cube at t as its
+//! image mode (volume mode: [`volume`] supplies each view's cube at t as its
 //! single key).
 //!
 //! Every camera has its own work: the main world fills the camera's [`ImageJob`], which is
@@ -36,6 +36,7 @@
 pub mod extract;
 pub mod node;
 pub mod prepare;
+pub mod volume;
 
 use bevy::asset::{RenderAssetUsages, embedded_asset};
 use bevy::core_pipeline::schedule::camera_driver;
@@ -48,6 +49,7 @@ use bevy::render::renderer::RenderGraph;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
 use super::ReconstructSystems;
+use super::frames::ImageFrame;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconMode;
@@ -86,11 +88,6 @@ pub struct ImageParams {
     /// Per view: x: first layer of the nearest key (distances), y: key count.
     pub nearest: [UVec4; MAX_IMAGE_VIEWS],
 }
-
-/// The frame a camera's image-mode passes write (an `Rgba32Float` storage texture, resized
-/// to the camera); every plenoptic camera has one.
-#[derive(Component, Debug, Clone)]
-pub struct ImageFrame(pub Handle<Image>);
 
 /// A camera's image-mode work this frame: `Some` while it is in image (or volume) mode on
 /// the GPU backend with keys to warp. Extracted onto the camera's render-world view.
@@ -134,14 +131,17 @@ pub struct WarpPlugin;
 impl Plugin for WarpPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "image.wgsl");
-        app.add_plugins(ExtractComponentPlugin::<ImageJob>::default())
-            .add_systems(
-                Update,
-                (
-                    add_frames.in_set(ReconstructSystems::Resources),
-                    extract::prepare_jobs.in_set(ReconstructSystems::Jobs),
-                ),
-            );
+        app.add_plugins((
+            ExtractComponentPlugin::<ImageJob>::default(),
+            volume::VolumeModePlugin,
+        ))
+        .add_systems(
+            Update,
+            (
+                add_frames.in_set(ReconstructSystems::Resources),
+                extract::prepare_jobs.in_set(ReconstructSystems::Jobs),
+            ),
+        );
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
             render_app
                 .init_resource::<prepare::ImageBuffers>()
@@ -163,8 +163,12 @@ fn add_frames(
 ) {
     for camera in &cameras {
         let frame = images.add(frame_image(1, 1));
-        commands
-            .entity(camera)
-            .insert((ImageFrame(frame), ImageJob::default()));
+        commands.entity(camera).insert((
+            ImageFrame {
+                image: frame,
+                active: false,
+            },
+            ImageJob::default(),
+        ));
     }
 }

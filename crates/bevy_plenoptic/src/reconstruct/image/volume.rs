@@ -10,7 +10,7 @@
 //! samples within `t ± tε` with tent weights ([`plenoptic_recon::volume::samples_to_cube`],
 //! at least three samples). The cubes (radiance as RGB9E5, distance, object id) are written
 //! into one `Rgba32Uint` 2D-array texture, six layers per view ([`VolumeCubes`]), and the
-//! image-mode passes ([`super::image`]) warp them as each view's single key (weight 1), blend
+//! image-mode passes ([`super`]) warp them as each view's single key (weight 1), blend
 //! the views and fill the background. Every volume-mode camera has its own [`VolumeCubes`].
 //!
 //! The cubes are rebuilt when the camera's time, its views or their weights change, once all
@@ -31,12 +31,13 @@ use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
 use plenoptic_pack::{ChunkKind, PackReader, cube::rgb9e5_pack};
 use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
 
-use super::image::MAX_IMAGE_VIEWS;
-use super::{ReconstructSystems, ResolvedBackend};
-use crate::Backend;
+use super::MAX_IMAGE_VIEWS;
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 use crate::camera::{PlenopticCamera, ReconMode};
+use crate::reconstruct::ReconstructSystems;
+use crate::settings::Backend;
+use crate::settings::ResolvedBackend;
 use crate::streaming::StreamCache;
 
 /// A volume-mode camera's cubes, six layers per view (a component of the camera, added when
@@ -127,7 +128,7 @@ fn texels((radiance, distance, ids): &Cubes) -> Vec<u8> {
 }
 
 /// Volume mode on the GPU: each volume-mode camera's cubes at its time, which the
-/// image-mode passes warp (part of [`super::PlenopticReconstructPlugin`]).
+/// image-mode passes warp (part of [`super::WarpPlugin`]).
 #[derive(Debug, Default)]
 pub struct VolumeModePlugin;
 
@@ -137,7 +138,7 @@ impl Plugin for VolumeModePlugin {
             Update,
             prepare_cubes
                 .in_set(ReconstructSystems::Jobs)
-                .before(super::image::extract::prepare_jobs),
+                .before(super::extract::prepare_jobs),
         );
     }
 }
