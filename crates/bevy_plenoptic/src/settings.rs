@@ -34,7 +34,7 @@ pub enum Backend {
     /// covered pixels × base views × 2 keys, more where the volume fallback or the hole fill
     /// runs). Image mode runs as compute passes ([`crate::reconstruct::image`]: splats of the
     /// weighted views' cube texels, view blend, background fill) shown through the proxies
-    /// and the background. Volume mode ([`crate::reconstruct::volume`]) interpolates each
+    /// and the background. Volume mode ([`crate::reconstruct::image::volume`]) interpolates each
     /// weighted view's cube at t from its resident temporal-volume blocks on the CPU (off
     /// the main thread, when the time or views change) and warps those cubes with the same
     /// passes. Every camera in image or volume mode has its own passes and frame; until its
