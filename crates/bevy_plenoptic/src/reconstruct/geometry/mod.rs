@@ -35,7 +35,12 @@
 //! ([`crate::camera::layers`]): any number of cameras, each with its own pack, time and mode,
 //! render in one app.
 //!
-//! - `mod.rs`: the material and the plugin; [`prepare`]: the main-world systems that attach
+//! - `mod.rs`: the material and the plugin; `geometry.wgsl`: its fragment shader, whose
+//!   libraries beside it (`plenoptic::geometry::*`) are `bindings.wgsl` (the bindings and
+//!   the fragment's state), `material.wgsl` (albedo, textures, normal map), `lookup.wgsl`
+//!   (the lookups and the volume fallback), `fill.wgsl` (the hole fill and the fallbacks
+//!   after it), `bsdf.wgsl`, `sun.wgsl` (the runtime sun) and `specular.wgsl` (reflections
+//!   for the camera); [`prepare`]: the main-world systems that attach
 //!   materials to proxies and keep them bound to their camera; [`view`] and [`frame`]: the
 //!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`]
 //!   and [`sun`]: the volume fallback's buffers, the ray-cast proxies, the reflection march
@@ -76,6 +81,15 @@ impl Plugin for GeometryAssistedPlugin {
         // The reflection march (`plenoptic::reflect`) and the ray cast (`plenoptic::rays`).
         bevy::shader::load_shader_library!(app, "reflect.wgsl");
         bevy::shader::load_shader_library!(app, "rays.wgsl");
+        // The fragment shader's libraries (`plenoptic::geometry::*`), imported by its entry
+        // file `geometry.wgsl`.
+        bevy::shader::load_shader_library!(app, "bindings.wgsl");
+        bevy::shader::load_shader_library!(app, "material.wgsl");
+        bevy::shader::load_shader_library!(app, "lookup.wgsl");
+        bevy::shader::load_shader_library!(app, "fill.wgsl");
+        bevy::shader::load_shader_library!(app, "bsdf.wgsl");
+        bevy::shader::load_shader_library!(app, "sun.wgsl");
+        bevy::shader::load_shader_library!(app, "specular.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<volume::VolumeBuffers>()

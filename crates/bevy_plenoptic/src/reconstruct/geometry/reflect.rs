@@ -7,7 +7,7 @@
 //!
 //! `albedo · lighting + emission(uv) + W(n·ω_o) · L_in`
 //!
-//! instead of the baked non-diffuse radiance (`geometry.wgsl`). Glossy lobes march 8 rays
+//! instead of the baked non-diffuse radiance (`specular.wgsl`). Glossy lobes march 8 rays
 //! reflected about GGX half-vectors from the same Hammersley set, turned per pixel by the
 //! same golden-ratio sequence, each weighted by `F · G · (ω_o·h) / ((n·ω_o)(n·h))`, and add
 //! the highlights of the pack's placed lamps (pack 4.1, `plenoptic_recon::lamps`) with a
@@ -72,9 +72,10 @@ mod tests {
         ] {
             assert!(wgsl.contains(&line), "reflect.wgsl lacks `{line}`");
         }
-        let geometry = include_str!("geometry.wgsl");
+        let specular = include_str!("specular.wgsl");
         let line = format!("const RAY_OFFSET: f32 = {RAY_OFFSET:?};");
-        assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+        assert!(specular.contains(&line), "specular.wgsl lacks `{line}`");
+        let lookup = include_str!("lookup.wgsl");
         for line in [
             format!(
                 "const NEIGHBOUR_TEXELS: i32 = {};",
@@ -85,13 +86,14 @@ mod tests {
                 plenoptic_recon::NEIGHBOUR_TOLERANCE
             ),
         ] {
-            assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+            assert!(lookup.contains(&line), "lookup.wgsl lacks `{line}`");
         }
         let line = format!(
             "lamps: array<vec4<f32>, {}>,",
             3 * plenoptic_recon::lamps::MAX_RUNTIME_LAMPS
         );
-        assert!(geometry.contains(&line), "geometry.wgsl lacks `{line}`");
+        let bindings = include_str!("bindings.wgsl");
+        assert!(bindings.contains(&line), "bindings.wgsl lacks `{line}`");
         let rays = include_str!("rays.wgsl");
         let line = format!("const NO_TRIANGLES: u32 = {NO_TRIANGLES:#x}u;");
         assert!(rays.contains(&line), "rays.wgsl lacks `{line}`");

@@ -1,7 +1,7 @@
 //! The runtime sun on the GPU (pack 3; docs/architecture.md, "The runtime sun"): a pack whose
 //! lighting leaves the sun's direct light out ([`plenoptic_pack::DirectSun`]) gets it back
 //! per fragment, as `plenoptic_recon::sun` adds it on the CPU: the surface's BSDF for the
-//! sun's direction (`geometry.wgsl`, the same formulas) × the track's illuminance at the
+//! sun's direction (`sun.wgsl`, the same formulas) × the track's illuminance at the
 //! camera's time × the cosine × the visibility.
 //!
 //! The visibility comes from Bevy's own cascaded shadow map of a [`DirectionalLight`] the

@@ -38,7 +38,8 @@ use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 
-/// One camera's lookups and settings, as `geometry.wgsl` reads them (`ViewParams` there).
+/// One camera's lookups and settings, as the geometry-assisted shader reads them (`ViewParams`
+/// in `bindings.wgsl`).
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
 pub struct ViewParams {
     /// x: lookup count, y: face size, z: volume block count, w: unused.

@@ -1,0 +1,138 @@
+// What the geometry-assisted fragment shader (geometry.wgsl; thesis §8.2.3) reads and keeps:
+// the camera's view buffer and the material's uniform (view.rs's ViewParams, mod.rs's
+// ObjectParams), the material's bindings (those of a lit app mesh's extension with
+// PLENOPTIC_STANDARD), the lookup limits, and the fragment's private state: its material at
+// the pixel, set once per fragment before any lookup.
+#define_import_path plenoptic::geometry::bindings
+
+#import plenoptic::environment::Environment
+
+const MAX_LOOKUPS: u32 = 16u;
+const MAX_VOLUMES: u32 = 8u;
+// Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
+const BIN_FACE: u32 = 16u;
+
+// A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
+struct ViewParams {
+    // x: lookup count, y: face size, z: volume block count (all as floats), w: unused.
+    header: vec4<f32>,
+    // x: depth tolerance, y: angular power, z: time t, w: temporal window tε.
+    tuning: vec4<f32>,
+    // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
+    // frame.
+    fill: vec4<f32>,
+    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
+    // y: how many lamps are in use.
+    flags: vec4<f32>,
+    // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
+    sun: vec4<f32>,
+    // Its illuminance at the camera's time (xyz).
+    sun_illuminance: vec4<f32>,
+    // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
+    // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
+    // pixel (plenoptic_recon's GLOSSY_RAYS).
+    specular: vec4<f32>,
+    // The placed lamps (plenoptic_recon's lamps module), 3 per lamp: position (xyz), range
+    // (w, −1: none); spot axis (xyz), cos outer cone (w, −2: a point light); colour ×
+    // intensity (xyz), 1 / (cos inner − cos outer) (w).
+    lamps: array<vec4<f32>, 12>,
+    // Per lookup: base view position (xyz) and first layer (w).
+    base: array<vec4<f32>, 16>,
+    // Per lookup: weight (x), whether the key has normals (y).
+    weight: array<vec4<f32>, 16>,
+    // Per volume block: base view position (xyz), view weight (w).
+    volume: array<vec4<f32>, 8>,
+    // Per volume block: first sample (x), first bin offset (y).
+    volume_range: array<vec4<u32>, 8>,
+    // The pack's environment at the camera's time, for reflected rays that leave the scene
+    // (not named `environment`: naga_oil would take the field for the imported function).
+    env: Environment,
+    // M_o(τ) per animated object (its motion slot) and lookup: entry slot · 16 + k.
+    motion: array<mat4x4<f32>>,
+}
+
+// A material's uniform (mod.rs, ObjectParams): its object and material.
+struct ObjectParams {
+    // x: object id, y: motion slot (−1: static, in world space), z: coverage of glazing,
+    // w: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
+    object: vec4<f32>,
+    // x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
+    // mean transmittance per surface.
+    glass: vec4<f32>,
+    // The object's base-colour factor (xyz) and metallic factor (w) when object.w is 1.
+    albedo: vec4<f32>,
+    // x: transmission factor; y, z, w: largest side of the base-colour and metallic-roughness
+    // textures and of the normal map (0: none).
+    material: vec4<f32>,
+    // KHR_texture_transform of the three textures: offset (xy), scale (zw); rotations in
+    // uv_rotation.xyz.
+    base_uv: vec4<f32>,
+    mr_uv: vec4<f32>,
+    normal_uv: vec4<f32>,
+    uv_rotation: vec4<f32>,
+    // x: roughness factor, y: IOR (the runtime sun's BSDF), z: the normal map's scale.
+    surface: vec4<f32>,
+    // The material's emissive factor (xyz).
+    emissive: vec4<f32>,
+    // The emissive texture's transform: offset (xy), scale (zw).
+    emissive_uv: vec4<f32>,
+    // x: the emissive texture's largest side (0: none), y: 1 when the pack leaves the
+    // emission to the runtime, z: 1 when double-sided, w: the texture's UV rotation.
+    emission: vec4<f32>,
+}
+
+#ifdef PLENOPTIC_STANDARD
+// An app mesh's StandardMaterial extended with the pack's lighting (lit/scene.rs): the
+// standard material's bindings come first, this extension's from 100 (the same bindings as
+// the proxy material's below, less its pack textures: the standard material has its own).
+@group(#{MATERIAL_BIND_GROUP}) @binding(100) var cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(101) var<uniform> params: ObjectParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(102) var<storage, read> volume_samples: array<vec4<u32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(103) var<storage, read> volume_bins: array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(104) var image_frame: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(105) var shading_cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(110) var<storage, read> cam: ViewParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
+#else
+@group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ObjectParams;
+// Three words per sample: (direction.xyz, radius), (radiance.rgb, distance), (t, object,
+// lighting RGB9E5, non-diffuse RGB9E5).
+@group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
+// The image-mode frame (image.wgsl), shown when cam.fill.z is 1.
+@group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
+// Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
+@group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
+
+@group(#{MATERIAL_BIND_GROUP}) @binding(6) var base_colour_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(7) var base_colour_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(8) var metallic_roughness_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(9) var metallic_roughness_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(14) var normal_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(15) var normal_sampler: sampler;
+@group(#{MATERIAL_BIND_GROUP}) @binding(16) var emissive_texture: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(17) var emissive_sampler: sampler;
+// The camera's view buffer: its lookups, settings, environment and objects' motion.
+@group(#{MATERIAL_BIND_GROUP}) @binding(10) var<storage, read> cam: ViewParams;
+@group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
+#endif
+
+// The fragment's diffuse albedo (set once per fragment, before any lookup).
+var<private> pixel_albedo: vec3<f32>;
+// Its textured base colour, metalness and roughness (the runtime sun's BSDF).
+var<private> pixel_base: vec3<f32>;
+var<private> pixel_metallic: f32;
+var<private> pixel_roughness: f32;
+// 0 where a marched reflection replaces the baked non-diffuse radiance.
+var<private> non_diffuse_weight: f32 = 1.0;
+// Its emission at its UV (pack 4 and marched surfaces; zero for app meshes).
+var<private> pixel_emission: vec3<f32>;
+// The drawn mesh's local_from_world (Bevy's mesh uniform): M_o(t)⁻¹ for a proxy placed at
+// the camera's time, the app mesh's own inverse transform for a lit mesh.
+var<private> local_from_world: mat4x4<f32>;
+
+// Whether this object is shaded from its material (albedo · lighting + non-diffuse).
+fn lit() -> bool {
+    return params.object.w == 1.0;
+}

@@ -1,0 +1,134 @@
+// The fragment's reconstructed radiance with plenoptic_recon's fallbacks, in its order
+// (thesis §8.2.3): its own lookups (lookup.wgsl), else the same-object hole fill over the
+// nearest ring of pixels (their points from the depth prepass, or on the fragment's plane),
+// else the object's nearby texels, else the heaviest key's texel ("background"); in image
+// mode the image-mode frame's texel.
+#define_import_path plenoptic::geometry::fill
+
+#import bevy_pbr::forward_io::VertexOutput
+#import bevy_pbr::mesh_view_bindings::view
+#import bevy_pbr::prepass_utils
+#import plenoptic::cube::cube_texel
+#import plenoptic::geometry::bindings::{MAX_LOOKUPS, cam, params, cubes, image_frame}
+#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour}
+
+// The world point where pixel centre `c` (framebuffer coordinates) sees the plane through `p`
+// with normal `nrm`; w = 0 where the ray misses it.
+fn pixel_on_plane(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
+    let uv = (c - view.viewport.xy) / view.viewport.zw;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let a4 = view.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    let b4 = view.world_from_clip * vec4<f32>(ndc, 0.5, 1.0);
+    let a = a4.xyz / a4.w;
+    let dir = normalize(b4.xyz / b4.w - a);
+    let denom = dot(dir, nrm);
+    if abs(denom) < 1e-4 {
+        return vec4<f32>(0.0);
+    }
+    let s = dot(p - a, nrm) / denom;
+    if s <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(a + dir * s, 1.0);
+}
+
+// The world point neighbouring pixel `c` (framebuffer coordinates, its centre) shows: from
+// the depth prepass where the camera has one (w = 0 where nothing is there), else where its
+// ray meets this fragment's surface plane (through `p`, normal `nrm`).
+fn neighbour_point(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
+#ifdef DEPTH_PREPASS
+    let depth = prepass_utils::prepass_depth(vec4<f32>(c, 0.0, 0.0), 0u);
+    if depth <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let uv = (c - view.viewport.xy) / view.viewport.zw;
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let w4 = view.world_from_clip * vec4<f32>(ndc, depth, 1.0);
+    return vec4<f32>(w4.xyz / w4.w, 1.0);
+#else
+    return pixel_on_plane(c, p, nrm);
+#endif
+}
+
+// The image-mode frame's texel of the fragment's pixel.
+fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
+    let size = textureDimensions(image_frame);
+    let uv = (position - view.viewport.xy) / view.viewport.zw;
+    let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+    return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
+}
+
+// The reconstructed radiance of the fragment (linear, before exposure).
+// `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
+fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
+    let object = u32(params.object.x);
+    let n = u32(cam.header.y);
+    let p = in.world_position.xyz;
+    let eye = view.world_position;
+    // The surface plane.
+    var nrm = ng_raw;
+    if dot(nrm, nrm) < 1e-20 {
+        nrm = in.world_normal;
+    }
+    nrm = normalize(nrm);
+    if cam.fill.z == 1.0 {
+        return image_frame_texel(in.position.xy);
+    }
+    let own = reconstruct(p, eye, object);
+    if own.w > 0.0 {
+        return vec4<f32>(own.rgb, 1.0);
+    }
+    // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
+    // this one whose points (neighbour_point) have a direct or volume lookup of this object;
+    // their mean.
+    let radius = i32(cam.fill.x);
+    let centre = in.position.xy;
+    for (var r = 1; r <= radius; r++) {
+        var sum = vec3<f32>(0.0);
+        var count = 0.0;
+        for (var dy = -r; dy <= r; dy++) {
+            // Whole rows at the ring's top and bottom, the two ends elsewhere.
+            let step = select(2 * r, 1, abs(dy) == r);
+            for (var dx = -r; dx <= r; dx += step) {
+                let c = centre + vec2<f32>(f32(dx), f32(dy));
+                if any(c < view.viewport.xy) || any(c >= view.viewport.xy + view.viewport.zw) {
+                    continue;
+                }
+                // Glazing is not in the depth prepass (Bevy's transparent pass): its ring
+                // pixels are found on its plane, panes being flat.
+                var q: vec4<f32>;
+                if params.object.z > 0.0 && params.object.z < 1.0 {
+                    q = pixel_on_plane(c, p, nrm);
+                } else {
+                    q = neighbour_point(c, p, nrm);
+                }
+                if q.w == 0.0 {
+                    continue;
+                }
+                let got = reconstruct(q.xyz, eye, object);
+                if got.w > 0.0 {
+                    sum += got.rgb;
+                    count += 1.0;
+                }
+            }
+        }
+        if count > 0.0 {
+            return vec4<f32>(sum / count, 1.0);
+        }
+    }
+    // A thin object no texel centre met where the lookups fell: its own nearest texels, else
+    // those of the surface around it at its distance.
+    let near = neighbour_texels(p, object);
+    if near.w > 0.0 {
+        return vec4<f32>(near.rgb / near.w, 1.0);
+    }
+    // Nothing: the heaviest key's texel in the point's direction ("background").
+    let h = u32(cam.fill.y);
+    if h < min(u32(cam.header.x), MAX_LOOKUPS) {
+        let t = cube_texel(p - cam.base[h].xyz, n);
+        let layer0 = u32(cam.base[h].w);
+        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
+        return vec4<f32>(colour(t, layer0, texel), 1.0);
+    }
+    return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+}

@@ -1,0 +1,307 @@
+// The lookups of geometry-assisted reconstruction (thesis §8.2.3; plenoptic_recon's geometry,
+// lookup, neighbour and volume modules, the same tests and weights): a point of the
+// fragment's object carried along its motion to each resident key's time, looked up in the
+// key's cube (the nearest texel, or seamlessly bilinear over the taps of the same surface),
+// accepted if the cube saw the same object at the same distance, and blended with
+// w_view · w_time · ((1 + cos θ)/2)^p; the temporal-volume fallback (thesis §7.4) where no
+// lookup is accepted, and the nearby texels tried after the hole fill (fill.wgsl).
+#define_import_path plenoptic::geometry::lookup
+
+#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
+#import plenoptic::geometry::bindings::{
+    MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, volume_samples,
+    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit,
+}
+
+// Point `p` of this object in the object's own frame (homogeneous): local_from_world · p
+// for an animated object; `p` itself for a static one (in world space), which is not
+// carried. Computed once per point, before its lookups.
+fn object_point(p: vec3<f32>) -> vec4<f32> {
+    if params.object.y < 0.0 {
+        return vec4<f32>(p, 1.0);
+    }
+    return local_from_world * vec4<f32>(p, 1.0);
+}
+
+// The point whose `object_point` is `local`, carried to lookup k's key time τ: M_o(τ) · local
+// for an animated object, the point itself for a static one.
+fn carried(local: vec4<f32>, k: u32) -> vec3<f32> {
+    let slot = params.object.y;
+    if slot < 0.0 {
+        return local.xyz;
+    }
+    return (cam.motion[u32(slot) * MAX_LOOKUPS + k] * local).xyz;
+}
+
+// The shaded colour of a shading texel: the fragment's albedo · lighting + non-diffuse (in the
+// hole fill, the neighbours' lighting times this fragment's own albedo, as on the CPU).
+fn shaded(s: vec2<u32>) -> vec3<f32> {
+    return pixel_albedo * rgb9e5_decode(s.x) + rgb9e5_decode(s.y) * non_diffuse_weight;
+}
+
+// plenoptic_pack::cube::oct_decode.
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    var v = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
+    if v.z < 0.0 {
+        let x = (1.0 - abs(v.y)) * select(-1.0, 1.0, v.x >= 0.0);
+        let y = (1.0 - abs(v.x)) * select(-1.0, 1.0, v.y >= 0.0);
+        v.x = x;
+        v.y = y;
+    }
+    return normalize(v);
+}
+
+// Whether key texel `c` (its key-texture texel `texel`) shows the surface of the lookup `d`
+// (length `l`) of `object`: the same object at the distance within `tol · l`, or, where the
+// key has normals (`normals`), its centre point on the plane through the lookup's point with
+// the texel's normal within `tol · l` (plenoptic_recon's lookup::same_surface).
+fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32>, l: f32, tol: f32, normals: bool) -> bool {
+    if texel.z != object {
+        return false;
+    }
+    let dc = bitcast<f32>(texel.y);
+    if abs(dc - l) <= tol * l {
+        return true;
+    }
+    if !normals {
+        return false;
+    }
+    let nrm = oct_decode(max(unpack2x16snorm(texel.w), vec2<f32>(-1.0)));
+    return abs(dot(texel_direction(c, n) * dc - d, nrm)) <= tol * l;
+}
+
+// The radiance of the key at `layer0` in direction `d` (length `l`), seamlessly bilinear
+// over the taps that show the lookup's surface of `object` (same_surface) or are the
+// nearest texel `t` (plenoptic_recon's lookup::filtered).
+fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32, tol: f32, normals: bool) -> vec3<f32> {
+    var acc = vec4<f32>(0.0);
+    for (var k = 0u; k < 4u; k++) {
+        let tap = bilinear_tap(d, n, k);
+        if tap.w <= 0.0 {
+            continue;
+        }
+        let c = vec3<u32>(tap.xyz);
+        let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
+        let nearest = all(c == t);
+        if nearest || same_surface(c, n, texel, object, d, l, tol, normals) {
+            acc += vec4<f32>(colour(c, layer0, texel), 1.0) * tap.w;
+        }
+    }
+    if acc.w > 0.0 {
+        return acc.rgb / acc.w;
+    }
+    return colour(t, layer0, textureLoad(cubes, t.xy, layer0 + t.z, 0));
+}
+
+// The colour of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`):
+// its radiance, or its shaded lighting for an object shaded from its material.
+fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
+    if lit() {
+        return shaded(textureLoad(shading_cubes, c.xy, layer0 + c.z, 0).xy);
+    }
+    return rgb9e5_decode(texel.x);
+}
+
+// Lookup k of a point: where in its key the point is looked up.
+struct Lookup {
+    // Whether the point is away from the key's centre (else the lookup has no direction).
+    ok: bool,
+    // From the key's centre to the point carried to the key's time.
+    d: vec3<f32>,
+    // |d|.
+    dist: f32,
+    // The key texel in direction d: (column, row, face).
+    t: vec3<u32>,
+}
+
+// Lookup k of the point whose `object_point` is `local`, in keys of face size `n`.
+fn lookup_of(local: vec4<f32>, k: u32, n: u32) -> Lookup {
+    var l: Lookup;
+    l.d = carried(local, k) - cam.base[k].xyz;
+    l.dist = length(l.d);
+    l.ok = !(l.dist <= 1e-6);
+    if l.ok {
+        l.t = cube_texel(l.d, n);
+    }
+    return l;
+}
+
+// The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
+fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+    let count = u32(cam.header.x);
+    let n = u32(cam.header.y);
+    let tol = cam.tuning.x;
+    let power = cam.tuning.y;
+    let to_eye = normalize(eye - p);
+    let local = object_point(p);
+    var sum = vec3<f32>(0.0);
+    var ws = 0.0;
+    for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
+        let l = lookup_of(local, k, n);
+        if !l.ok {
+            continue;
+        }
+        let d = l.d;
+        let dist = l.dist;
+        let t = l.t;
+        let layer = u32(cam.base[k].w) + t.z;
+        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0);
+        if texel.z != object {
+            continue;
+        }
+        let dc = bitcast<f32>(texel.y);
+        // Fast path: the texel's centre distance agrees. Otherwise compare with the distance
+        // to the texel's surface plane along the lookup direction (grazing surfaces).
+        if abs(dc - dist) > tol * dist {
+            if cam.weight[k].y == 0.0 {
+                continue;
+            }
+            let nrm = oct_decode(max(unpack2x16snorm(texel.w), vec2<f32>(-1.0)));
+            let denom = dot(d, nrm) / dist;
+            if abs(denom) <= 0.05 {
+                continue;
+            }
+            let expected = dot(texel_direction(t, n) * dc, nrm) / denom;
+            if abs(expected - dist) > tol * dist {
+                continue;
+            }
+        }
+        var wa = 1.0;
+        if power > 0.0 {
+            let c = max((1.0 - dot(d, to_eye) / dist) * 0.5, 1e-3);
+            wa = pow(c, power);
+        }
+        let w = cam.weight[k].x * wa;
+        var radiance = rgb9e5_decode(texel.x);
+        // Lighting is always filtered (plenoptic_recon's shading module).
+        if cam.flags.x == 1.0 || lit() {
+            radiance = filtered(u32(cam.base[k].w), n, d, t, object, dist, tol, cam.weight[k].y != 0.0);
+        }
+        sum += radiance * w;
+        ws += w;
+    }
+    return vec4<f32>(sum, ws);
+}
+
+// plenoptic_recon's NEIGHBOUR_TEXELS and NEIGHBOUR_TOLERANCE.
+const NEIGHBOUR_TEXELS: i32 = 8;
+const NEIGHBOUR_TOLERANCE: f32 = 0.25;
+// Ranks another object's texel behind every texel of the object itself.
+const OTHER_OBJECT: i32 = 2 * NEIGHBOUR_TEXELS * NEIGHBOUR_TEXELS + 1;
+// Above every score.
+const NO_TEXEL: i32 = 1073741824;
+
+// The fallback after the hole fill (plenoptic_recon's neighbour_texel): in each lookup's key,
+// the nearest texel at about the distance of `p` within NEIGHBOUR_TEXELS of the lookup's
+// texel on its face, `object`'s own first, then any surface's (the first in row order on
+// ties). Returns (Σ w·colour, Σ w).
+fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
+    var sum = vec3<f32>(0.0);
+    var ws = 0.0;
+    let count = u32(cam.header.x);
+    let n = u32(cam.header.y);
+    let local = object_point(p);
+    for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
+        let l = lookup_of(local, k, n);
+        if !l.ok {
+            continue;
+        }
+        let dist = l.dist;
+        let t = l.t;
+        let layer0 = u32(cam.base[k].w);
+        var best = NO_TEXEL;
+        var best_c = t;
+        for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
+            for (var di = -NEIGHBOUR_TEXELS; di <= NEIGHBOUR_TEXELS; di++) {
+                let x = i32(t.x) + di;
+                let y = i32(t.y) + dj;
+                if x < 0 || y < 0 || x >= i32(n) || y >= i32(n) {
+                    continue;
+                }
+                let c = vec3<u32>(u32(x), u32(y), t.z);
+                let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
+                // The object's own texels first, then any surface at the point's distance.
+                let score = di * di + dj * dj + select(OTHER_OBJECT, 0, texel.z == object);
+                if texel.z != 0u && abs(bitcast<f32>(texel.y) - dist) <= NEIGHBOUR_TOLERANCE * dist
+                    && score < best {
+                    best = score;
+                    best_c = c;
+                }
+            }
+        }
+        if best < NO_TEXEL {
+            let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
+            sum += colour(best_c, layer0, texel) * cam.weight[k].x;
+            ws += cam.weight[k].x;
+        }
+    }
+    return vec4<f32>(sum, ws);
+}
+
+// The temporal-volume fallback (plenoptic_recon's VolumeIndex::lookup, summed over the views
+// with their weights): samples of `object` in the direction bin of `p` from each base view,
+// whose cone contains that direction, whose distance agrees within 3× the depth tolerance and
+// whose time is within t ± tε, weighted by the tent filter and the angular falloff.
+// Returns (Σ w·radiance, Σ w).
+fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
+    let count = min(u32(cam.header.z), MAX_VOLUMES);
+    let tol = cam.tuning.x * 3.0;
+    let t = cam.tuning.z;
+    let eps = cam.tuning.w;
+    let half_bin = 1.0 / f32(BIN_FACE);
+    var sum = vec3<f32>(0.0);
+    var ws = 0.0;
+    for (var i = 0u; i < count; i++) {
+        let d = p - cam.volume[i].xyz;
+        let dist = length(d);
+        if dist <= 1e-6 {
+            continue;
+        }
+        let dir = d / dist;
+        let bt = cube_texel(dir, BIN_FACE);
+        let bin = cam.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
+        let first = cam.volume_range[i].x;
+        let view_w = cam.volume[i].w;
+        for (var j = volume_bins[bin]; j < volume_bins[bin + 1u]; j++) {
+            let s = 3u * (first + j);
+            let c = volume_samples[s + 2u];
+            if c.y != object {
+                continue;
+            }
+            let dt = abs(bitcast<f32>(c.x) - t);
+            if dt > eps {
+                continue;
+            }
+            let b = bitcast<vec4<f32>>(volume_samples[s + 1u]);
+            if abs(b.w - dist) > tol * dist {
+                continue;
+            }
+            let a = bitcast<vec4<f32>>(volume_samples[s]);
+            let angle = acos(clamp(dot(a.xyz, dir), -1.0, 1.0));
+            let r = max(a.w, half_bin);
+            if angle < r {
+                let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
+                var value = b.rgb;
+                if lit() {
+                    value = shaded(c.zw);
+                }
+                sum += value * w;
+                ws += w;
+            }
+        }
+    }
+    return vec4<f32>(sum, ws);
+}
+
+// Direct lookups, else the temporal-volume fallback: (radiance, 1) or (0, 0) for a hole.
+fn reconstruct(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+    let direct = direct_lookups(p, eye, object);
+    if direct.w > 0.0 {
+        return vec4<f32>(direct.rgb / direct.w, 1.0);
+    }
+    let volume = volume_lookups(p, object);
+    if volume.w > 0.0 {
+        return vec4<f32>(volume.rgb / volume.w, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
