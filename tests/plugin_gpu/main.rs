@@ -13,6 +13,7 @@
 //!   pair, a runtime sun per camera), each equal to its CPU frame.
 //! - [`per_view`]: a camera's lookups live in its view buffer; its materials are not
 //!   rewritten from frame to frame.
+//! - [`counters`]: the shaders' cost counters count what the frame did and change nothing.
 
 #[path = "../../crates/bevy_plenoptic/tests/gpu/common/mod.rs"]
 mod common;
@@ -21,6 +22,7 @@ mod common;
 #[path = "../../crates/plenoptic_recon/tests/common/mod.rs"]
 mod pack;
 
+mod counters;
 mod harness;
 mod lit;
 mod many_cameras;

@@ -59,8 +59,18 @@ pub(crate) fn plugin_cameras(
     dir: &std::path::Path,
     eyes: &[Eye],
 ) -> (App, Vec<Entity>, Vec<Handle<Image>>) {
+    plugin_cameras_with(dir, eyes, |_| {})
+}
+
+/// [`plugin_cameras`] with the plugin's settings changed by `settings` first.
+pub(crate) fn plugin_cameras_with(
+    dir: &std::path::Path,
+    eyes: &[Eye],
+    settings: impl FnOnce(&mut PlenopticSettings),
+) -> (App, Vec<Entity>, Vec<Handle<Image>>) {
     let mut app = headless_app_in(dir);
     app.world_mut().resource_mut::<PlenopticSettings>().backend = Backend::Gpu;
+    settings(&mut app.world_mut().resource_mut::<PlenopticSettings>());
     let handle: Handle<RadiancePack> = app.world().resource::<AssetServer>().load("room.pack");
     let mut targets = Vec::new();
     let mut cameras = Vec::new();

@@ -25,6 +25,11 @@ pub struct PlenopticSettings {
     /// environment light of its own gets one made from the pack's radiance around it at its
     /// time ([`crate::lit`]).
     pub environment_light: bool,
+    /// Count what the GPU reconstruction's shaders do per pixel (lookups, loads, samples,
+    /// steps, fallbacks) into each camera's [`crate::reconstruct::counters::CostReport`].
+    /// A diagnostic: the shaders are compiled with the counting in, and each frame's counts
+    /// are read back. Read when a camera's proxies get their materials.
+    pub cost_counters: bool,
 }
 
 /// Where frames are reconstructed.
@@ -57,6 +62,7 @@ impl Default for PlenopticSettings {
             backend: Backend::Auto,
             first_render_layer: 16,
             environment_light: true,
+            cost_counters: false,
         }
     }
 }

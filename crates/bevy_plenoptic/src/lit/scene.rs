@@ -60,6 +60,7 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::camera::layers::ViewLayer;
 use crate::proxy::{PlenopticScene, ProxyOf};
+use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::cpu::CpuFrameMaterial;
 use crate::reconstruct::environment::EnvironmentImages;
 use crate::reconstruct::frames::{CpuFrameImage, ImageFrame};
@@ -68,10 +69,10 @@ use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
 use crate::reconstruct::geometry::view::ViewBuffer;
 use crate::reconstruct::geometry::volume::VolumeBuffers;
 use crate::reconstruct::geometry::{
-    MaterialFactors, ObjectParams, material_factors, object_coverage,
+    GeometryKey, MaterialFactors, ObjectParams, material_factors, object_coverage,
 };
 use crate::reconstruct::{KeyTextures, ReconstructSystems};
-use crate::settings::{Backend, PlenopticSystems, ResolvedBackend};
+use crate::settings::{Backend, PlenopticSettings, PlenopticSystems, ResolvedBackend};
 
 /// Lights the meshes under this entity (a `WorldAssetRoot`, or any ancestor of them) with the
 /// pack of a plenoptic camera at that camera's time (see the module doc).
@@ -108,6 +109,7 @@ pub type LitMaterial = ExtendedMaterial<StandardMaterial, PlenopticLighting>;
 /// The pack's lighting for one lit mesh: the proxy material's bindings (from 100, after the
 /// standard material's), less its pack textures.
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
+#[bind_group_data(GeometryKey)]
 pub struct PlenopticLighting {
     /// Resident keys ([`crate::reconstruct`]).
     #[texture(100, dimension = "2d_array", sample_type = "u_int")]
@@ -141,6 +143,11 @@ pub struct PlenopticLighting {
     /// The camera's moving proxies placed at its time.
     #[storage(113, read_only)]
     pub ray_placements: Handle<ShaderBuffer>,
+    /// The camera's cost counters, written when `cost_counters` is on.
+    #[storage(114, visibility(fragment))]
+    pub counters: Handle<ShaderBuffer>,
+    /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
+    pub cost_counters: bool,
     /// The object's material in the pack (its transmission, IOR and emission; the per-pixel
     /// base colour, metalness and roughness are the standard material's).
     pub factors: Option<MaterialFactors>,
@@ -148,6 +155,14 @@ pub struct PlenopticLighting {
     pub coverage: f32,
     /// The camera's [`ViewBuffer::bindings`] when the bind group was last prepared.
     pub bindings: u64,
+}
+
+impl From<&PlenopticLighting> for GeometryKey {
+    fn from(m: &PlenopticLighting) -> Self {
+        Self {
+            cost_counters: m.cost_counters,
+        }
+    }
 }
 
 impl MaterialExtension for PlenopticLighting {
@@ -159,11 +174,12 @@ impl MaterialExtension for PlenopticLighting {
         _pipeline: &bevy::pbr::MaterialExtensionPipeline,
         descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
         _layout: &bevy::mesh::MeshVertexBufferLayoutRef,
-        _key: MaterialExtensionKey<Self>,
+        key: MaterialExtensionKey<Self>,
     ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
         if let Some(fragment) = descriptor.fragment.as_mut() {
             fragment.shader_defs.push("PLENOPTIC_STANDARD".into());
         }
+        key.bind_group_data.add_shader_defs(descriptor);
         Ok(())
     }
 }
@@ -351,19 +367,29 @@ fn attach_lit_materials(
     parents: Query<&ChildOf>,
     names: Query<&Name>,
     unchecked: Query<Unchecked, (Without<LitObject>, Without<NotInPack>)>,
-    cameras: Query<(&PlenopticCamera, &ImageFrame, &CameraRays, &ViewBuffer)>,
+    cameras: Query<(
+        &PlenopticCamera,
+        &ImageFrame,
+        &CameraRays,
+        &ViewBuffer,
+        &CounterBuffer,
+    )>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
     mut lit: ResMut<Assets<LitMaterial>>,
     mut env_images: ResMut<EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
-    (mut pack_rays, mut buffers): (ResMut<PackRays>, ResMut<Assets<ShaderBuffer>>),
+    (mut pack_rays, mut buffers, settings): (
+        ResMut<PackRays>,
+        ResMut<Assets<ShaderBuffer>>,
+        Res<PlenopticSettings>,
+    ),
 ) {
     if backend.0 != Backend::Gpu {
         return;
     }
     for (root, scene) in &roots {
-        let Ok((cam, image_frame, camera_rays, view)) = cameras.get(scene.camera) else {
+        let Ok((cam, image_frame, camera_rays, view, counters)) = cameras.get(scene.camera) else {
             continue;
         };
         let id = cam.pack.id();
@@ -409,6 +435,8 @@ fn attach_lit_materials(
                     environment_image: env_images.get(id, pack, &mut images),
                     rays: pack_rays.get(id, pack, &mut buffers),
                     ray_placements: camera_rays.buffer.clone(),
+                    counters: counters.buffer.clone(),
+                    cost_counters: settings.cost_counters,
                     factors,
                     coverage,
                     bindings: view.bindings,
@@ -492,11 +520,12 @@ impl frame::BindsView for LitMaterial {
         (&e.params, e.bindings, &e.view)
     }
 
-    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>) {
+    fn bind(&mut self, params: ObjectParams, view: &ViewBuffer) {
         let e = &mut self.extension;
         e.params = params;
-        e.bindings = bindings;
-        e.view = view;
+        e.bindings = view.bindings;
+        e.view = view.buffer.clone();
+        e.counters = view.counters.clone();
     }
 }
 

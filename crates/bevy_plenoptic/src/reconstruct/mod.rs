@@ -24,6 +24,7 @@
 //! (distances and ids are not filterable anyway).
 
 pub mod background;
+pub mod counters;
 pub mod cpu;
 pub mod environment;
 pub mod frames;
@@ -73,7 +74,10 @@ impl Plugin for PlenopticReconstructPlugin {
         // environment (`plenoptic::environment`).
         bevy::shader::load_shader_library!(app, "cube.wgsl");
         bevy::shader::load_shader_library!(app, "environment.wgsl");
+        // The cost counters (`plenoptic::counters`).
+        bevy::shader::load_shader_library!(app, "counters.wgsl");
         upload::build(app);
+        counters::build(app);
         app.init_resource::<KeyTextures>()
             .init_resource::<environment::EnvironmentImages>()
             .add_message::<frames::FrameReplaced>()

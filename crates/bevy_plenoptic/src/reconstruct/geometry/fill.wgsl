@@ -11,6 +11,7 @@
 #import plenoptic::cube::cube_texel
 #import plenoptic::geometry::bindings::{MAX_LOOKUPS, cam, params, cubes, image_frame}
 #import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour}
+#import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
 
 // The world point where pixel centre `c` (framebuffer coordinates) sees the plane through `p`
 // with normal `nrm`; w = 0 where the ray misses it.
@@ -37,6 +38,7 @@ fn pixel_on_plane(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
 // ray meets this fragment's surface plane (through `p`, normal `nrm`).
 fn neighbour_point(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
 #ifdef DEPTH_PREPASS
+    tally(C_LOADS_4, 1u);
     let depth = prepass_utils::prepass_depth(vec4<f32>(c, 0.0, 0.0), 0u);
     if depth <= 0.0 {
         return vec4<f32>(0.0);
@@ -55,6 +57,7 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
     let size = textureDimensions(image_frame);
     let uv = (position - view.viewport.xy) / view.viewport.zw;
     let p = min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+    tally(C_LOADS_16, 1u);
     return vec4<f32>(textureLoad(image_frame, p, 0).rgb, 1.0);
 }
 
@@ -83,6 +86,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     // their mean.
     let radius = i32(cam.fill.x);
     let centre = in.position.xy;
+    tally(C_FILL, 1u);
     for (var r = 1; r <= radius; r++) {
         var sum = vec3<f32>(0.0);
         var count = 0.0;
@@ -105,6 +109,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
                 if q.w == 0.0 {
                     continue;
                 }
+                tally(C_FILL_LOOKUPS, 1u);
                 let got = reconstruct(q.xyz, eye, object);
                 if got.w > 0.0 {
                     sum += got.rgb;
@@ -127,6 +132,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     if h < min(u32(cam.header.x), MAX_LOOKUPS) {
         let t = cube_texel(p - cam.base[h].xyz, n);
         let layer0 = u32(cam.base[h].w);
+        tally(C_LOADS_16, 1u);
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
         return vec4<f32>(colour(t, layer0, texel), 1.0);
     }

@@ -172,8 +172,8 @@ pub(crate) trait BindsView {
     fn shading(&self, id: u32) -> ObjectShading<'_>;
     /// The object's uniform, the camera bindings' generation and the view buffer it binds.
     fn bound(&self) -> (&ObjectParams, u64, &Handle<ShaderBuffer>);
-    /// Binds them.
-    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>);
+    /// Binds the uniform and the camera's view buffer and counters.
+    fn bind(&mut self, params: ObjectParams, view: &view::ViewBuffer);
 }
 
 /// Binds material `handle` to object `id`'s uniform as camera `cam` shows it from `pack` and
@@ -193,7 +193,7 @@ pub(crate) fn rebind<M: Asset + BindsView>(
     let (bound, bindings, buffer) = m.bound();
     let stale = *bound != params || bindings != view.bindings || *buffer != view.buffer;
     if stale && let Some(mut m) = materials.get_mut(handle) {
-        m.bind(params, view.bindings, view.buffer.clone());
+        m.bind(params, view);
     }
 }
 

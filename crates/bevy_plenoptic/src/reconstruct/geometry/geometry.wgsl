@@ -32,6 +32,7 @@
 #import plenoptic::geometry::fill::radiance
 #import plenoptic::geometry::sun::sun_light
 #import plenoptic::geometry::specular::{marched, see_through, reflection}
+#import plenoptic::counters::flush_counters
 
 // The reconstructed radiance, times the camera's exposure as Bevy's own lights are
 // (`view.exposure`, from its `Exposure`), kept inside the f16 HDR target's range; tonemapped
@@ -116,6 +117,7 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
     if see_through() {
         alpha = 1.0 - params.glass.y;
     }
+    flush_counters(in.position.xy);
     var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), alpha);
 #ifdef TONEMAP_IN_SHADER
     out = tone_mapping(out, view.color_grading);

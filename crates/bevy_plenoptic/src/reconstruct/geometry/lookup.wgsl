@@ -8,6 +8,7 @@
 #define_import_path plenoptic::geometry::lookup
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap}
+#import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, volume_samples,
     volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit,
@@ -81,6 +82,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32
             continue;
         }
         let c = vec3<u32>(tap.xyz);
+        tally(C_LOADS_16, 1u);
         let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
         let nearest = all(c == t);
         if nearest || same_surface(c, n, texel, object, d, l, tol, normals) {
@@ -90,6 +92,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32
     if acc.w > 0.0 {
         return acc.rgb / acc.w;
     }
+    tally(C_LOADS_16, 1u);
     return colour(t, layer0, textureLoad(cubes, t.xy, layer0 + t.z, 0));
 }
 
@@ -97,6 +100,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, object: u32, l: f32
 // its radiance, or its shaded lighting for an object shaded from its material.
 fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
     if lit() {
+        tally(C_LOADS_8, 1u);
         return shaded(textureLoad(shading_cubes, c.xy, layer0 + c.z, 0).xy);
     }
     return rgb9e5_decode(texel.x);
@@ -145,6 +149,8 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         let dist = l.dist;
         let t = l.t;
         let layer = u32(cam.base[k].w) + t.z;
+        tally(C_LOOKUPS, 1u);
+        tally(C_LOADS_16, 1u);
         let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer, 0);
         if texel.z != object {
             continue;
@@ -196,6 +202,7 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·colour, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
+    tally(C_NEIGHBOUR, 1u);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
     let count = u32(cam.header.x);
@@ -219,6 +226,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
                     continue;
                 }
                 let c = vec3<u32>(u32(x), u32(y), t.z);
+                tally(C_LOADS_16, 1u);
                 let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
                 // The object's own texels first, then any surface at the point's distance.
                 let score = di * di + dj * dj + select(OTHER_OBJECT, 0, texel.z == object);
@@ -230,6 +238,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
             }
         }
         if best < NO_TEXEL {
+            tally(C_LOADS_16, 1u);
             let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
             sum += colour(best_c, layer0, texel) * cam.weight[k].x;
             ws += cam.weight[k].x;
@@ -244,6 +253,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
 // whose time is within t ± tε, weighted by the tent filter and the angular falloff.
 // Returns (Σ w·radiance, Σ w).
 fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
+    tally(C_VOLUME, 1u);
     let count = min(u32(cam.header.z), MAX_VOLUMES);
     let tol = cam.tuning.x * 3.0;
     let t = cam.tuning.z;
@@ -262,8 +272,10 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
         let bin = cam.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
         let first = cam.volume_range[i].x;
         let view_w = cam.volume[i].w;
+        tally(C_LOADS_4, 2u);
         for (var j = volume_bins[bin]; j < volume_bins[bin + 1u]; j++) {
             let s = 3u * (first + j);
+            tally(C_LOADS_16, 1u);
             let c = volume_samples[s + 2u];
             if c.y != object {
                 continue;
@@ -272,10 +284,12 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
             if dt > eps {
                 continue;
             }
+            tally(C_LOADS_16, 1u);
             let b = bitcast<vec4<f32>>(volume_samples[s + 1u]);
             if abs(b.w - dist) > tol * dist {
                 continue;
             }
+            tally(C_LOADS_16, 1u);
             let a = bitcast<vec4<f32>>(volume_samples[s]);
             let angle = acos(clamp(dot(a.xyz, dir), -1.0, 1.0));
             let r = max(a.w, half_bin);

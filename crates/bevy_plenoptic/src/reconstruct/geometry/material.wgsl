@@ -8,6 +8,7 @@
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
 #import plenoptic::geometry::bindings::params
+#import plenoptic::counters::{tally, C_SAMPLES}
 #ifndef PLENOPTIC_STANDARD
 #import plenoptic::geometry::bindings::{
     base_colour_texture, base_colour_sampler, metallic_roughness_texture,
@@ -41,11 +42,13 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     if params.material.y > 0.0 {
         let st = uv_transform(uv, params.base_uv, params.uv_rotation.x);
         let lod = level(footprint, params.base_uv, params.material.y);
+        tally(C_SAMPLES, 1u);
         base *= textureSampleLevel(base_colour_texture, base_colour_sampler, st, lod).rgb;
     }
     if params.material.z > 0.0 {
         let st = uv_transform(uv, params.mr_uv, params.uv_rotation.y);
         let lod = level(footprint, params.mr_uv, params.material.z);
+        tally(C_SAMPLES, 1u);
         let mr = textureSampleLevel(metallic_roughness_texture, metallic_roughness_sampler, st, lod);
         metallic *= mr.b;
         roughness *= mr.g;
@@ -67,6 +70,7 @@ fn material_emission(in: VertexOutput, uv: vec2<f32>, footprint: f32) -> vec3<f3
     if params.emission.x > 0.0 && any(e != vec3<f32>(0.0)) {
         let st = uv_transform(uv, params.emissive_uv, params.emission.w);
         let lod = level(footprint, params.emissive_uv, params.emission.x);
+        tally(C_SAMPLES, 1u);
         e *= textureSampleLevel(emissive_texture, emissive_sampler, st, lod).rgb;
     }
     return e;
@@ -81,6 +85,7 @@ fn bent_normal(ns: vec3<f32>, tangent: vec4<f32>, uv: vec2<f32>, footprint: f32)
     }
     let st = uv_transform(uv, params.normal_uv, params.uv_rotation.z);
     let lod = level(footprint, params.normal_uv, params.material.w);
+    tally(C_SAMPLES, 1u);
     let c = textureSampleLevel(normal_texture, normal_sampler, st, lod).rgb * 2.0 - 1.0;
     let local = vec3<f32>(c.xy * params.surface.z, c.z);
     let t = tangent.xyz - ns * dot(ns, tangent.xyz);

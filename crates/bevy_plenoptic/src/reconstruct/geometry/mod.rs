@@ -119,6 +119,7 @@ impl Plugin for GeometryAssistedPlugin {
 /// ([`view::ViewBuffer`]) for the camera's lookups, which every material of the camera
 /// shares.
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
+#[bind_group_data(GeometryKey)]
 pub struct PlenopticMaterial {
     /// Resident keys (see the module doc).
     #[texture(0, dimension = "2d_array", sample_type = "u_int")]
@@ -170,6 +171,12 @@ pub struct PlenopticMaterial {
     /// The camera's moving proxies placed at its time ([`rays::CameraRays`]).
     #[storage(13, read_only)]
     pub ray_placements: Handle<ShaderBuffer>,
+    /// The camera's cost counters ([`crate::reconstruct::counters::CounterBuffer`]), written
+    /// when `cost_counters` is on.
+    #[storage(18, visibility(fragment))]
+    pub counters: Handle<ShaderBuffer>,
+    /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
+    pub cost_counters: bool,
     /// The object's diffuse albedo factors from its material in the pack: base-colour factor
     /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
     /// (the textures multiply per pixel); `None` for an object without a material, which
@@ -190,6 +197,36 @@ pub struct PlenopticMaterial {
     pub transmissive: bool,
     /// The camera's [`view::ViewBuffer::bindings`] when the bind group was last prepared.
     pub bindings: u64,
+}
+
+/// The pipeline key of a [`PlenopticMaterial`] and of a lit mesh's lighting: what its
+/// shader is compiled with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct GeometryKey {
+    /// Counting the cost (the `PLENOPTIC_COUNTERS` shader def).
+    pub cost_counters: bool,
+}
+
+impl From<&PlenopticMaterial> for GeometryKey {
+    fn from(m: &PlenopticMaterial) -> Self {
+        Self {
+            cost_counters: m.cost_counters,
+        }
+    }
+}
+
+impl GeometryKey {
+    /// Adds this key's shader defs to a pipeline's fragment stage.
+    pub fn add_shader_defs(
+        self,
+        descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
+    ) {
+        if let Some(fragment) = descriptor.fragment.as_mut()
+            && self.cost_counters
+        {
+            fragment.shader_defs.push("PLENOPTIC_COUNTERS".into());
+        }
+    }
 }
 
 impl Material for PlenopticMaterial {
@@ -214,9 +251,10 @@ impl Material for PlenopticMaterial {
         _pipeline: &bevy::pbr::MaterialPipeline,
         descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
         _layout: &bevy::mesh::MeshVertexBufferLayoutRef,
-        _key: bevy::pbr::MaterialPipelineKey<Self>,
+        key: bevy::pbr::MaterialPipelineKey<Self>,
     ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
         descriptor.primitive.cull_mode = None;
+        key.bind_group_data.add_shader_defs(descriptor);
         Ok(())
     }
 }

@@ -13,9 +13,10 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::proxy::{PlenopticScene, ProxyOf};
 use crate::reconstruct::KeyTextures;
+use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentImages;
 use crate::reconstruct::frames::ImageFrame;
-use crate::settings::{Backend, ResolvedBackend};
+use crate::settings::{Backend, PlenopticSettings, ResolvedBackend};
 
 /// Gives every proxy of a camera on the GPU backend its proxy material.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
@@ -24,7 +25,13 @@ pub(super) fn attach_materials(
     backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
-    cameras: Query<(&ImageFrame, &rays::CameraRays, &view::ViewBuffer)>,
+    cameras: Query<(
+        &ImageFrame,
+        &rays::CameraRays,
+        &view::ViewBuffer,
+        &CounterBuffer,
+    )>,
+    settings: Res<PlenopticSettings>,
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
@@ -40,7 +47,8 @@ pub(super) fn attach_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Ok((image_frame, camera_rays, view_buffer)) = cameras.get(scene.camera) else {
+        let Ok((image_frame, camera_rays, view_buffer, counters)) = cameras.get(scene.camera)
+        else {
             continue;
         };
         let (Some(tex), Some(vol), Some(pack)) = (
@@ -70,6 +78,8 @@ pub(super) fn attach_materials(
             environment_image,
             rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
             ray_placements: camera_rays.buffer.clone(),
+            counters: counters.buffer.clone(),
+            cost_counters: settings.cost_counters,
             albedo: factors,
             coverage: object_coverage(pack, of.id),
             transmissive,
@@ -123,9 +133,10 @@ impl frame::BindsView for PlenopticMaterial {
         (&self.params, self.bindings, &self.view)
     }
 
-    fn bind(&mut self, params: ObjectParams, bindings: u64, view: Handle<ShaderBuffer>) {
+    fn bind(&mut self, params: ObjectParams, view: &view::ViewBuffer) {
         self.params = params;
-        self.bindings = bindings;
-        self.view = view;
+        self.bindings = view.bindings;
+        self.view = view.buffer.clone();
+        self.counters = view.counters.clone();
     }
 }

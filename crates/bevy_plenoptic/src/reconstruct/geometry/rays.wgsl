@@ -3,6 +3,8 @@
 // nodes with miss links (Smits 1998); every link points forward, so it ends.
 #define_import_path plenoptic::rays
 
+#import plenoptic::counters::{tally, C_LOADS_16, C_STEPS}
+
 #ifdef PLENOPTIC_STANDARD
 @group(#{MATERIAL_BIND_GROUP}) @binding(112) var<storage, read> rays: array<vec4<f32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(113) var<storage, read> ray_placements: array<vec4<f32>>;
@@ -63,6 +65,8 @@ fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) 
     let inv = safe_recip(dir);
     var i = first;
     while i < end {
+        tally(C_STEPS, 1u);
+        tally(C_LOADS_16, 2u);
         let a = rays[i];
         let b = rays[i + 1u];
         if !meets_box(origin, inv, tmax, a.xyz, b.xyz) {
@@ -76,6 +80,8 @@ fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) 
         }
         var j = leaf;
         loop {
+            tally(C_STEPS, 1u);
+            tally(C_LOADS_16, 3u);
             let v0 = rays[j];
             if hits_triangle(origin, dir, tmax, v0.xyz, rays[j + 1u].xyz, rays[j + 2u].xyz) {
                 return true;

@@ -6,6 +6,7 @@
 #define_import_path plenoptic::reflect
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel}
+#import plenoptic::counters::{tally, C_LOADS_16, C_STEPS}
 
 // plenoptic_recon::specular's MAX_STEPS, REFINE_STEPS and STEP_TEXELS (checked by a test in
 // reflect.rs).
@@ -19,6 +20,8 @@ fn gap(cubes: texture_2d_array<u32>, layer0: u32, n: u32, centre: vec3<f32>, ori
     let q = origin + dir * s - centre;
     let d = length(q);
     let t = cube_texel(q, n);
+    tally(C_STEPS, 1u);
+    tally(C_LOADS_16, 1u);
     let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
     return vec2<f32>(d - bitcast<f32>(texel.y), d);
 }
@@ -83,9 +86,11 @@ fn fetch(cubes: texture_2d_array<u32>, layer0: u32, n: u32, to: vec3<f32>, angle
     let axis = normalize(to);
     if angle < 0.5 * (2.0 / f32(n)) {
         let t = cube_texel(axis, n);
+        tally(C_LOADS_16, 1u);
         return rgb9e5_decode(textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0).x);
     }
     let pair = orthonormal_pair(axis);
+    tally(C_LOADS_16, 25u);
     var sum = vec3<f32>(0.0);
     var total = 0.0;
     for (var i = -2; i <= 2; i++) {

@@ -11,6 +11,7 @@
 #import plenoptic::environment::environment
 #import plenoptic::reflect::{march, fetch, orthonormal_pair}
 #import plenoptic::rays::{has_rays, occluded}
+#import plenoptic::counters::{tally, C_LOADS_16}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, cam, params, cubes, env_image, pixel_base, pixel_metallic, pixel_roughness,
 }
@@ -33,13 +34,21 @@ fn see_through() -> bool {
     return params.glass.x == 1.0 && cam.fill.z != 1.0;
 }
 
+// The pack's environment in direction `dir` (an image's 4 bilinear texels counted).
+fn environment_towards(dir: vec3<f32>) -> vec3<f32> {
+    if cam.env.kind.x == 3.0 {
+        tally(C_LOADS_16, 4u);
+    }
+    return environment(cam.env, env_image, dir);
+}
+
 // Radiance arriving at `origin` along unit `dir`, over a cone of half-angle `cone`, from the
 // lookups' keys: (radiance, 1), or (0, 0) where no lookup can tell.
 fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     // A ray that meets no proxy has left the scene (plenoptic_recon::specular's escape
     // test, cast off the surface it starts on).
     if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, cam.specular.z) {
-        return vec4<f32>(environment(cam.env, env_image, dir), 1.0);
+        return vec4<f32>(environment_towards(dir), 1.0);
     }
     let count = min(u32(cam.header.x), MAX_LOOKUPS);
     let n = u32(cam.header.y);
@@ -69,7 +78,7 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
         return vec4<f32>(sum / total, 1.0);
     }
     if escaped {
-        return vec4<f32>(environment(cam.env, env_image, dir), 1.0);
+        return vec4<f32>(environment_towards(dir), 1.0);
     }
     return vec4<f32>(0.0);
 }

@@ -8,6 +8,7 @@
 #import bevy_pbr::mesh_view_bindings::{view, lights}
 #import bevy_pbr::shadows::fetch_directional_shadow
 #import plenoptic::geometry::bindings::{cam, params, pixel_base, pixel_metallic, pixel_roughness}
+#import plenoptic::counters::{tally, C_SAMPLES}
 #import plenoptic::geometry::bsdf::{PI, fresnel_dielectric, ggx_d, smith_g1, glossy_bsdf, viewer}
 
 // The BSDF for light from `wi` seen along `wo`, with shading normal `n` and geometric normal
@@ -86,6 +87,8 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
                 view.view_from_world[3].z
             ), in.world_position);
             let towards = select(-ng, ng, dot(wi, ng) >= 0.0);
+            // One filtered sample per shadow lookup (Bevy's filter taps are not counted).
+            tally(C_SAMPLES, 1u);
             shadow = fetch_directional_shadow(i, in.world_position, towards, view_z, in.position.xy);
             break;
         }

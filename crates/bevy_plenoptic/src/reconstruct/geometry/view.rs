@@ -32,6 +32,7 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconSettings;
+use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentUniform;
 use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
@@ -94,6 +95,8 @@ pub struct ViewBuffer {
     pub(crate) lookups: FrameLookups,
     /// Changes when something the camera's materials bind was replaced (see the module doc).
     pub bindings: u64,
+    /// The camera's cost counters ([`CounterBuffer`]), which its materials bind too.
+    pub counters: Handle<ShaderBuffer>,
 }
 
 impl ViewBuffer {
@@ -136,6 +139,7 @@ pub(super) fn add_view_buffers(
                 params,
                 lookups: FrameLookups::default(),
                 bindings: 0,
+                counters: Handle::default(),
             },
             ViewDisplay::default(),
         ));
@@ -153,13 +157,14 @@ pub(super) fn update_view_buffers(
         &PlenopticCamera,
         &GlobalTransform,
         &ImageFrame,
+        &CounterBuffer,
         &mut ViewBuffer,
         &mut ViewDisplay,
     )>,
     images: Res<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (cam, transform, frame, mut view, mut display) in &mut cameras {
+    for (cam, transform, frame, counters, mut view, mut display) in &mut cameras {
         let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
@@ -205,6 +210,10 @@ pub(super) fn update_view_buffers(
         view.buffer.id().hash(&mut h);
         pack_volumes.map(|v| v.generation).hash(&mut h);
         images.get(&frame.image).map(Image::size).hash(&mut h);
+        counters.buffer.id().hash(&mut h);
+        if view.counters != counters.buffer {
+            view.counters = counters.buffer.clone();
+        }
         let bindings = h.finish();
         if view.bindings != bindings {
             view.bindings = bindings;
