@@ -37,6 +37,7 @@
 //! ([`volume`]), on every device.
 
 pub mod exclusive;
+mod lighting;
 pub mod probes;
 pub mod scene;
 pub mod volume;
