@@ -10,6 +10,7 @@
 //! cargo bench --no-default-features --bench recon     # any benches, as many as wanted
 //! cargo run --no-default-features --example bench_report   # writes the table
 //! cargo run --no-default-features --example bench_report -- --criterion DIR --out FILE
+//! cargo run --no-default-features --example bench_report -- --flags "-- --measurement-time 2"
 //! ```
 
 use std::collections::BTreeMap;
@@ -76,13 +77,15 @@ struct BenchFile {
 fn main() -> ExitCode {
     let mut criterion = PathBuf::from("target/criterion");
     let mut out = PathBuf::from("docs/results/benchmarks.md");
+    let mut flags = String::new();
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match (arg.as_str(), args.next()) {
             ("--criterion", Some(v)) => criterion = v.into(),
             ("--out", Some(v)) => out = v.into(),
+            ("--flags", Some(v)) => flags = format!(" {v}"),
             _ => {
-                eprintln!("usage: bench_report [--criterion DIR] [--out FILE]");
+                eprintln!("usage: bench_report [--criterion DIR] [--out FILE] [--flags TEXT]");
                 return ExitCode::FAILURE;
             }
         }
@@ -102,7 +105,7 @@ fn main() -> ExitCode {
         }
     };
     let files = bench_files(Path::new("benches"));
-    let report = render(&rows, &files);
+    let report = render(&rows, &files, &flags);
     if let Err(e) = std::fs::write(&out, report) {
         eprintln!("{}: {e}", out.display());
         return ExitCode::FAILURE;
@@ -195,7 +198,9 @@ fn bench_files(dir: &Path) -> Vec<BenchFile> {
     files
 }
 
-fn render(rows: &[Row], files: &[BenchFile]) -> String {
+/// The report: `flags` (empty, or starting with a space) are the arguments the benches were
+/// run with, written into each command.
+fn render(rows: &[Row], files: &[BenchFile], flags: &str) -> String {
     let mut md = String::from("# Benchmarks\n\n");
     let _ = writeln!(
         md,
@@ -219,7 +224,7 @@ fn render(rows: &[Row], files: &[BenchFile]) -> String {
         if let Some(f) = files.iter().find(|f| f.name == file) {
             let _ = writeln!(
                 md,
-                "{}\n\n`cargo bench --no-default-features --bench {file}`\n",
+                "{}\n\n`cargo bench --no-default-features --bench {file}{flags}`\n",
                 f.doc
             );
         }
