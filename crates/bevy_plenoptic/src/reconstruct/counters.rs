@@ -75,7 +75,7 @@ pub struct CostReport {
 }
 
 impl CostReport {
-    /// Reduces a counter buffer's words (the header, then [`TILE_WORDS`] per tile); `None`
+    /// Reduces a counter buffer's words (the header, then `TILE_WORDS` per tile); `None`
     /// when the words are not a whole buffer.
     pub fn from_words(words: &[u32]) -> Option<Self> {
         let (header, tiles) = words.split_at_checked(HEADER_WORDS)?;

@@ -6,7 +6,7 @@
 //!   shader does `plenoptic_recon`'s lookups, with each camera's lookups in its view buffer;
 //! - [`image`]: image mode, `plenoptic_recon`'s warping in compute passes per view, whose
 //!   frame the proxy materials and the background show;
-//! - [`volume`]: volume mode, cubes at t interpolated on the CPU from the temporal volumes and
+//! - [`image::volume`]: volume mode, cubes at t interpolated on the CPU from the temporal volumes and
 //!   warped by the image-mode passes;
 //! - [`background`]: the pack's environment (or the heaviest key's cube) behind the proxies;
 //! - [`cpu`]: the CPU backend, `plenoptic_recon` run off the main thread and shown in screen
