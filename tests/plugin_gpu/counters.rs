@@ -49,8 +49,7 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
         .get::<ViewBuffer>(cameras[0])
         .unwrap()
         .params()
-        .header
-        .x as f64;
+        .lookup_count as f64;
     eprintln!("{lookups} lookups in the view; {report:?}");
 
     let (w, h) = (crate::common::WIDTH as u64, crate::common::HEIGHT as u64);

@@ -12,26 +12,42 @@ const MAX_VOLUMES: u32 = 8u;
 // Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
 const BIN_FACE: u32 = 16u;
 
+// Bits of ViewParams.flags (view.rs, ViewFlags).
+// Accepted lookups filtered seamlessly bilinear (ReconSettings::cube_filter).
+const VIEW_BILINEAR: u32 = 1u;
+// The image-mode frame is shown instead of the lookups.
+const VIEW_IMAGE_MODE: u32 = 2u;
+// The pack has a runtime sun (pack 3).
+const VIEW_SUN: u32 = 4u;
+// Reflections are marched for the camera.
+const VIEW_MARCHED: u32 = 8u;
+
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
-    // x: lookup count, y: face size, z: volume block count (all as floats), w: unused.
-    header: vec4<f32>,
-    // x: depth tolerance, y: angular power, z: time t, w: temporal window tε.
-    tuning: vec4<f32>,
-    // x: hole-fill radius (pixels), y: index of the heaviest lookup, z: 1 for the image-mode
-    // frame.
-    fill: vec4<f32>,
-    // x: 1 for seamless bilinear filtering of accepted lookups (ReconSettings::cube_filter);
-    // y: how many lamps are in use.
-    flags: vec4<f32>,
-    // The runtime sun (pack 3): direction towards it (xyz), w: 1 when there is one.
+    // Lookups in use, the keys' face size, volume blocks in use, VIEW_* bits.
+    lookup_count: u32,
+    face: u32,
+    volume_count: u32,
+    flags: u32,
+    // The same-surface test's relative depth tolerance; the angular power p.
+    depth_tolerance: f32,
+    angular_power: f32,
+    // The camera's time t and the volume samples' temporal window tε.
+    time: f32,
+    time_window: f32,
+    // Hole-fill radius (pixels); the heaviest lookup (≥ lookup_count: none).
+    fill_radius: u32,
+    heaviest: u32,
+    // Lamps in use; rays per glossy pixel (plenoptic_recon's GLOSSY_RAYS).
+    lamp_count: u32,
+    glossy_rays: u32,
+    // The roughest glossy surface marched (−1: ideal mirrors only); how far rays are marched.
+    glossy_roughness: f32,
+    march_distance: f32,
+    // The runtime sun: direction towards it (xyz), with VIEW_SUN.
     sun: vec4<f32>,
     // Its illuminance at the camera's time (xyz).
     sun_illuminance: vec4<f32>,
-    // Reflections marched for the camera: x: 1 when on, y: the roughest glossy surface
-    // marched (−1: ideal mirrors only), z: how far rays are marched, w: rays per glossy
-    // pixel (plenoptic_recon's GLOSSY_RAYS).
-    specular: vec4<f32>,
     // The placed lamps (plenoptic_recon's lamps module), 3 per lamp: position (xyz), range
     // (w, −1: none); spot axis (xyz), cos outer cone (w, −2: a point light); colour ×
     // intensity (xyz), 1 / (cos inner − cos outer) (w).
@@ -100,7 +116,7 @@ struct ObjectParams {
 // lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> volume_samples: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> volume_bins: array<u32>;
-// The image-mode frame (image.wgsl), shown when cam.fill.z is 1.
+// The image-mode frame (image.wgsl), shown with VIEW_IMAGE_MODE.
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
 // Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
@@ -131,6 +147,16 @@ var<private> pixel_emission: vec3<f32>;
 // The drawn mesh's local_from_world (Bevy's mesh uniform): M_o(t)⁻¹ for a proxy placed at
 // the camera's time, the app mesh's own inverse transform for a lit mesh.
 var<private> local_from_world: mat4x4<f32>;
+
+// Whether the camera's flags have `bit` (VIEW_*).
+fn view_has(bit: u32) -> bool {
+    return (cam.flags & bit) != 0u;
+}
+
+// Whether the image-mode frame is shown instead of the lookups.
+fn image_mode() -> bool {
+    return view_has(VIEW_IMAGE_MODE);
+}
 
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {

@@ -9,7 +9,7 @@
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
 #import plenoptic::cube::cube_texel
-#import plenoptic::geometry::bindings::{MAX_LOOKUPS, cam, params, cubes, image_frame}
+#import plenoptic::geometry::bindings::{MAX_LOOKUPS, cam, params, cubes, image_frame, image_mode}
 #import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour}
 #import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
 
@@ -65,7 +65,7 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
 fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     let object = u32(params.object.x);
-    let n = u32(cam.header.y);
+    let n = cam.face;
     let p = in.world_position.xyz;
     let eye = view.world_position;
     // The surface plane.
@@ -74,7 +74,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         nrm = in.world_normal;
     }
     nrm = normalize(nrm);
-    if cam.fill.z == 1.0 {
+    if image_mode() {
         return image_frame_texel(in.position.xy);
     }
     let own = reconstruct(p, eye, object);
@@ -84,7 +84,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
     // this one whose points (neighbour_point) have a direct or volume lookup of this object;
     // their mean.
-    let radius = i32(cam.fill.x);
+    let radius = i32(cam.fill_radius);
     let centre = in.position.xy;
     tally(C_FILL, 1u);
     for (var r = 1; r <= radius; r++) {
@@ -128,8 +128,8 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(near.rgb / near.w, 1.0);
     }
     // Nothing: the heaviest key's texel in the point's direction ("background").
-    let h = u32(cam.fill.y);
-    if h < min(u32(cam.header.x), MAX_LOOKUPS) {
+    let h = cam.heaviest;
+    if h < min(cam.lookup_count, MAX_LOOKUPS) {
         let t = cube_texel(p - cam.base[h].xyz, n);
         let layer0 = u32(cam.base[h].w);
         tally(C_LOADS_16, 1u);

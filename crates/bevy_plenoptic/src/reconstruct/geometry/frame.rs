@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
 use plenoptic_recon::temporal::bracketing;
 
-use super::view::{ViewParams, motion_slot};
+use super::view::{ViewFlags, ViewParams, motion_slot};
 use super::{MaterialFactors, ObjectParams, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
@@ -203,29 +203,21 @@ impl CameraFrame<'_> {
         let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
         let m = pack.reader.manifest();
         let mut params = ViewParams {
-            header: Vec4::new(f.lookups.len() as f32, tex.face as f32, 0.0, 0.0),
-            tuning: Vec4::new(
-                cam.settings.depth_tolerance,
-                cam.settings.angular_power,
-                0.0,
-                0.0,
-            ),
-            fill: Vec4::new(
-                cam.settings.hole_fill_radius as f32,
-                f.heaviest.unwrap_or(MAX_LOOKUPS) as f32,
-                if self.image_mode { 1.0 } else { 0.0 },
-                0.0,
-            ),
-            flags: Vec4::new(
-                if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
-                    1.0
-                } else {
-                    0.0
-                },
-                0.0,
-                0.0,
-                0.0,
-            ),
+            lookup_count: f.lookups.len() as u32,
+            face: tex.face,
+            depth_tolerance: cam.settings.depth_tolerance,
+            angular_power: cam.settings.angular_power,
+            fill_radius: cam.settings.hole_fill_radius,
+            heaviest: f.heaviest.unwrap_or(MAX_LOOKUPS) as u32,
+            flags: if self.image_mode {
+                ViewFlags::IMAGE_MODE
+            } else {
+                0
+            } | if cam.settings.cube_filter == plenoptic_recon::CubeFilter::Bilinear {
+                ViewFlags::BILINEAR
+            } else {
+                0
+            },
             environment: EnvironmentUniform::new(&pack.environment.at(cam.time)),
             ..default()
         };

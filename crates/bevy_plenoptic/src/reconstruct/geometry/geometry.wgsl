@@ -27,7 +27,7 @@
 
 #import plenoptic::geometry::bindings::{
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
-    non_diffuse_weight, pixel_emission, local_from_world,
+    non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
 }
 #import plenoptic::geometry::fill::radiance
 #import plenoptic::geometry::sun::sun_light
@@ -85,7 +85,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 // and sun light, times the exposure.
 fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
     var reflected = vec3<f32>(0.0);
-    if lit() && cam.fill.z != 1.0 && marched() {
+    if lit() && !image_mode() && marched() {
         let r = reflection(in, ng);
         if r.w > 0.0 {
             non_diffuse_weight = 0.0;
@@ -93,7 +93,7 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         }
     }
     // Pack 4 leaves the emission to the runtime: where no marched reflection carries it.
-    if lit() && cam.fill.z != 1.0 && params.emission.y == 1.0 && non_diffuse_weight != 0.0
+    if lit() && !image_mode() && params.emission.y == 1.0 && non_diffuse_weight != 0.0
         && !see_through() {
         reflected += pixel_emission;
     }
@@ -107,12 +107,12 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         c = radiance(in, ng);
         c = vec4<f32>(c.rgb + reflected, c.a);
     }
-    if lit() && cam.sun.w == 1.0 && cam.fill.z != 1.0 {
+    if lit() && view_has(VIEW_SUN) && !image_mode() {
         c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
     }
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
-    let glazing = params.object.z > 0.0 && params.object.z < 1.0 && cam.fill.z != 1.0;
+    let glazing = params.object.z > 0.0 && params.object.z < 1.0 && !image_mode();
     var alpha = select(c.a, params.object.z, glazing);
     if see_through() {
         alpha = 1.0 - params.glass.y;

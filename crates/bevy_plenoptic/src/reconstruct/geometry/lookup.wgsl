@@ -11,7 +11,7 @@
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, volume_samples,
-    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit,
+    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit, view_has, VIEW_BILINEAR,
 }
 
 // Point `p` of this object in the object's own frame (homogeneous): local_from_world · p
@@ -132,10 +132,10 @@ fn lookup_of(local: vec4<f32>, k: u32, n: u32) -> Lookup {
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w).
 fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
-    let count = u32(cam.header.x);
-    let n = u32(cam.header.y);
-    let tol = cam.tuning.x;
-    let power = cam.tuning.y;
+    let count = cam.lookup_count;
+    let n = cam.face;
+    let tol = cam.depth_tolerance;
+    let power = cam.angular_power;
     let to_eye = normalize(eye - p);
     let local = object_point(p);
     var sum = vec3<f32>(0.0);
@@ -180,7 +180,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         let w = cam.weight[k].x * wa;
         var radiance = rgb9e5_decode(texel.x);
         // Lighting is always filtered (plenoptic_recon's shading module).
-        if cam.flags.x == 1.0 || lit() {
+        if view_has(VIEW_BILINEAR) || lit() {
             radiance = filtered(u32(cam.base[k].w), n, d, t, object, dist, tol, cam.weight[k].y != 0.0);
         }
         sum += radiance * w;
@@ -205,8 +205,8 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
     tally(C_NEIGHBOUR, 1u);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;
-    let count = u32(cam.header.x);
-    let n = u32(cam.header.y);
+    let count = cam.lookup_count;
+    let n = cam.face;
     let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let l = lookup_of(local, k, n);
@@ -254,10 +254,10 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
 // Returns (Σ w·radiance, Σ w).
 fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
     tally(C_VOLUME, 1u);
-    let count = min(u32(cam.header.z), MAX_VOLUMES);
-    let tol = cam.tuning.x * 3.0;
-    let t = cam.tuning.z;
-    let eps = cam.tuning.w;
+    let count = min(cam.volume_count, MAX_VOLUMES);
+    let tol = cam.depth_tolerance * 3.0;
+    let t = cam.time;
+    let eps = cam.time_window;
     let half_bin = 1.0 / f32(BIN_FACE);
     var sum = vec3<f32>(0.0);
     var ws = 0.0;

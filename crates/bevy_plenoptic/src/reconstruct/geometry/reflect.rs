@@ -16,7 +16,6 @@
 //!
 //! The emission is the material's at the fragment's UV (`pixel_emission`), as on the CPU.
 
-use bevy::prelude::*;
 use plenoptic_recon::Specular;
 use plenoptic_recon::lamps::runtime_lamps;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
@@ -29,7 +28,7 @@ use crate::camera::ReconSettings;
 pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &ReconSettings) {
     let manifest = pack.reader.manifest();
     let lamps = runtime_lamps(manifest).unwrap_or_default();
-    params.flags.y = lamps.len() as f32;
+    params.lamp_count = lamps.len() as u32;
     for (k, lamp) in lamps.iter().enumerate() {
         let (cos_outer, scale) = lamp.cone.unwrap_or((-2.0, 0.0));
         let range = if lamp.range.is_finite() {
@@ -41,18 +40,13 @@ pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &Reco
         params.lamps[3 * k + 1] = lamp.direction.extend(cos_outer);
         params.lamps[3 * k + 2] = lamp.radiant.extend(scale);
     }
-    params.specular = match settings.specular {
-        Specular::Baked => Vec4::ZERO,
-        Specular::Marched { max_roughness } => {
-            let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());
-            Vec4::new(
-                1.0,
-                if glossy { max_roughness } else { -1.0 },
-                march_distance(manifest),
-                GLOSSY_RAYS as f32,
-            )
-        }
-    };
+    if let Specular::Marched { max_roughness } = settings.specular {
+        let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());
+        params.flags |= super::view::ViewFlags::MARCHED;
+        params.glossy_roughness = if glossy { max_roughness } else { -1.0 };
+        params.march_distance = march_distance(manifest);
+        params.glossy_rays = GLOSSY_RAYS as u32;
+    }
 }
 
 #[cfg(test)]

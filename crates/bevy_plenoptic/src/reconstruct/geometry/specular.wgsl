@@ -14,6 +14,7 @@
 #import plenoptic::counters::{tally, C_LOADS_16}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, cam, params, cubes, env_image, pixel_base, pixel_metallic, pixel_roughness,
+    view_has, image_mode, VIEW_MARCHED,
 }
 #import plenoptic::geometry::bsdf::{
     fresnel_dielectric, fresnel_schlick, glossy_weight, glossy_bsdf, viewer,
@@ -25,13 +26,13 @@ const RAY_OFFSET: f32 = 0.001;
 // Whether this fragment's surface is marched: no transmission, an ideal mirror, or glossy
 // up to the roughest surface marched.
 fn marched() -> bool {
-    return cam.specular.x == 1.0 && (params.material.x <= 0.0 || see_through())
-        && (pixel_roughness < 0.02 || pixel_roughness <= cam.specular.y);
+    return view_has(VIEW_MARCHED) && (params.material.x <= 0.0 || see_through())
+        && (pixel_roughness < 0.02 || pixel_roughness <= cam.glossy_roughness);
 }
 
 // Whether this fragment is see-through transmissive glass (flags.z).
 fn see_through() -> bool {
-    return params.glass.x == 1.0 && cam.fill.z != 1.0;
+    return params.glass.x == 1.0 && !image_mode();
 }
 
 // The pack's environment in direction `dir` (an image's 4 bilinear texels counted).
@@ -47,11 +48,11 @@ fn environment_towards(dir: vec3<f32>) -> vec3<f32> {
 fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     // A ray that meets no proxy has left the scene (plenoptic_recon::specular's escape
     // test, cast off the surface it starts on).
-    if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, cam.specular.z) {
+    if has_rays() && !occluded(origin + dir * RAY_OFFSET, dir, cam.march_distance) {
         return vec4<f32>(environment_towards(dir), 1.0);
     }
-    let count = min(u32(cam.header.x), MAX_LOOKUPS);
-    let n = u32(cam.header.y);
+    let count = min(cam.lookup_count, MAX_LOOKUPS);
+    let n = cam.face;
     var sum = vec3<f32>(0.0);
     var total = 0.0;
     var escaped = false;
@@ -61,12 +62,12 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
         }
         let centre = cam.base[k].xyz;
         let layer0 = u32(cam.base[k].w);
-        let m = march(cubes, layer0, n, centre, origin, dir, cam.specular.z, cam.tuning.x);
+        let m = march(cubes, layer0, n, centre, origin, dir, cam.march_distance, cam.depth_tolerance);
         if m.y == 1.0 {
             let to = origin + dir * m.x - centre;
             let d = length(to);
             let cos = dot(to, dir) / max(d, 1e-6);
-            let w = cam.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), cam.tuning.y);
+            let w = cam.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), cam.angular_power);
             let angle = min(cone * m.x / max(d, 1e-3), 0.5);
             sum += fetch(cubes, layer0, n, to, angle) * w;
             total += w;
@@ -84,14 +85,14 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
 }
 
 // The radiance the glossy lobe (roughness `alpha`, the fragment's material) reflects
-// towards `wo` around `n` (geometric normal `ng`, relative IOR `eta`): cam.specular.w
+// towards `wo` around `n` (geometric normal `ng`, relative IOR `eta`): cam.glossy_rays
 // directions reflected about GGX half-vectors, a Hammersley set turned by `turn`, each
 // weighted by F · G · (ω_o·h) / ((n·ω_o)(n·h)) (plenoptic_recon's Bsdf::glossy_weight).
 fn lobe(origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f32, eta: f32, turn: f32) -> vec4<f32> {
     let pair = orthonormal_pair(n);
     var sum = vec3<f32>(0.0);
     var count = 0.0;
-    let rays = u32(cam.specular.w);
+    let rays = cam.glossy_rays;
     for (var k = 0u; k < rays; k++) {
         let u1 = (f32(k) + 0.5) / f32(rays);
         let u2 = fract(f32(reverseBits(k)) / 4294967296.0 + turn);
@@ -125,7 +126,7 @@ fn lobe(origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f3
 fn highlights(p: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f32, eta: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
-    for (var k = 0u; k < u32(cam.flags.y); k++) {
+    for (var k = 0u; k < cam.lamp_count; k++) {
         let a = cam.lamps[3u * k];
         let b = cam.lamps[3u * k + 1u];
         let c = cam.lamps[3u * k + 2u];

@@ -43,29 +43,42 @@ use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 /// in `bindings.wgsl`).
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
 pub struct ViewParams {
-    /// x: lookup count, y: face size, z: volume block count, w: unused.
-    pub header: Vec4,
-    /// x: relative depth tolerance, y: angular power, z: time t, w: temporal window tε.
-    pub tuning: Vec4,
-    /// x: same-object hole-fill radius in pixels, y: index of the heaviest lookup (the
-    /// "background" fallback; ≥ the lookup count when there is none), z: 1 to show the
-    /// image-mode passes' frame instead (image and volume modes).
-    pub fill: Vec4,
-    /// x: 1 to filter accepted lookups seamlessly bilinear, as `plenoptic_recon` does with
-    /// `CubeFilter::Bilinear` (0: the nearest texel); y: how many of `lamps` are in use.
-    pub flags: Vec4,
-    /// The runtime sun: unit direction towards it (xyz), w: 1 when the pack has one.
+    /// Lookups in use (of `base` and `weight`).
+    pub lookup_count: u32,
+    /// Face size of the keys, in texels.
+    pub face: u32,
+    /// Volume blocks in use (of `volume` and `volume_range`).
+    pub volume_count: u32,
+    /// [`ViewFlags`] bits.
+    pub flags: u32,
+    /// Relative depth tolerance of the same-surface test.
+    pub depth_tolerance: f32,
+    /// Angular power p of the lookups' weight ((1 + cos θ)/2)^p.
+    pub angular_power: f32,
+    /// The camera's time t.
+    pub time: f32,
+    /// The temporal window tε of the volume samples.
+    pub time_window: f32,
+    /// Same-object hole-fill radius, in pixels.
+    pub fill_radius: u32,
+    /// Index of the heaviest lookup (the "background" fallback; ≥ `lookup_count`: none).
+    pub heaviest: u32,
+    /// How many of `lamps` are in use.
+    pub lamp_count: u32,
+    /// Rays per glossy pixel ([`super::reflect`]).
+    pub glossy_rays: u32,
+    /// The roughest glossy surface marched (−1: ideal mirrors only).
+    pub glossy_roughness: f32,
+    /// How far reflected rays are marched.
+    pub march_distance: f32,
+    /// The runtime sun: unit direction towards it (xyz; w unused), with [`ViewFlags::SUN`].
     pub sun: Vec4,
     /// The runtime sun's illuminance at the camera's time (xyz).
     pub sun_illuminance: Vec4,
-    /// Reflections marched for the camera ([`super::reflect`]): x: 1 when on, y: the
-    /// roughest glossy surface marched (−1: ideal mirrors only), z: how far rays are marched,
-    /// w: rays per glossy pixel.
-    pub specular: Vec4,
     /// The lamps whose highlights glossy surfaces add ([`super::reflect`],
     /// `plenoptic_recon::lamps`), 3 per lamp: position (xyz) and range (w, −1: none);
     /// spot axis (xyz) and the cosine of its outer cone (w, −2: a point light); colour ×
-    /// intensity (xyz) and `1 / (cos inner − cos outer)` (w). `flags.y` counts them.
+    /// intensity (xyz) and `1 / (cos inner − cos outer)` (w). `lamp_count` counts them.
     pub lamps: [Vec4; 3 * MAX_RUNTIME_LAMPS],
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
@@ -82,6 +95,22 @@ pub struct ViewParams {
     /// object in motion slot `slot` (its index among the pack's animated objects) and lookup `k`.
     #[shader(size(runtime))]
     pub motion: Vec<Mat4>,
+}
+
+/// Bits of [`ViewParams::flags`] (`VIEW_*` in `bindings.wgsl`).
+#[derive(Debug, Clone, Copy)]
+pub struct ViewFlags;
+
+impl ViewFlags {
+    /// Accepted lookups filtered seamlessly bilinear, as `plenoptic_recon` does with
+    /// `CubeFilter::Bilinear` (else the nearest texel).
+    pub const BILINEAR: u32 = 1 << 0;
+    /// The image-mode passes' frame is shown instead (image and volume modes).
+    pub const IMAGE_MODE: u32 = 1 << 1;
+    /// The pack has a runtime sun (`sun`, `sun_illuminance`).
+    pub const SUN: u32 = 1 << 2;
+    /// Reflections are marched for the camera ([`super::reflect`]).
+    pub const MARCHED: u32 = 1 << 3;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
@@ -199,7 +228,7 @@ pub(super) fn update_view_buffers(
         }
         let shown = ViewDisplay {
             heaviest_layer: lookups.heaviest_layer(),
-            image_mode: params.fill.z == 1.0,
+            image_mode: params.flags & ViewFlags::IMAGE_MODE != 0,
         };
         if *display != shown {
             *display = shown;

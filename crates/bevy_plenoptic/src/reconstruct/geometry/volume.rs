@@ -138,7 +138,7 @@ pub(super) fn fill_params(
             n += 1;
         }
     }
-    params.header.z = n as f32;
-    params.tuning.z = t;
-    params.tuning.w = eps;
+    params.volume_count = n as u32;
+    params.time = t;
+    params.time_window = eps;
 }
