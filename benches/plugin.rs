@@ -12,7 +12,13 @@
 //!   reconstruction (no clear colour left, more than the placeholder's one colour), at
 //!   320 × 240 with one camera and at 1280 × 720 with one and with two cameras;
 //! - `plugin/frame`: one `App::update` of a settled app at 1280 × 720 with one and with two
-//!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes).
+//!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes);
+//! - `plugin/costs`: the same frames with the shaders' cost counters on
+//!   (`PlenopticSettings::cost_counters`): each case prints, per fragment, its lookups, loads
+//!   by width, samples, march steps and fallback entries, the loads of a diffuse fragment,
+//!   and the mean over 32-pixel groups of the group's largest loads and work against the
+//!   mean (what divergence costs). Counts need no GPU: on lavapipe they are what a GPU
+//!   would do, which its frame times are not.
 //!
 //! With `PLENOPTIC_TOUR_PACK` set to the architectural tour's baked pack, both groups also
 //! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B;
@@ -42,6 +48,7 @@ use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::window::ExitCondition;
 use bevy_plenoptic::prelude::*;
+use bevy_plenoptic::reconstruct::counters::CostReport;
 use bevy_plenoptic::streaming::{StreamState, decode_key, decode_volume, key_bytes, volume_bytes};
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use plenoptic_pack::PackReader;
@@ -427,5 +434,91 @@ fn settled_frames(
     }
 }
 
-criterion_group!(benches, decode, first_frame, frame);
+/// The frames of `plugin/frame` with the cost counters on: `App::update` timed, and the
+/// counts printed (see the module doc).
+fn costs(c: &mut Criterion) {
+    let dir = room_pack();
+    let mut g = c.benchmark_group("plugin/costs");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(10));
+    counted_frames(&mut g, "room_face32_1280x720_1camera", || {
+        scene(dir.path(), "room.pack", &room_views(1), TOUR_SIZE)
+    });
+    if let Some((pack, views)) = tour() {
+        let (assets, name) = tour_location(&pack);
+        let mirror = vec![tour_view("room_a_mirror.json", 0.0)];
+        for (case, views) in [("tour_1280x720", &views), ("tour_mirror_1280x720", &mirror)] {
+            counted_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
+        }
+    }
+    g.finish();
+}
+
+/// [`settled_frames`] with the cost counters on, then the first camera's counts printed.
+fn counted_frames(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    make: impl Fn() -> Scene,
+) {
+    let mut settled: Option<Scene> = None;
+    g.bench_function(name, |b| {
+        let s = settled.get_or_insert_with(|| {
+            let mut s = make();
+            s.app
+                .world_mut()
+                .resource_mut::<PlenopticSettings>()
+                .cost_counters = true;
+            s.until_reconstructed();
+            print_adapter(&s.app);
+            s
+        });
+        b.iter(|| s.app.update())
+    });
+    let Some(s) = settled.as_mut() else {
+        return;
+    };
+    for _ in 0..100 {
+        s.app.update();
+        if let Some(r) = s.app.world().get::<CostReport>(s.cameras[0]) {
+            print_costs(name, r);
+            return;
+        }
+    }
+    eprintln!("{name}: no cost report was read back");
+}
+
+/// One case's counts, per fragment (see the module doc).
+fn print_costs(name: &str, r: &CostReport) {
+    let m = |n: &str| r.mean_of(n).unwrap_or(f64::NAN);
+    eprintln!(
+        "costs {name}: {} fragments; per fragment: {:.1} lookups, {:.1} loads \
+         ({:.1} × 16 B, {:.1} × 8 B, {:.1} × 4 B), {:.2} samples, {:.1} steps, \
+         {:.3} volume, {:.3} fill entries, {:.2} fill lookups, {:.3} neighbour; \
+         {:.1} loads per diffuse fragment ({} of them); 32-pixel groups: largest loads \
+         {:.1} ({:.2}× the mean), largest work {:.1} ({:.2}× the mean {:.1})",
+        r.fragments,
+        m("lookups"),
+        r.loads,
+        m("loads_16"),
+        m("loads_8"),
+        m("loads_4"),
+        m("samples"),
+        m("steps"),
+        m("volume"),
+        m("fill"),
+        m("fill_lookups"),
+        m("neighbour"),
+        r.diffuse_loads,
+        r.diffuse_fragments,
+        r.group_max_loads,
+        r.group_max_loads / r.loads.max(1e-9),
+        r.group_max_work,
+        r.group_max_work / r.work.max(1e-9),
+        r.work,
+    );
+}
+
+criterion_group!(benches, decode, first_frame, frame, costs);
 criterion_main!(benches);
