@@ -21,8 +21,9 @@ pub type LitMaterial = ExtendedMaterial<StandardMaterial, PlenopticLighting>;
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
 #[bind_group_data(GeometryKey)]
 pub struct PlenopticLighting {
-    /// Resident keys ([`crate::reconstruct`]).
+    /// Resident keys ([`crate::reconstruct`]), with their nearest sampler for gathers.
     #[texture(100, dimension = "2d_array", sample_type = "u_int")]
+    #[sampler(115, sampler_type = "non_filtering")]
     pub cubes: Handle<Image>,
     /// The mesh's object: its id, motion slot, coverage and material.
     #[uniform(101)]

@@ -60,9 +60,9 @@ pub struct CostReport {
     pub fragments: u64,
     /// Mean of each counter per fragment ([`COUNTER_NAMES`]).
     pub mean: [f64; COUNTERS],
-    /// Mean loads (all widths) per fragment.
+    /// Mean fetches per fragment: loads of all widths and gathers (each one fetch instruction).
     pub loads: f64,
-    /// Mean work (loads, samples, gathers and steps) per fragment.
+    /// Mean work (fetches, samples and steps) per fragment.
     pub work: f64,
     /// Mean over tiles of the tile's largest fragment loads.
     pub group_max_loads: f64,
@@ -70,7 +70,7 @@ pub struct CostReport {
     pub group_max_work: f64,
     /// Fragments that marched nothing (no reflection steps): the diffuse fragments.
     pub diffuse_fragments: u64,
-    /// Mean loads per diffuse fragment.
+    /// Mean fetches (loads and gathers) per diffuse fragment.
     pub diffuse_loads: f64,
 }
 
@@ -103,12 +103,12 @@ impl CostReport {
         }
         let per = |v: u64, n: u64| if n == 0 { 0.0 } else { v as f64 / n as f64 };
         let mean = sums.map(|s| per(s, fragments));
-        let loads = mean[1] + mean[2] + mean[3];
+        let loads = mean[1] + mean[2] + mean[3] + mean[5];
         Some(Self {
             fragments,
             mean,
             loads,
-            work: loads + mean[4] + mean[5] + mean[6],
+            work: loads + mean[4] + mean[6],
             group_max_loads: per(max_loads, groups),
             group_max_work: per(max_work, groups),
             diffuse_fragments: diffuse,
@@ -237,6 +237,7 @@ mod tests {
         t[0] = 12; // lookups
         t[1] = 30; // loads_16
         t[2] = 6; // loads_8
+        t[5] = 3; // gathers, fetches as loads are
         t[6] = 9; // steps
         t[COUNTERS] = 3; // fragments
         t[COUNTERS + 1] = 20; // largest loads
@@ -251,8 +252,8 @@ mod tests {
         let r = CostReport::from_words(&buffer()).unwrap();
         assert_eq!(r.fragments, 3);
         assert!((r.mean_of("lookups").unwrap() - 4.0).abs() < 1e-12);
-        assert!((r.loads - 12.0).abs() < 1e-12);
-        assert!((r.work - 15.0).abs() < 1e-12);
+        assert!((r.loads - 13.0).abs() < 1e-12);
+        assert!((r.work - 16.0).abs() < 1e-12);
         // The empty tile is no group.
         assert!((r.group_max_loads - 20.0).abs() < 1e-12);
         assert!((r.group_max_work - 29.0).abs() < 1e-12);

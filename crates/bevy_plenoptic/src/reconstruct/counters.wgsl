@@ -18,7 +18,7 @@ const C_LOADS_8: u32 = 2u;
 const C_LOADS_4: u32 = 3u;
 // Filtered texture samples (material textures, the sun's shadow map).
 const C_SAMPLES: u32 = 4u;
-// Texture gathers.
+// Texture gathers: one fetch of one channel of a 2 × 2 footprint (four 4-byte texels).
 const C_GATHERS: u32 = 5u;
 // March steps through the distance cubes and node or triangle visits of the ray cast.
 const C_STEPS: u32 = 6u;
@@ -69,8 +69,9 @@ fn flush_counters(frag: vec2<f32>) {
             atomicAdd(&counters[base + i], cost[i]);
         }
     }
-    let loads = cost[C_LOADS_16] + cost[C_LOADS_8] + cost[C_LOADS_4];
-    let work = loads + cost[C_SAMPLES] + cost[C_GATHERS] + cost[C_STEPS];
+    // Fetches: loads of every width and gathers.
+    let loads = cost[C_LOADS_16] + cost[C_LOADS_8] + cost[C_LOADS_4] + cost[C_GATHERS];
+    let work = loads + cost[C_SAMPLES] + cost[C_STEPS];
     atomicAdd(&counters[base + COUNTERS], 1u);
     atomicMax(&counters[base + COUNTERS + 1u], loads);
     atomicMax(&counters[base + COUNTERS + 2u], work);

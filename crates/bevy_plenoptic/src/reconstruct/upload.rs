@@ -10,6 +10,7 @@
 use std::collections::{HashMap, HashSet};
 
 use bevy::asset::RenderAssetUsages;
+use bevy::image::ImageSampler;
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::{
@@ -114,6 +115,8 @@ pub(super) fn upload_keys(
                     RenderAssetUsages::RENDER_WORLD,
                 );
                 image.texture_view_descriptor = None;
+                // Integer texels are gathered, never filtered (geometry/lookup.wgsl).
+                image.sampler = ImageSampler::nearest();
                 image
             };
             KeyTexture {

@@ -107,6 +107,7 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(103) var<storage, read> volume_bins: array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(104) var image_frame: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(105) var shading_cubes: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(115) var cube_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(110) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
 #else
@@ -120,6 +121,8 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var image_frame: texture_2d<f32>;
 // Per texel of the key texture: (lighting RGB9E5, non-diffuse RGB9E5).
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var shading_cubes: texture_2d_array<u32>;
+// A nearest sampler for gathering the key textures' footprints (lookup.wgsl).
+@group(#{MATERIAL_BIND_GROUP}) @binding(19) var cube_sampler: sampler;
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(6) var base_colour_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(7) var base_colour_sampler: sampler;

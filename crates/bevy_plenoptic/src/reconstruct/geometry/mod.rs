@@ -121,8 +121,9 @@ impl Plugin for GeometryAssistedPlugin {
 #[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
 #[bind_group_data(GeometryKey)]
 pub struct PlenopticMaterial {
-    /// Resident keys (see the module doc).
+    /// Resident keys (see the module doc), with their nearest sampler for gathers.
     #[texture(0, dimension = "2d_array", sample_type = "u_int")]
+    #[sampler(19, sampler_type = "non_filtering")]
     pub cubes: Handle<Image>,
     /// The object's id, motion slot, coverage and material.
     #[uniform(1)]
