@@ -494,7 +494,7 @@ fn print_costs(name: &str, r: &CostReport) {
     let m = |n: &str| r.mean_of(n).unwrap_or(f64::NAN);
     eprintln!(
         "costs {name}: {} fragments; per fragment: {:.1} lookups, {:.1} loads \
-         ({:.1} × 16 B, {:.1} × 8 B, {:.1} × 4 B), {:.2} samples, {:.1} steps, \
+         ({:.1} × 16 B, {:.1} × 8 B, {:.1} × 4 B, {:.1} gathers), {:.2} samples, {:.1} steps, \
          {:.3} volume, {:.3} fill entries, {:.2} fill lookups, {:.3} neighbour; \
          {:.1} loads per diffuse fragment ({} of them); 32-pixel groups: largest loads \
          {:.1} ({:.2}× the mean), largest work {:.1} ({:.2}× the mean {:.1})",
@@ -504,6 +504,7 @@ fn print_costs(name: &str, r: &CostReport) {
         m("loads_16"),
         m("loads_8"),
         m("loads_4"),
+        m("gathers"),
         m("samples"),
         m("steps"),
         m("volume"),
