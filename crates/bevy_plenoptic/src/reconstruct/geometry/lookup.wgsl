@@ -208,22 +208,27 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
 }
 
 // Lookup `l` in the key at `layer0` whose filter footprint `fp` lies on one face, from
-// gathers: the footprint's object ids and distances (two gathers) test its nearest texel and
-// every tap, its normals are gathered only where a tap of the object misses the distance
-// test on a key with normals, and its colours come from one gather (radiance) or two
-// (lighting, non-diffuse radiance). The same tests, weights and order as loaded_lookup with
-// `bilinear`, in 4 to 5 fetches instead of 5 to 9.
+// gathers: the footprint's object ids (one gather; a nearest texel of another object ends
+// the lookup there) and distances (one more) test its nearest texel and every tap, its
+// normals are gathered only where a tap of the object misses the distance test on a key
+// with normals, and its colours come from one gather (radiance) or two (lighting,
+// non-diffuse radiance). The same tests, weights and order as loaded_lookup with
+// `bilinear`: 1 fetch for another object's texel, 4 to 6 for an accepted lookup where the
+// loaded path takes 5 to 9.
 fn gathered_lookup(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec4<f32> {
     let uv = (vec2<f32>(fp.corner) + 1.0) / f32(n);
     let layer = layer0 + fp.face;
-    tally(C_GATHERS, 2u);
+    // The ids first: a lookup whose nearest texel shows another object (most of the hole
+    // fill's) costs one fetch, as a single load would.
+    tally(C_GATHERS, 1u);
     let ids = textureGather(2, cubes, cube_sampler, uv, layer);
-    let dists = textureGather(1, cubes, cube_sampler, uv, layer);
     let kt = min(l.t.xy - fp.corner, vec2<u32>(1u));
     let kn = kt.x + 2u * kt.y;
     if lane(ids, kn) != object {
         return vec4<f32>(0.0);
     }
+    tally(C_GATHERS, 1u);
+    let dists = textureGather(1, cubes, cube_sampler, uv, layer);
     let fd = bitcast<vec4<f32>>(dists);
     var nrms = vec4<u32>(0u);
     if normals && any((ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist))) {
