@@ -75,7 +75,7 @@ fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32
 // over the taps that show the lookup's surface of `object` (same_surface) or are the
 // nearest texel `t`, whose key texel `nearest` the caller has loaded (plenoptic_recon's
 // lookup::filtered). Each tap is loaded on its own: the path of a footprint across a face
-// seam (gathered_lookup takes the others).
+// seam (gathered_filter takes the others).
 fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> vec3<f32> {
     var acc = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
@@ -154,19 +154,24 @@ fn nearest_accepts(l: Lookup, n: u32, dc: f32, normal: u32, tol: f32, normals: b
     return abs(expected - l.dist) <= tol * l.dist;
 }
 
-// Lookup `l` in the key at `layer0` from single texel loads: (radiance, 1) when its nearest
-// texel shows the point of `object`, else 0; the radiance filtered (`bilinear`) or the nearest
-// texel's.
-fn loaded_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bool, bilinear: bool) -> vec4<f32> {
+// Lookup `l` in the key at `layer0`: (radiance, 1) when its nearest texel (one load) shows
+// the point of `object`, else 0. The radiance is the nearest texel's, or filtered
+// (`bilinear`): gathered where the footprint lies on one face, else tap by tap across the
+// seam.
+fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bool, bilinear: bool) -> vec4<f32> {
     tally(C_LOADS_16, 1u);
     let texel = textureLoad(cubes, l.t.xy, layer0 + l.t.z, 0);
     if texel.z != object || !nearest_accepts(l, n, bitcast<f32>(texel.y), texel.w, tol, normals) {
         return vec4<f32>(0.0);
     }
-    if bilinear {
-        return vec4<f32>(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
+    if !bilinear {
+        return vec4<f32>(rgb9e5_decode(texel.x), 1.0);
     }
-    return vec4<f32>(rgb9e5_decode(texel.x), 1.0);
+    let fp = footprint(l.d, n);
+    if fp.inside {
+        return vec4<f32>(gathered_filter(l, fp, layer0, n, object, tol, normals), 1.0);
+    }
+    return vec4<f32>(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
 }
 
 // The 2 × 2 texels of the bilinear filter around a lookup's direction where they lie on one
@@ -207,36 +212,24 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
     }
 }
 
-// Lookup `l` in the key at `layer0` whose filter footprint `fp` lies on one face, from
-// gathers: the footprint's object ids (one gather; a nearest texel of another object ends
-// the lookup there) and distances (one more) test its nearest texel and every tap, its
-// normals are gathered only where a tap of the object misses the distance test on a key
-// with normals, and its colours come from one gather (radiance) or two (lighting,
-// non-diffuse radiance). The same tests, weights and order as loaded_lookup with
-// `bilinear`: 1 fetch for another object's texel, 4 to 6 for an accepted lookup where the
-// loaded path takes 5 to 9.
-fn gathered_lookup(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec4<f32> {
+// The bilinear filter of lookup `l`, whose nearest texel was accepted, over its footprint
+// `fp` on one face, from gathers: the footprint's object ids and distances (two gathers),
+// its normals only where a tap of the object misses the distance test on a key with normals,
+// and its colours from one gather (radiance) or two (lighting, non-diffuse radiance). The
+// same tests, weights and order as `filtered`: 4 to 5 fetches where its taps take 4 to 8.
+fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec3<f32> {
     let uv = (vec2<f32>(fp.corner) + 1.0) / f32(n);
     let layer = layer0 + fp.face;
-    // The ids first: a lookup whose nearest texel shows another object (most of the hole
-    // fill's) costs one fetch, as a single load would.
-    tally(C_GATHERS, 1u);
+    tally(C_GATHERS, 2u);
     let ids = textureGather(2, cubes, cube_sampler, uv, layer);
+    let dists = textureGather(1, cubes, cube_sampler, uv, layer);
     let kt = min(l.t.xy - fp.corner, vec2<u32>(1u));
     let kn = kt.x + 2u * kt.y;
-    if lane(ids, kn) != object {
-        return vec4<f32>(0.0);
-    }
-    tally(C_GATHERS, 1u);
-    let dists = textureGather(1, cubes, cube_sampler, uv, layer);
     let fd = bitcast<vec4<f32>>(dists);
     var nrms = vec4<u32>(0u);
     if normals && any((ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist))) {
         tally(C_GATHERS, 1u);
         nrms = textureGather(3, cubes, cube_sampler, uv, layer);
-    }
-    if !nearest_accepts(l, n, bitcast<f32>(lane(dists, kn)), lane(nrms, kn), tol, normals) {
-        return vec4<f32>(0.0);
     }
     var c0 = vec4<u32>(0u);
     var c1 = vec4<u32>(0u);
@@ -259,9 +252,9 @@ fn gathered_lookup(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
         }
     }
     if acc.w > 0.0 {
-        return vec4<f32>(acc.rgb / acc.w, 1.0);
+        return acc.rgb / acc.w;
     }
-    return vec4<f32>(gathered_colour(lane(c0, kn), lane(c1, kn)), 1.0);
+    return gathered_colour(lane(c0, kn), lane(c1, kn));
 }
 
 // A gathered texel's colour: its shaded lighting for an object shaded from its material
@@ -274,8 +267,8 @@ fn gathered_colour(a: u32, b: u32) -> vec3<f32> {
 }
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w). With
-// bilinear filtering (always for lighting, plenoptic_recon's shading module) a lookup whose
-// footprint lies on one face is gathered, one across a seam loaded tap by tap.
+// bilinear filtering (always for lighting, plenoptic_recon's shading module) an accepted
+// lookup whose footprint lies on one face is gathered, one across a seam loaded tap by tap.
 fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let count = cam.lookup_count;
     let n = cam.face;
@@ -294,13 +287,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
         tally(C_LOOKUPS, 1u);
         let layer0 = u32(cam.base[k].w);
         let normals = cam.weight[k].y != 0.0;
-        var got = vec4<f32>(0.0);
-        let fp = footprint(l.d, n);
-        if bilinear && fp.inside {
-            got = gathered_lookup(l, fp, layer0, n, object, tol, normals);
-        } else {
-            got = loaded_lookup(l, layer0, n, object, tol, normals, bilinear);
-        }
+        let got = key_lookup(l, layer0, n, object, tol, normals, bilinear);
         if got.w == 0.0 {
             continue;
         }
