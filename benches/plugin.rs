@@ -413,12 +413,12 @@ fn frame(c: &mut Criterion) {
 /// Measures `App::update` of the scene `make` builds, once it shows its reconstruction; says
 /// which adapter drew it and, with `PLENOPTIC_BENCH_PASSES`, its passes' times. The scene is
 /// made on the first call only (criterion calls the closure once per sample), and not at all
-/// when a filter leaves the case out.
+/// when a filter leaves the case out. Returns the scene, where it was made.
 fn settled_frames(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     name: &str,
     make: impl Fn() -> Scene,
-) {
+) -> Option<Scene> {
     let mut settled: Option<Scene> = None;
     g.bench_function(name, |b| {
         let s = settled.get_or_insert_with(|| {
@@ -432,6 +432,7 @@ fn settled_frames(
     if let Some(s) = &settled {
         print_passes(&s.app);
     }
+    settled
 }
 
 /// The frames of `plugin/frame` with the cost counters on: `App::update` timed, and the
@@ -462,21 +463,15 @@ fn counted_frames(
     name: &str,
     make: impl Fn() -> Scene,
 ) {
-    let mut settled: Option<Scene> = None;
-    g.bench_function(name, |b| {
-        let s = settled.get_or_insert_with(|| {
-            let mut s = make();
-            s.app
-                .world_mut()
-                .resource_mut::<PlenopticSettings>()
-                .cost_counters = true;
-            s.until_reconstructed();
-            print_adapter(&s.app);
-            s
-        });
-        b.iter(|| s.app.update())
+    let settled = settled_frames(g, name, || {
+        let mut s = make();
+        s.app
+            .world_mut()
+            .resource_mut::<PlenopticSettings>()
+            .cost_counters = true;
+        s
     });
-    let Some(s) = settled.as_mut() else {
+    let Some(mut s) = settled else {
         return;
     };
     for _ in 0..100 {
