@@ -139,6 +139,7 @@ pub(crate) fn settled_frames(app: &mut App, targets: &[Handle<Image>]) -> Vec<Ve
     let mut stable = 0;
     for frame in 0..3000 {
         app.update();
+        assert_shaders_compile(app);
         std::thread::sleep(std::time::Duration::from_millis(10));
         let now: Vec<Option<Vec<u8>>> = latest.iter().map(|l| l.lock().unwrap().take()).collect();
         if now.iter().any(Option::is_none) {

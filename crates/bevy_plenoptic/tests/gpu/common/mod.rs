@@ -31,7 +31,8 @@ pub fn headless_app() -> App {
 }
 
 /// `DefaultPlugins` without a window (and without winit's event loop, which must run on the
-/// main thread and needs a display, when the `winit` feature is on).
+/// main thread and needs a display, when the `winit` feature is on), recording shader
+/// compile errors for [`assert_shaders_compile`].
 #[allow(
     unexpected_cfgs,
     reason = "each package that includes this file has one of the two window features"
@@ -48,7 +49,7 @@ pub fn headless_plugins() -> bevy::app::PluginGroupBuilder {
     // turns on the same Bevy window backend when the facade's tests include this file.
     #[cfg(any(feature = "winit", feature = "window"))]
     let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
-    plugins
+    plugins.add(ShaderErrorsPlugin)
 }
 
 /// Like [`headless_app`], with assets read from `dir` and the plenoptic plugin added
@@ -119,6 +120,7 @@ pub fn render_until(
     let mut last = None;
     for _ in 0..max_frames {
         app.update();
+        assert_shaders_compile(app);
         if let Some(data) = latest.lock().unwrap().take() {
             if ready(&data) {
                 return data;
@@ -128,6 +130,64 @@ pub fn render_until(
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
     last.unwrap_or_else(|| panic!("no readback in {max_frames} frames"))
+}
+
+/// The first pipeline error the render world met, shared with the main world (the render
+/// sub-app runs on its own thread with pipelined rendering).
+#[derive(Resource, Clone, Default)]
+pub struct ShaderErrors(Arc<Mutex<Option<String>>>);
+
+/// Records in [`ShaderErrors`] the first pipeline whose shader failed to compile.
+struct ShaderErrorsPlugin;
+
+impl Plugin for ShaderErrorsPlugin {
+    fn build(&self, app: &mut App) {
+        use bevy::render::{Render, RenderApp, RenderSystems};
+        let errors = ShaderErrors::default();
+        app.insert_resource(errors.clone());
+        if let Some(render) = app.get_sub_app_mut(RenderApp) {
+            render
+                .insert_resource(errors)
+                .add_systems(Render, record_shader_errors.in_set(RenderSystems::Cleanup));
+        }
+    }
+}
+
+fn record_shader_errors(
+    cache: Res<bevy::render::render_resource::PipelineCache>,
+    errors: Res<ShaderErrors>,
+) {
+    use bevy::render::render_resource::CachedPipelineState;
+    use bevy::shader::ShaderCacheError;
+    let mut first = errors.0.lock().unwrap();
+    if first.is_some() {
+        return;
+    }
+    for pipeline in cache.pipelines() {
+        if let CachedPipelineState::Err(
+            e @ (ShaderCacheError::ProcessShaderError(_) | ShaderCacheError::CreateShaderModule(_)),
+        ) = &pipeline.state
+        {
+            *first = Some(e.to_string());
+            return;
+        }
+    }
+}
+
+/// Panics with the shader compiler's message where a pipeline failed to compile. A WGSL error
+/// (a reserved word such as `filter` as a name, a function shadowed) otherwise leaves its
+/// objects undrawn, and a test waiting for its frame to settle runs until its frame limit or
+/// fails on a comparison far from the cause.
+pub fn assert_shaders_compile(app: &App) {
+    // The lock is released before the panic, so the render thread's next look finds it
+    // unpoisoned.
+    let first = app
+        .world()
+        .get_resource::<ShaderErrors>()
+        .and_then(|errors| errors.0.lock().unwrap().clone());
+    if let Some(e) = first {
+        panic!("a pipeline failed to compile (the log has the shader's lines): {e}");
+    }
 }
 
 /// The RGBA8 pixel at (x, y).
