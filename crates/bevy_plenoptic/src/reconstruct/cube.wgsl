@@ -77,24 +77,49 @@ fn face_uv_direction(face: u32, u: f32, v: f32) -> vec3<f32> {
     }
 }
 
+// The 2 × 2 texels of the bilinear filter of a face-size `n` cube around a direction, on
+// the direction's face (plenoptic_recon's sample::bilinear_taps before the seam).
+struct Footprint {
+    // The first tap's (column, row); -1 or n - 1 where the footprint leaves the face.
+    corner: vec2<f32>,
+    // The face.
+    face: u32,
+    // The fractions that weight the taps.
+    f: vec2<f32>,
+    // Whether all four taps lie on the face.
+    inside: bool,
+}
+
+// The footprint of direction `dir` in a cube of face size `n`.
+fn footprint(dir: vec3<f32>, n: u32) -> Footprint {
+    let fuv = face_uv(dir);
+    let nf = f32(n);
+    let s = fuv.yz * nf - 0.5;
+    var fp: Footprint;
+    fp.corner = floor(s);
+    fp.face = u32(fuv.x);
+    fp.f = s - fp.corner;
+    fp.inside = all(fp.corner >= vec2<f32>(0.0)) && all(fp.corner + 1.0 < vec2<f32>(nf));
+    return fp;
+}
+
+// The bilinear weight of tap `k` (0..4: (0,0), (1,0), (0,1), (1,1)) for fractions `f`.
+fn tap_weight(f: vec2<f32>, k: u32) -> f32 {
+    let wx = select(1.0 - f.x, f.x, (k & 1u) == 1u);
+    let wy = select(1.0 - f.y, f.y, (k >> 1u) == 1u);
+    return wx * wy;
+}
+
 // Tap `k` (0..4: (0,0), (1,0), (0,1), (1,1)) of the seamless bilinear filter of a face-size
 // `n` cube around `dir` (plenoptic_recon's sample::bilinear_taps): (column, row, face) and its
 // weight in w; weight 0 where the tap is the missing fourth texel of a cube corner.
 fn bilinear_tap(dir: vec3<f32>, n: u32, k: u32) -> vec4<f32> {
-    let fuv = face_uv(dir);
-    let face = u32(fuv.x);
+    let fp = footprint(dir, n);
+    let face = fp.face;
     let nf = f32(n);
-    let s = fuv.y * nf - 0.5;
-    let t = fuv.z * nf - 0.5;
-    let i0 = floor(s);
-    let j0 = floor(t);
-    let fx = s - i0;
-    let fy = t - j0;
-    let di = f32(k & 1u);
-    let dj = f32(k >> 1u);
-    let w = select(1.0 - fx, fx, di == 1.0) * select(1.0 - fy, fy, dj == 1.0);
-    let i = i0 + di;
-    let j = j0 + dj;
+    let w = tap_weight(fp.f, k);
+    let i = fp.corner.x + f32(k & 1u);
+    let j = fp.corner.y + f32(k >> 1u);
     let in_i = i >= 0.0 && i < nf;
     let in_j = j >= 0.0 && j < nf;
     if in_i && in_j {

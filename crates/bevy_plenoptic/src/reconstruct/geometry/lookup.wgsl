@@ -7,7 +7,7 @@
 // lookup is accepted, and the nearby texels tried after the hole fill (fill.wgsl).
 #define_import_path plenoptic::geometry::lookup
 
-#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap, face_uv}
+#import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap, Footprint, footprint, tap_weight}
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
@@ -174,33 +174,6 @@ fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bo
     return vec4<f32>(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
 }
 
-// The 2 × 2 texels of the bilinear filter around a lookup's direction where they lie on one
-// face (bilinear_tap's four taps, none across a seam).
-struct Footprint {
-    // Whether all four taps lie on the face.
-    inside: bool,
-    // The first tap's (column, row).
-    corner: vec2<u32>,
-    // The face.
-    face: u32,
-    // The fractions that weight the taps.
-    f: vec2<f32>,
-}
-
-// The footprint of direction `d` in a cube of face size `n`.
-fn footprint(d: vec3<f32>, n: u32) -> Footprint {
-    let fuv = face_uv(d);
-    let nf = f32(n);
-    let s = fuv.yz * nf - 0.5;
-    let c0 = floor(s);
-    var fp: Footprint;
-    fp.inside = all(c0 >= vec2<f32>(0.0)) && all(c0 + 1.0 < vec2<f32>(nf));
-    fp.corner = vec2<u32>(max(c0, vec2<f32>(0.0)));
-    fp.face = u32(fuv.x);
-    fp.f = s - c0;
-    return fp;
-}
-
 // Tap k's lane of a gather (taps in bilinear_tap's order (0,0), (1,0), (0,1), (1,1); a
 // gather returns (0,1), (1,1), (1,0), (0,0)).
 fn lane(v: vec4<u32>, k: u32) -> u32 {
@@ -218,12 +191,13 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
 // and its colours from one gather (radiance) or two (lighting, non-diffuse radiance). The
 // same tests, weights and order as `filtered`: 4 to 5 fetches where its taps take 4 to 8.
 fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec3<f32> {
-    let uv = (vec2<f32>(fp.corner) + 1.0) / f32(n);
+    let corner = vec2<u32>(fp.corner);
+    let uv = (fp.corner + 1.0) / f32(n);
     let layer = layer0 + fp.face;
     tally(C_GATHERS, 2u);
     let ids = textureGather(2, cubes, cube_sampler, uv, layer);
     let dists = textureGather(1, cubes, cube_sampler, uv, layer);
-    let kt = min(l.t.xy - fp.corner, vec2<u32>(1u));
+    let kt = min(l.t.xy - corner, vec2<u32>(1u));
     let kn = kt.x + 2u * kt.y;
     let fd = bitcast<vec4<f32>>(dists);
     var nrms = vec4<u32>(0u);
@@ -243,9 +217,8 @@ fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
     }
     var acc = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
-        let dk = vec2<u32>(k & 1u, k >> 1u);
-        let w = select(1.0 - fp.f.x, fp.f.x, dk.x == 1u) * select(1.0 - fp.f.y, fp.f.y, dk.y == 1u);
-        let c = vec3<u32>(fp.corner + dk, fp.face);
+        let w = tap_weight(fp.f, k);
+        let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
         let texel = vec4<u32>(lane(c0, k), lane(dists, k), lane(ids, k), lane(nrms, k));
         if k == kn || same_surface(c, n, texel, object, l.d, l.dist, tol, normals) {
             acc += vec4<f32>(gathered_colour(lane(c0, k), lane(c1, k)), 1.0) * w;
