@@ -189,7 +189,8 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
 // `fp` on one face, from gathers: the footprint's object ids and distances (two gathers),
 // its normals only where a tap of the object misses the distance test on a key with normals,
 // and its colours from one gather (radiance) or two (lighting, non-diffuse radiance). The
-// same tests, weights and order as `filtered`: 4 to 5 fetches where its taps take 4 to 8.
+// same tests, weights and order as `filtered`: 3 to 5 gathers where its other three taps
+// take 3 loads (radiance) or 7 (lighting, with their shading texels).
 fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec3<f32> {
     let corner = vec2<u32>(fp.corner);
     let uv = (fp.corner + 1.0) / f32(n);
