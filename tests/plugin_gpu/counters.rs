@@ -13,27 +13,23 @@ use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::counters::CostReport;
 use bevy_plenoptic::reconstruct::geometry::view::ViewBuffer;
 
-/// The room, geometry-assisted with counters on: the report counts every covered pixel,
-/// `lookups` is the camera's lookup count per reconstruction (the pixel's own and each point
-/// the hole fill reconstructs again), each lookup loads at least its texel, a group's largest
-/// pixel is at least the mean, and the frame still equals the CPU's.
-#[test]
-fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("room.pack");
-    write_pack(
-        &room(true),
-        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
-        &path,
-    );
-    let eye = || Eye {
+/// The room's camera below, geometry-assisted.
+fn eye() -> Eye {
+    Eye {
         at: Vec3::new(0.3, 1.3, 1.0),
         target: Vec3::new(0.0, 0.8, -2.5),
         t: 0.6,
         mode: ReconMode::GeometryAssisted,
-    };
-    let (mut app, cameras, targets) =
-        plugin_cameras_with(dir.path(), &[eye()], |s| s.cost_counters = true);
+    }
+}
+
+/// The settled frames of `eye()` over the room pack in `dir` with counters on (and the
+/// screen-space fill on or off), its first cost report and the view's lookup count.
+fn counted(dir: &std::path::Path, screen_fill: bool) -> (Vec<Vec<Vec3>>, CostReport, f64) {
+    let (mut app, cameras, targets) = plugin_cameras_with(dir, &[eye()], |s| {
+        s.cost_counters = true;
+        s.screen_fill = screen_fill;
+    });
     let frames = settled_frames(&mut app, &targets);
     let mut report = None;
     for _ in 0..200 {
@@ -50,26 +46,58 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
         .unwrap()
         .params()
         .lookup_count as f64;
-    eprintln!("{lookups} lookups in the view; {report:?}");
+    eprintln!("screen fill {screen_fill}: {lookups} lookups in the view; {report:?}");
+    (frames, report, lookups)
+}
 
-    let (w, h) = (crate::common::WIDTH as u64, crate::common::HEIGHT as u64);
-    assert!(
-        report.fragments >= w * h * 9 / 10,
-        "{} fragments counted of {} pixels",
-        report.fragments,
-        w * h
+/// The room, geometry-assisted with counters on: the report counts every covered pixel,
+/// `lookups` is the camera's lookup count per reconstruction (the pixel's own and each point
+/// the fragment hole fill reconstructs again), each lookup loads at least its texel, a
+/// group's largest pixel is at least the mean, and the frame still equals the CPU's. With the
+/// screen-space fill no fragment reconstructs a neighbour; without it the holes' fragments do,
+/// and the frame is the same.
+#[test]
+fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("room.pack");
+    write_pack(
+        &room(true),
+        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
+        &path,
     );
-    let reconstructions = 1.0 + report.mean_of("fill_lookups").unwrap();
-    let per = report.mean_of("lookups").unwrap() / reconstructions;
-    assert!(lookups >= 2.0);
-    assert!(
-        (per - lookups).abs() < 1e-6 * lookups,
-        "{per} lookups per reconstruction, the view has {lookups}"
-    );
-    assert!(report.mean_of("loads_16").unwrap() >= report.mean_of("lookups").unwrap());
-    assert!(report.group_max_loads >= report.loads && report.group_max_work >= report.work);
-    assert!(report.diffuse_fragments > 0 && report.diffuse_loads > 0.0);
-
     let cpu = cpu_frame(&path, eye());
-    assert_each_matches(&frames, &[cpu], 0.003, 0.995);
+    let (screen, fragment) = (counted(dir.path(), true), counted(dir.path(), false));
+    for (frames, report, lookups) in [&screen, &fragment] {
+        let (w, h) = (crate::common::WIDTH as u64, crate::common::HEIGHT as u64);
+        assert!(
+            report.fragments >= w * h * 9 / 10,
+            "{} fragments counted of {} pixels",
+            report.fragments,
+            w * h
+        );
+        let reconstructions = 1.0 + report.mean_of("fill_lookups").unwrap();
+        let per = report.mean_of("lookups").unwrap() / reconstructions;
+        assert!(*lookups >= 2.0);
+        assert!(
+            (per - lookups).abs() < 1e-6 * lookups,
+            "{per} lookups per reconstruction, the view has {lookups}"
+        );
+        assert!(report.mean_of("loads_16").unwrap() >= report.mean_of("lookups").unwrap());
+        assert!(report.group_max_loads >= report.loads && report.group_max_work >= report.work);
+        assert!(report.diffuse_fragments > 0 && report.diffuse_loads > 0.0);
+        assert_each_matches(frames, std::slice::from_ref(&cpu), 0.003, 0.995);
+    }
+    // The same holes, entered by both; reconstructed again only by the fragment fill.
+    let (s, f) = (&screen.1, &fragment.1);
+    assert!(s.mean_of("fill").unwrap() > 0.1, "{s:?}");
+    assert!((s.mean_of("fill").unwrap() - f.mean_of("fill").unwrap()).abs() < 1e-9);
+    assert_eq!(s.mean_of("fill_lookups"), Some(0.0));
+    assert!(f.mean_of("fill_lookups").unwrap() > 1.0, "{f:?}");
+    eprintln!(
+        "fetches per pixel: screen fill {:.1}, fragment fill {:.1} ({:.2}×)",
+        s.loads,
+        f.loads,
+        f.loads / s.loads
+    );
+    assert!(s.loads < f.loads);
 }

@@ -30,6 +30,12 @@ pub struct PlenopticSettings {
     /// A diagnostic: the shaders are compiled with the counting in, and each frame's counts
     /// are read back. Read when a camera's proxies get their materials.
     pub cost_counters: bool,
+    /// Fill the holes of the geometry-assisted reconstruction with a compute pass over the
+    /// opaque pass's output ([`crate::reconstruct::geometry::screen_fill`]) on every camera
+    /// that can take it (an `Hdr` camera with `Msaa::Off`), instead of in the fragment shader,
+    /// which reconstructs each ring pixel again. The same frame, for a fraction of the loads;
+    /// off only to compare the two.
+    pub screen_fill: bool,
 }
 
 /// Where frames are reconstructed.
@@ -63,6 +69,7 @@ impl Default for PlenopticSettings {
             first_render_layer: 16,
             environment_light: true,
             cost_counters: false,
+            screen_fill: true,
         }
     }
 }

@@ -57,6 +57,9 @@ pub struct PlenopticLighting {
     /// The camera's cost counters, written when `cost_counters` is on.
     #[storage(114, visibility(fragment))]
     pub counters: Handle<ShaderBuffer>,
+    /// The camera's screen-fill entries, written when the camera has the screen-space fill.
+    #[storage(116, visibility(fragment))]
+    pub fill_entries: Handle<ShaderBuffer>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
     /// The object's material in the pack (its transmission, IOR and emission; the per-pixel
@@ -102,6 +105,7 @@ impl frame::BindsView for LitMaterial {
             id,
             coverage: e.coverage,
             factors: e.factors.as_ref(),
+            opaque_pass: matches!(self.base.alpha_mode, AlphaMode::Opaque | AlphaMode::Mask(_)),
         }
     }
 
@@ -116,5 +120,6 @@ impl frame::BindsView for LitMaterial {
         e.bindings = view.bindings;
         e.view = view.buffer.clone();
         e.counters = view.counters.clone();
+        e.fill_entries = view.fill_entries.clone();
     }
 }

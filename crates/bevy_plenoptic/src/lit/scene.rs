@@ -351,6 +351,7 @@ fn attach_lit_materials(
                     rays: pack_rays.get(id, pack, &mut buffers),
                     ray_placements: camera_rays.buffer.clone(),
                     counters: counters.buffer.clone(),
+                    fill_entries: view.fill_entries.clone(),
                     cost_counters: settings.cost_counters,
                     factors,
                     coverage,

@@ -21,6 +21,8 @@ const VIEW_IMAGE_MODE: u32 = 2u;
 const VIEW_SUN: u32 = 4u;
 // Reflections are marched for the camera.
 const VIEW_MARCHED: u32 = 8u;
+// Holes of the opaque pass are filled by the screen-space fill kernel (screen_fill.rs).
+const VIEW_SCREEN_FILL: u32 = 16u;
 
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
@@ -73,7 +75,8 @@ struct ObjectParams {
     // w: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
     object: vec4<f32>,
     // x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
-    // mean transmittance per surface.
+    // mean transmittance per surface, z: 1 when the object is drawn in the opaque pass (its
+    // holes may be left to the screen-space fill).
     glass: vec4<f32>,
     // The object's base-colour factor (xyz) and metallic factor (w) when object.w is 1.
     albedo: vec4<f32>,
@@ -110,6 +113,7 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(115) var cube_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(110) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(116) var<storage, read_write> fill_entries: array<vec4<u32>>;
 #else
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ObjectParams;
@@ -135,6 +139,9 @@ struct ObjectParams {
 // The camera's view buffer: its lookups, settings, environment and objects' motion.
 @group(#{MATERIAL_BIND_GROUP}) @binding(10) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(11) var env_image: texture_2d<f32>;
+// The camera's screen-fill entries (fill_entry.wgsl), one per viewport pixel, written with
+// VIEW_SCREEN_FILL.
+@group(#{MATERIAL_BIND_GROUP}) @binding(20) var<storage, read_write> fill_entries: array<vec4<u32>>;
 #endif
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).

@@ -1,17 +1,84 @@
 // The fragment's reconstructed radiance with plenoptic_recon's fallbacks, in its order
 // (thesis §8.2.3): its own lookups (lookup.wgsl), else the same-object hole fill over the
-// nearest ring of pixels (their points from the depth prepass, or on the fragment's plane),
-// else the object's nearby texels, else the heaviest key's texel ("background"); in image
-// mode the image-mode frame's texel.
+// nearest ring of pixels, else the object's nearby texels, else the heaviest key's texel
+// ("background"); in image mode the image-mode frame's texel.
+//
+// The hole fill runs in one of two places. On a camera with the screen-space fill
+// (VIEW_SCREEN_FILL, screen_fill.rs) a fragment drawn in the opaque pass leaves its terms, or
+// its hole, in the camera's fill entries (fill_entry.wgsl), shows its later fallbacks, and the
+// fill kernel (screen_fill.wgsl) overwrites each hole its ring search fills: no neighbour's
+// lookups are computed again. Elsewhere (glazing and glass in the transparent pass, cameras
+// without the fill) the fragment recomputes its ring pixels' lookups at the points they show
+// (from the depth prepass, or on the fragment's plane).
 #define_import_path plenoptic::geometry::fill
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
 #import plenoptic::cube::cube_texel
-#import plenoptic::geometry::bindings::{MAX_LOOKUPS, cam, params, cubes, image_frame, image_mode}
-#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour}
+#import plenoptic::geometry::bindings::{
+    MAX_LOOKUPS, cam, params, cubes, image_frame, image_mode, view_has, lit, pixel_albedo,
+    non_diffuse_weight, VIEW_SCREEN_FILL,
+}
+#ifdef DEPTH_PREPASS
+#import plenoptic::geometry::bindings::fill_entries
+#import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, pack_pair}
+#endif
+#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour, shade}
 #import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
+
+// What the fragment leaves in the fill entries: nothing, its terms, or its hole.
+const ENTRY_NONE: u32 = 0u;
+const ENTRY_ANSWERED: u32 = 1u;
+const ENTRY_HOLE: u32 = 2u;
+var<private> entry_kind: u32 = ENTRY_NONE;
+// The fragment's terms (lookup.wgsl's Weighted), with ENTRY_ANSWERED.
+var<private> entry_terms: mat2x3<f32>;
+
+// Whether this fragment's hole is left to the screen-space fill kernel: the camera has it,
+// and the object is drawn in the opaque pass (params.glass.z), before the kernel runs.
+fn screen_fill() -> bool {
+#ifdef DEPTH_PREPASS
+    return view_has(VIEW_SCREEN_FILL) && params.glass.z == 1.0;
+#else
+    return false;
+#endif
+}
+
+// Writes the fragment's fill entry, if it has one (`frag`: its framebuffer position;
+// `added`: what it adds to its reconstructed radiance, before the exposure). Only the
+// fragment the depth prepass kept writes: a storage write is not depth-tested.
+fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
+#ifdef DEPTH_PREPASS
+    if entry_kind == ENTRY_NONE {
+        return;
+    }
+    if frag.z < prepass_utils::prepass_depth(frag, 0u) {
+        return;
+    }
+    let px = vec2<u32>(frag.xy - view.viewport.xy);
+    let size = vec2<u32>(view.viewport.zw);
+    if any(px >= size) {
+        return;
+    }
+    let i = px.y * size.x + px.x;
+    let object = u32(params.object.x) + 1u;
+    let e = view.exposure;
+    if entry_kind == ENTRY_ANSWERED {
+        fill_entries[i] = vec4<u32>(pack_pair(entry_terms[0] * e, entry_terms[1] * e), object);
+        return;
+    }
+    var albedo = vec3<f32>(1.0);
+    var tag = object | HOLE;
+    if lit() {
+        albedo = pixel_albedo;
+        if non_diffuse_weight != 0.0 {
+            tag |= HOLE_NON_DIFFUSE;
+        }
+    }
+    fill_entries[i] = vec4<u32>(pack_pair(added * e, albedo), tag);
+#endif
+}
 
 // The world point where pixel centre `c` (framebuffer coordinates) sees the plane through `p`
 // with normal `nrm`; w = 0 where the ray misses it.
@@ -78,17 +145,49 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         return image_frame_texel(in.position.xy);
     }
     let own = reconstruct(p, eye, object);
+    let deferred = screen_fill();
     if own.w > 0.0 {
-        return vec4<f32>(own.rgb, 1.0);
+        if deferred {
+            entry_kind = ENTRY_ANSWERED;
+            entry_terms = own.terms;
+        }
+        return vec4<f32>(shade(own.terms), 1.0);
     }
-    // Same-object hole fill (plenoptic_recon's ring search): the nearest ring of pixels around
-    // this one whose points (neighbour_point) have a direct or volume lookup of this object;
-    // their mean.
-    let radius = i32(cam.fill_radius);
-    let centre = in.position.xy;
     tally(C_FILL, 1u);
+    if deferred {
+        // The fill kernel's ring search; the fallbacks below stay where it finds nothing.
+        entry_kind = ENTRY_HOLE;
+    } else {
+        let filled = fragment_fill(in.position.xy, p, nrm, eye, object);
+        if filled.w > 0.0 {
+            return filled;
+        }
+    }
+    // A thin object no texel centre met where the lookups fell: its own nearest texels, else
+    // those of the surface around it at its distance.
+    let near = neighbour_texels(p, object);
+    if near.w > 0.0 {
+        return vec4<f32>(shade(near.terms * (1.0 / near.w)), 1.0);
+    }
+    // Nothing: the heaviest key's texel in the point's direction ("background").
+    let h = cam.heaviest;
+    if h < min(cam.lookup_count, MAX_LOOKUPS) {
+        let t = cube_texel(p - cam.base[h].xyz, n);
+        let layer0 = u32(cam.base[h].w);
+        tally(C_LOADS_16, 1u);
+        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
+        return vec4<f32>(shade(colour(t, layer0, texel)), 1.0);
+    }
+    return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+}
+
+// Same-object hole fill in the fragment (plenoptic_recon's ring search): the nearest ring of
+// pixels around `centre` whose points (neighbour_point) have a direct or volume lookup of
+// this object; their mean, shaded with this fragment's albedo (w = 0: none).
+fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+    let radius = i32(cam.fill_radius);
     for (var r = 1; r <= radius; r++) {
-        var sum = vec3<f32>(0.0);
+        var sum = mat2x3<f32>();
         var count = 0.0;
         for (var dy = -r; dy <= r; dy++) {
             // Whole rows at the ring's top and bottom, the two ends elsewhere.
@@ -112,29 +211,14 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
                 tally(C_FILL_LOOKUPS, 1u);
                 let got = reconstruct(q.xyz, eye, object);
                 if got.w > 0.0 {
-                    sum += got.rgb;
+                    sum += got.terms;
                     count += 1.0;
                 }
             }
         }
         if count > 0.0 {
-            return vec4<f32>(sum / count, 1.0);
+            return vec4<f32>(shade(sum * (1.0 / count)), 1.0);
         }
     }
-    // A thin object no texel centre met where the lookups fell: its own nearest texels, else
-    // those of the surface around it at its distance.
-    let near = neighbour_texels(p, object);
-    if near.w > 0.0 {
-        return vec4<f32>(near.rgb / near.w, 1.0);
-    }
-    // Nothing: the heaviest key's texel in the point's direction ("background").
-    let h = cam.heaviest;
-    if h < min(cam.lookup_count, MAX_LOOKUPS) {
-        let t = cube_texel(p - cam.base[h].xyz, n);
-        let layer0 = u32(cam.base[h].w);
-        tally(C_LOADS_16, 1u);
-        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
-        return vec4<f32>(colour(t, layer0, texel), 1.0);
-    }
-    return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    return vec4<f32>(0.0);
 }

@@ -134,6 +134,9 @@ pub(crate) struct ObjectShading<'a> {
     pub(crate) coverage: f32,
     /// Its material from the pack, if any.
     pub(crate) factors: Option<&'a MaterialFactors>,
+    /// Whether it is drawn in Bevy's opaque pass (its holes may be left to the screen-space
+    /// fill, which runs before the transparent pass).
+    pub(crate) opaque_pass: bool,
 }
 
 impl ObjectShading<'_> {
@@ -161,6 +164,7 @@ impl ObjectShading<'_> {
                 params.glass = Vec4::new(1.0, (t.x + t.y + t.z) / 3.0, 0.0, 0.0);
             }
         }
+        params.glass.z = if self.opaque_pass { 1.0 } else { 0.0 };
         params
     }
 }

@@ -29,7 +29,7 @@
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
 }
-#import plenoptic::geometry::fill::radiance
+#import plenoptic::geometry::fill::{radiance, write_fill_entry}
 #import plenoptic::geometry::sun::sun_light
 #import plenoptic::geometry::specular::{marched, see_through, reflection}
 #import plenoptic::counters::flush_counters
@@ -98,6 +98,8 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         reflected += pixel_emission;
     }
     var c: vec4<f32>;
+    // What is added to the reconstructed radiance: reflection, emission and the sun.
+    var added = reflected;
     if see_through() {
         // Transmissive glass: its reflection alone (none where no lookup answers; the baked
         // radiance holds what it lets through), what lies behind blended in by the
@@ -108,8 +110,11 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         c = vec4<f32>(c.rgb + reflected, c.a);
     }
     if lit() && view_has(VIEW_SUN) && !image_mode() {
-        c = vec4<f32>(c.rgb + sun_light(in, ng), c.a);
+        let sun = sun_light(in, ng);
+        added += sun;
+        c = vec4<f32>(c.rgb + sun, c.a);
     }
+    write_fill_entry(in.position, added);
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
     let glazing = params.object.z > 0.0 && params.object.z < 1.0 && !image_mode();

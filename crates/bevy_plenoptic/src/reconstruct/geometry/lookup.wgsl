@@ -34,10 +34,34 @@ fn carried(local: vec4<f32>, k: u32) -> vec3<f32> {
     return (cam.motion[u32(slot) * MAX_LOOKUPS + k] * local).xyz;
 }
 
-// The shaded colour of a shading texel: the fragment's albedo · lighting + non-diffuse (in the
-// hole fill, the neighbours' lighting times this fragment's own albedo, as on the CPU).
-fn shaded(s: vec2<u32>) -> vec3<f32> {
-    return pixel_albedo * rgb9e5_decode(s.x) + rgb9e5_decode(s.y) * non_diffuse_weight;
+// A colour as its two terms, kept apart until a pixel's own material is applied (`shade`):
+// column 0 the lighting (or, for an object not shaded from its material, the radiance),
+// column 1 the non-diffuse radiance (zero for radiance). Every blend below is linear, so the
+// terms blend exactly as their shaded colour would; the hole fill averages its neighbours'
+// terms and shades them with the hole's own albedo, as the CPU fills its lighting and
+// non-diffuse planes apart. Terms with a weight: (Σ w·terms, Σ w), or normalised (w = 1).
+struct Weighted {
+    terms: mat2x3<f32>,
+    w: f32,
+}
+
+// A shading texel's terms: (lighting, non-diffuse).
+fn shaded(s: vec2<u32>) -> mat2x3<f32> {
+    return mat2x3<f32>(rgb9e5_decode(s.x), rgb9e5_decode(s.y));
+}
+
+// A radiance texel's terms: (radiance, 0).
+fn radiance_terms(x: u32) -> mat2x3<f32> {
+    return mat2x3<f32>(rgb9e5_decode(x), vec3<f32>(0.0));
+}
+
+// The fragment's colour from terms: albedo · lighting + non-diffuse for an object shaded from
+// its material, else the radiance.
+fn shade(terms: mat2x3<f32>) -> vec3<f32> {
+    if lit() {
+        return pixel_albedo * terms[0] + terms[1] * non_diffuse_weight;
+    }
+    return terms[0];
 }
 
 // plenoptic_pack::cube::oct_decode.
@@ -76,8 +100,9 @@ fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32
 // nearest texel `t`, whose key texel `nearest` the caller has loaded (plenoptic_recon's
 // lookup::filtered). Each tap is loaded on its own: the path of a footprint across a face
 // seam (gathered_filter takes the others).
-fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> vec3<f32> {
-    var acc = vec4<f32>(0.0);
+fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> mat2x3<f32> {
+    var acc = mat2x3<f32>();
+    var aw = 0.0;
     for (var k = 0u; k < 4u; k++) {
         let tap = bilinear_tap(d, n, k);
         if tap.w <= 0.0 {
@@ -85,29 +110,32 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>,
         }
         let c = vec3<u32>(tap.xyz);
         if all(c == t) {
-            acc += vec4<f32>(colour(c, layer0, nearest), 1.0) * tap.w;
+            acc += colour(c, layer0, nearest) * tap.w;
+            aw += tap.w;
             continue;
         }
         tally(C_LOADS_16, 1u);
         let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
         if same_surface(c, n, texel, object, d, l, tol, normals) {
-            acc += vec4<f32>(colour(c, layer0, texel), 1.0) * tap.w;
+            acc += colour(c, layer0, texel) * tap.w;
+            aw += tap.w;
         }
     }
-    if acc.w > 0.0 {
-        return acc.rgb / acc.w;
+    if aw > 0.0 {
+        return acc * (1.0 / aw);
     }
     return colour(t, layer0, nearest);
 }
 
-// The colour of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`):
-// its radiance, or its shaded lighting for an object shaded from its material.
-fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> vec3<f32> {
+// The terms of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`):
+// its radiance, or its lighting and non-diffuse radiance for an object shaded from its
+// material.
+fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> mat2x3<f32> {
     if lit() {
         tally(C_LOADS_8, 1u);
         return shaded(textureLoad(shading_cubes, c.xy, layer0 + c.z, 0).xy);
     }
-    return rgb9e5_decode(texel.x);
+    return radiance_terms(texel.x);
 }
 
 // Lookup k of a point: where in its key the point is looked up.
@@ -154,24 +182,24 @@ fn nearest_accepts(l: Lookup, n: u32, dc: f32, normal: u32, tol: f32, normals: b
     return abs(expected - l.dist) <= tol * l.dist;
 }
 
-// Lookup `l` in the key at `layer0`: (radiance, 1) when its nearest texel (one load) shows
-// the point of `object`, else 0. The radiance is the nearest texel's, or filtered
+// Lookup `l` in the key at `layer0`: (terms, 1) when its nearest texel (one load) shows the
+// point of `object`, else w = 0. The terms are the nearest texel's, or filtered
 // (`bilinear`): gathered where the footprint lies on one face, else tap by tap across the
 // seam.
-fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bool, bilinear: bool) -> vec4<f32> {
+fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bool, bilinear: bool) -> Weighted {
     tally(C_LOADS_16, 1u);
     let texel = textureLoad(cubes, l.t.xy, layer0 + l.t.z, 0);
     if texel.z != object || !nearest_accepts(l, n, bitcast<f32>(texel.y), texel.w, tol, normals) {
-        return vec4<f32>(0.0);
+        return Weighted(mat2x3<f32>(), 0.0);
     }
     if !bilinear {
-        return vec4<f32>(rgb9e5_decode(texel.x), 1.0);
+        return Weighted(colour(l.t, layer0, texel), 1.0);
     }
     let fp = footprint(l.d, n);
     if fp.inside {
-        return vec4<f32>(gathered_filter(l, fp, layer0, n, object, tol, normals), 1.0);
+        return Weighted(gathered_filter(l, fp, layer0, n, object, tol, normals), 1.0);
     }
-    return vec4<f32>(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
+    return Weighted(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
 }
 
 // Tap k's lane of a gather (taps in bilinear_tap's order (0,0), (1,0), (0,1), (1,1); a
@@ -191,7 +219,7 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
 // and its colours from one gather (radiance) or two (lighting, non-diffuse radiance). The
 // same tests, weights and order as `filtered`: 3 to 5 gathers where its other three taps
 // take 3 loads (radiance) or 7 (lighting, with their shading texels).
-fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> vec3<f32> {
+fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> mat2x3<f32> {
     let corner = vec2<u32>(fp.corner);
     let uv = (fp.corner + 1.0) / f32(n);
     let layer = layer0 + fp.face;
@@ -216,34 +244,36 @@ fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
         tally(C_GATHERS, 1u);
         c0 = textureGather(0, cubes, cube_sampler, uv, layer);
     }
-    var acc = vec4<f32>(0.0);
+    var acc = mat2x3<f32>();
+    var aw = 0.0;
     for (var k = 0u; k < 4u; k++) {
         let w = tap_weight(fp.f, k);
         let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
         let texel = vec4<u32>(lane(c0, k), lane(dists, k), lane(ids, k), lane(nrms, k));
         if k == kn || same_surface(c, n, texel, object, l.d, l.dist, tol, normals) {
-            acc += vec4<f32>(gathered_colour(lane(c0, k), lane(c1, k)), 1.0) * w;
+            acc += gathered_colour(lane(c0, k), lane(c1, k)) * w;
+            aw += w;
         }
     }
-    if acc.w > 0.0 {
-        return acc.rgb / acc.w;
+    if aw > 0.0 {
+        return acc * (1.0 / aw);
     }
     return gathered_colour(lane(c0, kn), lane(c1, kn));
 }
 
-// A gathered texel's colour: its shaded lighting for an object shaded from its material
-// (`a`, `b`: lighting, non-diffuse), else its radiance (`a`).
-fn gathered_colour(a: u32, b: u32) -> vec3<f32> {
+// A gathered texel's terms: its lighting and non-diffuse radiance for an object shaded from
+// its material (`a`, `b`), else its radiance (`a`).
+fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
     if lit() {
         return shaded(vec2<u32>(a, b));
     }
-    return rgb9e5_decode(a);
+    return radiance_terms(a);
 }
 
-// The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·radiance, Σ w). With
+// The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·terms, Σ w). With
 // bilinear filtering (always for lighting, plenoptic_recon's shading module) an accepted
 // lookup whose footprint lies on one face is gathered, one across a seam loaded tap by tap.
-fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     let count = cam.lookup_count;
     let n = cam.face;
     let tol = cam.depth_tolerance;
@@ -251,7 +281,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let bilinear = view_has(VIEW_BILINEAR) || lit();
     let to_eye = normalize(eye - p);
     let local = object_point(p);
-    var sum = vec3<f32>(0.0);
+    var sum = mat2x3<f32>();
     var ws = 0.0;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let l = lookup_of(local, k, n);
@@ -271,10 +301,10 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
             wa = pow(c, power);
         }
         let w = cam.weight[k].x * wa;
-        sum += got.rgb * w;
+        sum += got.terms * w;
         ws += w;
     }
-    return vec4<f32>(sum, ws);
+    return Weighted(sum, ws);
 }
 
 // plenoptic_recon's NEIGHBOUR_TEXELS and NEIGHBOUR_TOLERANCE.
@@ -288,10 +318,10 @@ const NO_TEXEL: i32 = 1073741824;
 // The fallback after the hole fill (plenoptic_recon's neighbour_texel): in each lookup's key,
 // the nearest texel at about the distance of `p` within NEIGHBOUR_TEXELS of the lookup's
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
-// ties). Returns (Σ w·colour, Σ w).
-fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
+// ties). Returns (Σ w·terms, Σ w).
+fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
     tally(C_NEIGHBOUR, 1u);
-    var sum = vec3<f32>(0.0);
+    var sum = mat2x3<f32>();
     var ws = 0.0;
     let count = cam.lookup_count;
     let n = cam.face;
@@ -332,22 +362,22 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> vec4<f32> {
             ws += cam.weight[k].x;
         }
     }
-    return vec4<f32>(sum, ws);
+    return Weighted(sum, ws);
 }
 
 // The temporal-volume fallback (plenoptic_recon's VolumeIndex::lookup, summed over the views
 // with their weights): samples of `object` in the direction bin of `p` from each base view,
 // whose cone contains that direction, whose distance agrees within 3× the depth tolerance and
 // whose time is within t ± tε, weighted by the tent filter and the angular falloff.
-// Returns (Σ w·radiance, Σ w).
-fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
+// Returns (Σ w·terms, Σ w).
+fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
     tally(C_VOLUME, 1u);
     let count = min(cam.volume_count, MAX_VOLUMES);
     let tol = cam.depth_tolerance * 3.0;
     let t = cam.time;
     let eps = cam.time_window;
     let half_bin = 1.0 / f32(BIN_FACE);
-    var sum = vec3<f32>(0.0);
+    var sum = mat2x3<f32>();
     var ws = 0.0;
     for (var i = 0u; i < count; i++) {
         let d = p - cam.volume[i].xyz;
@@ -383,7 +413,7 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
             let r = max(a.w, half_bin);
             if angle < r {
                 let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
-                var value = b.rgb;
+                var value = mat2x3<f32>(b.rgb, vec3<f32>(0.0));
                 if lit() {
                     value = shaded(c.zw);
                 }
@@ -392,18 +422,18 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> vec4<f32> {
             }
         }
     }
-    return vec4<f32>(sum, ws);
+    return Weighted(sum, ws);
 }
 
-// Direct lookups, else the temporal-volume fallback: (radiance, 1) or (0, 0) for a hole.
-fn reconstruct(p: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
+// Direct lookups, else the temporal-volume fallback: (terms, 1), or w = 0 for a hole.
+fn reconstruct(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     let direct = direct_lookups(p, eye, object);
     if direct.w > 0.0 {
-        return vec4<f32>(direct.rgb / direct.w, 1.0);
+        return Weighted(direct.terms * (1.0 / direct.w), 1.0);
     }
     let volume = volume_lookups(p, object);
     if volume.w > 0.0 {
-        return vec4<f32>(volume.rgb / volume.w, 1.0);
+        return Weighted(volume.terms * (1.0 / volume.w), 1.0);
     }
-    return vec4<f32>(0.0);
+    return Weighted(mat2x3<f32>(), 0.0);
 }

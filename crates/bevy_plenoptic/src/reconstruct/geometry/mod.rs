@@ -56,6 +56,7 @@ pub mod frame;
 pub mod prepare;
 pub mod rays;
 pub mod reflect;
+pub mod screen_fill;
 pub mod sun;
 pub mod view;
 pub mod volume;
@@ -91,6 +92,7 @@ impl Plugin for GeometryAssistedPlugin {
         bevy::shader::load_shader_library!(app, "sun.wgsl");
         bevy::shader::load_shader_library!(app, "specular.wgsl");
         embedded_asset!(app, "geometry.wgsl");
+        screen_fill::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<volume::VolumeBuffers>()
             .init_resource::<rays::PackRays>()
@@ -102,6 +104,7 @@ impl Plugin for GeometryAssistedPlugin {
                         rays::add_camera_rays,
                         rays::place_rays,
                         view::add_view_buffers,
+                        screen_fill::prepare_screen_fill,
                     )
                         .chain()
                         .in_set(ReconstructSystems::Resources),
@@ -176,6 +179,10 @@ pub struct PlenopticMaterial {
     /// when `cost_counters` is on.
     #[storage(18, visibility(fragment))]
     pub counters: Handle<ShaderBuffer>,
+    /// The camera's screen-fill entries ([`screen_fill::ScreenFill`]), written by the
+    /// fragments of the opaque pass when the camera has the screen-space fill.
+    #[storage(20, visibility(fragment))]
+    pub fill_entries: Handle<ShaderBuffer>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
     /// The object's diffuse albedo factors from its material in the pack: base-colour factor

@@ -79,6 +79,7 @@ pub(super) fn attach_materials(
             rays: pack_rays.get(scene.pack.id(), pack, &mut buffers),
             ray_placements: camera_rays.buffer.clone(),
             counters: counters.buffer.clone(),
+            fill_entries: view_buffer.fill_entries.clone(),
             cost_counters: settings.cost_counters,
             albedo: factors,
             coverage: object_coverage(pack, of.id),
@@ -126,6 +127,7 @@ impl frame::BindsView for PlenopticMaterial {
             id,
             coverage: self.coverage,
             factors: self.albedo.as_ref(),
+            opaque_pass: self.alpha_mode() == AlphaMode::Opaque,
         }
     }
 
@@ -138,5 +140,6 @@ impl frame::BindsView for PlenopticMaterial {
         self.bindings = view.bindings;
         self.view = view.buffer.clone();
         self.counters = view.counters.clone();
+        self.fill_entries = view.fill_entries.clone();
     }
 }

@@ -32,6 +32,7 @@ use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconSettings;
+use super::screen_fill::ScreenFill;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentUniform;
 use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
@@ -111,6 +112,8 @@ impl ViewFlags {
     pub const SUN: u32 = 1 << 2;
     /// Reflections are marched for the camera ([`super::reflect`]).
     pub const MARCHED: u32 = 1 << 3;
+    /// Holes of the opaque pass are left to the screen-space fill ([`super::screen_fill`]).
+    pub const SCREEN_FILL: u32 = 1 << 4;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
@@ -126,6 +129,8 @@ pub struct ViewBuffer {
     pub bindings: u64,
     /// The camera's cost counters ([`CounterBuffer`]), which its materials bind too.
     pub counters: Handle<ShaderBuffer>,
+    /// The camera's screen-fill entries ([`ScreenFill`]), which its materials bind too.
+    pub fill_entries: Handle<ShaderBuffer>,
 }
 
 impl ViewBuffer {
@@ -169,6 +174,7 @@ pub(super) fn add_view_buffers(
                 lookups: FrameLookups::default(),
                 bindings: 0,
                 counters: Handle::default(),
+                fill_entries: Handle::default(),
             },
             ViewDisplay::default(),
         ));
@@ -187,13 +193,14 @@ pub(super) fn update_view_buffers(
         &GlobalTransform,
         &ImageFrame,
         &CounterBuffer,
+        Option<&ScreenFill>,
         &mut ViewBuffer,
         &mut ViewDisplay,
     )>,
     images: Res<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (cam, transform, frame, counters, mut view, mut display) in &mut cameras {
+    for (cam, transform, frame, counters, fill, mut view, mut display) in &mut cameras {
         let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
@@ -216,7 +223,10 @@ pub(super) fn update_view_buffers(
             lookups: &lookups,
             image_mode: warped(cam.mode) && frame.active,
         };
-        let params = ctx.view_params();
+        let mut params = ctx.view_params();
+        if fill.is_some_and(ScreenFill::on) && !ctx.image_mode {
+            params.flags |= ViewFlags::SCREEN_FILL;
+        }
         let view = view.as_mut();
         if params.motion.len() != view.params.motion.len() {
             // Another size: a new buffer, which the materials must bind again.
@@ -242,6 +252,12 @@ pub(super) fn update_view_buffers(
         counters.buffer.id().hash(&mut h);
         if view.counters != counters.buffer {
             view.counters = counters.buffer.clone();
+        }
+        if let Some(fill) = fill {
+            fill.entries.id().hash(&mut h);
+            if view.fill_entries != fill.entries {
+                view.fill_entries = fill.entries.clone();
+            }
         }
         let bindings = h.finish();
         if view.bindings != bindings {
