@@ -60,8 +60,17 @@ pub struct PlenopticLighting {
     /// The camera's screen-fill entries, written when the camera has the screen-space fill.
     #[storage(116, visibility(fragment))]
     pub fill_entries: Handle<ShaderBuffer>,
+    /// The camera's hole list.
+    #[storage(117, visibility(fragment))]
+    pub hole_list: Handle<ShaderBuffer>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
+    /// Whether the camera has the screen-space fill (its fragments write fill entries).
+    pub screen_fill: bool,
+    /// Whether the device can force early depth tests.
+    pub early_depth: bool,
+    /// Whether the app's material discards (alpha mask): no forced early depth test then.
+    pub masked: bool,
     /// The object's material in the pack (its transmission, IOR and emission; the per-pixel
     /// base colour, metalness and roughness are the standard material's).
     pub factors: Option<MaterialFactors>,
@@ -73,9 +82,7 @@ pub struct PlenopticLighting {
 
 impl From<&PlenopticLighting> for GeometryKey {
     fn from(m: &PlenopticLighting) -> Self {
-        Self {
-            cost_counters: m.cost_counters,
-        }
+        Self::new(m.cost_counters, m.screen_fill, m.early_depth, m.masked)
     }
 }
 
@@ -105,7 +112,7 @@ impl frame::BindsView for LitMaterial {
             id,
             coverage: e.coverage,
             factors: e.factors.as_ref(),
-            opaque_pass: matches!(self.base.alpha_mode, AlphaMode::Opaque | AlphaMode::Mask(_)),
+            opaque_pass: matches!(self.base.alpha_mode, AlphaMode::Opaque),
         }
     }
 
@@ -121,5 +128,7 @@ impl frame::BindsView for LitMaterial {
         e.view = view.buffer.clone();
         e.counters = view.counters.clone();
         e.fill_entries = view.fill_entries.clone();
+        e.hole_list = view.hole_list.clone();
+        e.screen_fill = view.screen_fill();
     }
 }

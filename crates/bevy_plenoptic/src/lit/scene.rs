@@ -64,6 +64,7 @@ use crate::reconstruct::environment::EnvironmentImages;
 use crate::reconstruct::frames::{CpuFrameImage, ImageFrame};
 use crate::reconstruct::geometry::frame;
 use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
+use crate::reconstruct::geometry::screen_fill::EarlyDepthSupport;
 use crate::reconstruct::geometry::view::ViewBuffer;
 use crate::reconstruct::geometry::volume::VolumeBuffers;
 use crate::reconstruct::geometry::{ObjectParams, material_factors, object_coverage};
@@ -294,10 +295,11 @@ fn attach_lit_materials(
     mut lit: ResMut<Assets<LitMaterial>>,
     mut env_images: ResMut<EnvironmentImages>,
     mut images: ResMut<Assets<Image>>,
-    (mut pack_rays, mut buffers, settings): (
+    (mut pack_rays, mut buffers, settings, early_depth): (
         ResMut<PackRays>,
         ResMut<Assets<ShaderBuffer>>,
         Res<PlenopticSettings>,
+        Res<EarlyDepthSupport>,
     ),
 ) {
     if backend.0 != Backend::Gpu {
@@ -331,6 +333,7 @@ fn attach_lit_materials(
                 .as_ref()
                 .is_some_and(|f| f.material.transmission > 0.0);
             let mut base = base.clone();
+            let masked = matches!(base.alpha_mode, AlphaMode::Mask(_));
             // Blended as the proxy would be (see `PlenopticMaterial::transmissive`).
             if coverage < 1.0 {
                 base.alpha_mode = AlphaMode::Blend;
@@ -352,7 +355,11 @@ fn attach_lit_materials(
                     ray_placements: camera_rays.buffer.clone(),
                     counters: counters.buffer.clone(),
                     fill_entries: view.fill_entries.clone(),
+                    hole_list: view.hole_list.clone(),
                     cost_counters: settings.cost_counters,
+                    screen_fill: view.screen_fill(),
+                    early_depth: early_depth.0,
+                    masked,
                     factors,
                     coverage,
                     bindings: view.bindings,

@@ -33,12 +33,13 @@ pub const COUNTER_NAMES: [&str; COUNTERS] = [
     "fill",
     "fill_lookups",
     "neighbour",
+    "kernel_loads",
 ];
 /// Counters per pixel (`counters.wgsl`'s `COUNTERS`).
-pub const COUNTERS: usize = 11;
+pub const COUNTERS: usize = 12;
 /// Words per tile (`TILE_WORDS`): the sums, the fragment count, the largest loads and work,
 /// the diffuse fragments and their loads.
-const TILE_WORDS: usize = 16;
+const TILE_WORDS: usize = 17;
 /// Words before the first tile (`HEADER_WORDS`): tiles across and down.
 const HEADER_WORDS: usize = 4;
 /// Pixels a tile spans across and down.
@@ -62,6 +63,9 @@ pub struct CostReport {
     pub mean: [f64; COUNTERS],
     /// Mean fetches per fragment: loads of all widths and gathers (each one fetch instruction).
     pub loads: f64,
+    /// Mean fetches of the screen-space fill kernel per fragment (its holes' ring searches
+    /// and fallbacks, run apart from the fragments).
+    pub kernel_loads: f64,
     /// Mean work (fetches, samples and steps) per fragment.
     pub work: f64,
     /// Mean over tiles of the tile's largest fragment loads.
@@ -108,6 +112,7 @@ impl CostReport {
             fragments,
             mean,
             loads,
+            kernel_loads: mean[11],
             work: loads + mean[4] + mean[6],
             group_max_loads: per(max_loads, groups),
             group_max_work: per(max_work, groups),

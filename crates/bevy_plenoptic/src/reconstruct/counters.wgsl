@@ -30,14 +30,16 @@ const C_FILL: u32 = 8u;
 const C_FILL_LOOKUPS: u32 = 9u;
 // Entries into the neighbour-texel fallback.
 const C_NEIGHBOUR: u32 = 10u;
-const COUNTERS: u32 = 11u;
+// Fetches of the screen-space fill kernel (screen_fill.wgsl) for the tile's holes.
+const C_KERNEL_LOADS: u32 = 11u;
+const COUNTERS: u32 = 12u;
 // Words per tile: the COUNTERS sums, then the fragment count, the largest loads and work,
 // the diffuse fragments and their loads.
-const TILE_WORDS: u32 = 16u;
+const TILE_WORDS: u32 = 17u;
 // Words before the first tile: tiles across, tiles down (written on the CPU).
 const HEADER_WORDS: u32 = 4u;
 
-var<private> cost: array<u32, 11>;
+var<private> cost: array<u32, 12>;
 
 #ifdef PLENOPTIC_COUNTERS
 #ifdef PLENOPTIC_STANDARD
@@ -57,17 +59,9 @@ fn tally(i: u32, n: u32) {
 // Adds this fragment's counts to its tile (`frag`: its framebuffer position).
 fn flush_counters(frag: vec2<f32>) {
 #ifdef PLENOPTIC_COUNTERS
-    let tiles_x = atomicLoad(&counters[0]);
-    let tiles_y = atomicLoad(&counters[1]);
-    let tile = vec2<u32>(frag) / vec2<u32>(8u, 4u);
-    if tile.x >= tiles_x || tile.y >= tiles_y {
+    let base = add_sums(frag);
+    if base == 0u {
         return;
-    }
-    let base = HEADER_WORDS + (tile.y * tiles_x + tile.x) * TILE_WORDS;
-    for (var i = 0u; i < COUNTERS; i++) {
-        if cost[i] != 0u {
-            atomicAdd(&counters[base + i], cost[i]);
-        }
     }
     // Fetches: loads of every width and gathers.
     let loads = cost[C_LOADS_16] + cost[C_LOADS_8] + cost[C_LOADS_4] + cost[C_GATHERS];
@@ -79,5 +73,41 @@ fn flush_counters(frag: vec2<f32>) {
         atomicAdd(&counters[base + COUNTERS + 3u], 1u);
         atomicAdd(&counters[base + COUNTERS + 4u], loads);
     }
+#endif
+}
+
+// Adds the counts of a compute pass's work for pixel `frag` (framebuffer position), whose
+// fragment counted itself (screen_fill.wgsl): its fetches as C_KERNEL_LOADS, its entries
+// into fallbacks as they are.
+fn flush_kernel_counters(frag: vec2<f32>) {
+#ifdef PLENOPTIC_COUNTERS
+    cost[C_KERNEL_LOADS] = cost[C_LOADS_16] + cost[C_LOADS_8] + cost[C_LOADS_4] + cost[C_GATHERS];
+    cost[C_LOADS_16] = 0u;
+    cost[C_LOADS_8] = 0u;
+    cost[C_LOADS_4] = 0u;
+    cost[C_GATHERS] = 0u;
+    add_sums(frag);
+#endif
+}
+
+// Adds this invocation's counts to the sums of the tile of `frag` (framebuffer position) and
+// returns the tile's first word, 0 outside the buffer's tiles.
+fn add_sums(frag: vec2<f32>) -> u32 {
+#ifdef PLENOPTIC_COUNTERS
+    let tiles_x = atomicLoad(&counters[0]);
+    let tiles_y = atomicLoad(&counters[1]);
+    let tile = vec2<u32>(frag) / vec2<u32>(8u, 4u);
+    if tile.x >= tiles_x || tile.y >= tiles_y {
+        return 0u;
+    }
+    let base = HEADER_WORDS + (tile.y * tiles_x + tile.x) * TILE_WORDS;
+    for (var i = 0u; i < COUNTERS; i++) {
+        if cost[i] != 0u {
+            atomicAdd(&counters[base + i], cost[i]);
+        }
+    }
+    return base;
+#else
+    return 0u;
 #endif
 }

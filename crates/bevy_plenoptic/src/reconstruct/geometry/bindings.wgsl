@@ -6,6 +6,7 @@
 #define_import_path plenoptic::geometry::bindings
 
 #import plenoptic::environment::Environment
+#import plenoptic::fill_entry::HoleList
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
@@ -114,6 +115,7 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(110) var<storage, read> cam: ViewParams;
 @group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(116) var<storage, read_write> fill_entries: array<vec4<u32>>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(117) var<storage, read_write> hole_list: HoleList;
 #else
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ObjectParams;
@@ -142,6 +144,8 @@ struct ObjectParams {
 // The camera's screen-fill entries (fill_entry.wgsl), one per viewport pixel, written with
 // VIEW_SCREEN_FILL.
 @group(#{MATERIAL_BIND_GROUP}) @binding(20) var<storage, read_write> fill_entries: array<vec4<u32>>;
+// Its hole list (fill_entry.wgsl): the holes left to the fill kernel.
+@group(#{MATERIAL_BIND_GROUP}) @binding(21) var<storage, read_write> hole_list: HoleList;
 #endif
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).

@@ -15,16 +15,15 @@
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
-#import plenoptic::cube::cube_texel
 #import plenoptic::geometry::bindings::{
-    MAX_LOOKUPS, cam, params, cubes, image_frame, image_mode, view_has, lit, pixel_albedo,
+    cam, params, image_frame, image_mode, view_has, lit, pixel_albedo,
     non_diffuse_weight, VIEW_SCREEN_FILL,
 }
-#ifdef DEPTH_PREPASS
-#import plenoptic::geometry::bindings::fill_entries
+#ifdef PLENOPTIC_SCREEN_FILL
+#import plenoptic::geometry::bindings::{fill_entries, hole_list}
 #import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, pack_pair}
 #endif
-#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, colour, shade}
+#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, heaviest_texel, object_point, shade}
 #import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
 
 // What the fragment leaves in the fill entries: nothing, its terms, or its hole.
@@ -34,26 +33,44 @@ const ENTRY_HOLE: u32 = 2u;
 var<private> entry_kind: u32 = ENTRY_NONE;
 // The fragment's terms (lookup.wgsl's Weighted), with ENTRY_ANSWERED.
 var<private> entry_terms: mat2x3<f32>;
+// With ENTRY_HOLE: its record's index in the hole list and its point.
+var<private> hole_index: u32;
+var<private> hole_point: vec3<f32>;
 
-// Whether this fragment's hole is left to the screen-space fill kernel: the camera has it,
-// and the object is drawn in the opaque pass (params.glass.z), before the kernel runs.
+// Whether this fragment's hole is left to the screen-space fill kernel: the camera has it
+// (PLENOPTIC_SCREEN_FILL, compiled with the depth test forced before the fragment shader, so
+// that only the fragment the depth prepass kept runs and writes), and the object is drawn in
+// the opaque pass (params.glass.z), before the kernel runs.
 fn screen_fill() -> bool {
-#ifdef DEPTH_PREPASS
+#ifdef PLENOPTIC_SCREEN_FILL
     return view_has(VIEW_SCREEN_FILL) && params.glass.z == 1.0;
 #else
     return false;
 #endif
 }
 
-// Writes the fragment's fill entry, if it has one (`frag`: its framebuffer position;
-// `added`: what it adds to its reconstructed radiance, before the exposure). Only the
-// fragment the depth prepass kept writes: a storage write is not depth-tested.
-fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
-#ifdef DEPTH_PREPASS
-    if entry_kind == ENTRY_NONE {
-        return;
+// Appends the fragment's hole (at `p`) to the camera's hole list; false (the fragment fills
+// it itself) where the list is full.
+fn claim_hole(p: vec3<f32>) -> bool {
+#ifdef PLENOPTIC_SCREEN_FILL
+    let i = atomicAdd(&hole_list.count, 1u);
+    if i >= arrayLength(&hole_list.records) {
+        return false;
     }
-    if frag.z < prepass_utils::prepass_depth(frag, 0u) {
+    hole_index = i;
+    hole_point = p;
+    return true;
+#else
+    return false;
+#endif
+}
+
+// Writes the fragment's fill entry, if it has one (`frag`: its framebuffer position;
+// `added`: what it adds to its reconstructed radiance, before the exposure), and a hole's
+// record.
+fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
+#ifdef PLENOPTIC_SCREEN_FILL
+    if entry_kind == ENTRY_NONE {
         return;
     }
     let px = vec2<u32>(frag.xy - view.viewport.xy);
@@ -76,7 +93,12 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
             tag |= HOLE_NON_DIFFUSE;
         }
     }
-    fill_entries[i] = vec4<u32>(pack_pair(added * e, albedo), tag);
+    fill_entries[i] = vec4<u32>(hole_index, 0u, 0u, tag);
+    let r = &hole_list.records[hole_index];
+    (*r).pair = pack_pair(added * e, albedo);
+    (*r).pixel = i;
+    (*r).local = vec4<f32>(object_point(hole_point).xyz, params.object.y);
+    (*r).world = vec4<f32>(hole_point, select(0.0, 1.0, lit()));
 #endif
 }
 
@@ -132,7 +154,6 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
 fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     let object = u32(params.object.x);
-    let n = cam.face;
     let p = in.world_position.xyz;
     let eye = view.world_position;
     // The surface plane.
@@ -154,14 +175,14 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(shade(own.terms), 1.0);
     }
     tally(C_FILL, 1u);
-    if deferred {
-        // The fill kernel's ring search; the fallbacks below stay where it finds nothing.
+    if deferred && claim_hole(p) {
+        // The fill kernel fills the pixel: its ring search, else the fallbacks below.
         entry_kind = ENTRY_HOLE;
-    } else {
-        let filled = fragment_fill(in.position.xy, p, nrm, eye, object);
-        if filled.w > 0.0 {
-            return filled;
-        }
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let filled = fragment_fill(in.position.xy, p, nrm, eye, object);
+    if filled.w > 0.0 {
+        return filled;
     }
     // A thin object no texel centre met where the lookups fell: its own nearest texels, else
     // those of the surface around it at its distance.
@@ -170,15 +191,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(shade(near.terms * (1.0 / near.w)), 1.0);
     }
     // Nothing: the heaviest key's texel in the point's direction ("background").
-    let h = cam.heaviest;
-    if h < min(cam.lookup_count, MAX_LOOKUPS) {
-        let t = cube_texel(p - cam.base[h].xyz, n);
-        let layer0 = u32(cam.base[h].w);
-        tally(C_LOADS_16, 1u);
-        let texel = textureLoad(cubes, vec2<u32>(t.x, t.y), layer0 + t.z, 0);
-        return vec4<f32>(shade(colour(t, layer0, texel)), 1.0);
-    }
-    return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    return vec4<f32>(shade(heaviest_texel(p, lit()).terms), 1.0);
 }
 
 // Same-object hole fill in the fragment (plenoptic_recon's ring search): the nearest ring of

@@ -1,12 +1,11 @@
-// The screen-space hole fill's per-pixel entries (screen_fill.rs; thesis §8.2.3's hole fill
-// over the first pass's output): what a proxy fragment drawn in the opaque pass leaves at its
-// pixel for the fill kernel (screen_fill.wgsl), 16 bytes:
+// What the screen-space hole fill (screen_fill.rs; thesis §8.2.3's hole fill over the first
+// pass's output) reads: what each proxy fragment drawn in the opaque pass leaves for the fill
+// kernel (screen_fill.wgsl). Per pixel an entry of 16 bytes:
 // - a pixel its lookups answered: its terms (lighting and non-diffuse, or radiance and 0;
-//   lookup.wgsl's Weighted) times the camera's exposure, and its object + 1;
-// - a hole: what the fragment adds to its reconstructed radiance (reflection, emission, the
-//   runtime sun) times the exposure, the albedo and non-diffuse weight it shades filled terms
-//   with, its object + 1 and HOLE;
+//   lookup.wgsl's Weighted) times the camera's exposure (xyz), its object + 1 (w);
+// - a hole: its object + 1 with HOLE (w), the index of its record (x);
 // - nothing drawn there: 0.
+// Per hole a record in the camera's hole list (HoleRecord), appended by its fragment.
 // Colours are kept as half floats (the HDR target's own precision), two per word.
 #define_import_path plenoptic::fill_entry
 
@@ -14,6 +13,26 @@
 const HOLE: u32 = 0x80000000u;
 const HOLE_NON_DIFFUSE: u32 = 0x40000000u;
 const OBJECT_BITS: u32 = 0x3fffffffu;
+
+// A hole's record.
+struct HoleRecord {
+    // What its fragment adds to the reconstructed radiance (reflection, emission, the runtime
+    // sun) times the exposure, and the albedo it shades filled terms with (pack_pair).
+    pair: vec3<u32>,
+    // Its pixel (row-major in the viewport).
+    pixel: u32,
+    // Its point in its object's frame (lookup.wgsl's object_point) and its motion slot (w).
+    local: vec4<f32>,
+    // Its world point, and 1 when its object is shaded from its material (w).
+    world: vec4<f32>,
+}
+
+// A camera's hole list: records appended, the first `count` of them written (count may pass
+// the list's length: those holes were filled by their fragments).
+struct HoleList {
+    count: atomic<u32>,
+    records: array<HoleRecord>,
+}
 
 // The largest half float.
 const HALF_MAX: f32 = 65504.0;

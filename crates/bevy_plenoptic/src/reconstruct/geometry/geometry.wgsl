@@ -42,6 +42,9 @@
 // An app mesh: its own StandardMaterial's base colour, metalness, roughness and normal (its
 // textures and normal map, as Bevy's PBR reads them) with the pack's lighting at this
 // object's points, exactly as a proxy fragment of the same object is shaded.
+#ifdef PLENOPTIC_EARLY_DEPTH
+@early_depth_test(force)
+#endif
 @fragment
 fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(vertex.instance_index);
@@ -58,6 +61,12 @@ fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @loc
     return shade(in, ng);
 }
 #else
+// With storage writes (cost counters, fill entries) a fragment shader is run before the depth
+// test unless the test is forced first: forced, a fragment the depth prepass hid costs
+// nothing and writes nothing.
+#ifdef PLENOPTIC_EARLY_DEPTH
+@early_depth_test(force)
+#endif
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(in.instance_index);

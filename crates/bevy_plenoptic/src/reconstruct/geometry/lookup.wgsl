@@ -25,9 +25,8 @@ fn object_point(p: vec3<f32>) -> vec4<f32> {
 }
 
 // The point whose `object_point` is `local`, carried to lookup k's key time τ: M_o(τ) · local
-// for an animated object, the point itself for a static one.
-fn carried(local: vec4<f32>, k: u32) -> vec3<f32> {
-    let slot = params.object.y;
+// for an animated object (its motion slot `slot`), the point itself for a static one (−1).
+fn carried(local: vec4<f32>, k: u32, slot: f32) -> vec3<f32> {
     if slot < 0.0 {
         return local.xyz;
     }
@@ -127,11 +126,16 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>,
     return colour(t, layer0, nearest);
 }
 
-// The terms of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`):
-// its radiance, or its lighting and non-diffuse radiance for an object shaded from its
-// material.
+// The terms of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`) for
+// this fragment's object.
 fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> mat2x3<f32> {
-    if lit() {
+    return texel_terms(c, layer0, texel, lit());
+}
+
+// The terms of key texel `c`: its radiance, or its lighting and non-diffuse radiance for an
+// object shaded from its material (`material`).
+fn texel_terms(c: vec3<u32>, layer0: u32, texel: vec4<u32>, material: bool) -> mat2x3<f32> {
+    if material {
         tally(C_LOADS_8, 1u);
         return shaded(textureLoad(shading_cubes, c.xy, layer0 + c.z, 0).xy);
     }
@@ -150,10 +154,11 @@ struct Lookup {
     t: vec3<u32>,
 }
 
-// Lookup k of the point whose `object_point` is `local`, in keys of face size `n`.
-fn lookup_of(local: vec4<f32>, k: u32, n: u32) -> Lookup {
+// Lookup k of the point whose `object_point` is `local` (of an object with motion slot
+// `slot`), in keys of face size `n`.
+fn lookup_of(local: vec4<f32>, k: u32, n: u32, slot: f32) -> Lookup {
     var l: Lookup;
-    l.d = carried(local, k) - cam.base[k].xyz;
+    l.d = carried(local, k, slot) - cam.base[k].xyz;
     l.dist = length(l.d);
     l.ok = !(l.dist <= 1e-6);
     if l.ok {
@@ -284,7 +289,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     var sum = mat2x3<f32>();
     var ws = 0.0;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let l = lookup_of(local, k, n);
+        let l = lookup_of(local, k, n, params.object.y);
         if !l.ok {
             continue;
         }
@@ -320,14 +325,20 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·terms, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
+    return nearby_texels(object_point(p), object, params.object.y, lit());
+}
+
+// `neighbour_texels` of the point whose `object_point` is `local`, of `object` with motion
+// slot `slot`, shaded from its material or not (`material`): the screen-space fill kernel's
+// entry, which has no material bound.
+fn nearby_texels(local: vec4<f32>, object: u32, slot: f32, material: bool) -> Weighted {
     tally(C_NEIGHBOUR, 1u);
     var sum = mat2x3<f32>();
     var ws = 0.0;
     let count = cam.lookup_count;
     let n = cam.face;
-    let local = object_point(p);
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let l = lookup_of(local, k, n);
+        let l = lookup_of(local, k, n, slot);
         if !l.ok {
             continue;
         }
@@ -358,7 +369,7 @@ fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
         if best < NO_TEXEL {
             tally(C_LOADS_16, 1u);
             let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
-            sum += colour(best_c, layer0, texel) * cam.weight[k].x;
+            sum += texel_terms(best_c, layer0, texel, material) * cam.weight[k].x;
             ws += cam.weight[k].x;
         }
     }
@@ -423,6 +434,21 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
         }
     }
     return Weighted(sum, ws);
+}
+
+// The last fallback: the heaviest key's texel in the direction of world point `p`
+// ("background"), the terms of an object shaded from its material or not (`material`);
+// w = 0 without lookups.
+fn heaviest_texel(p: vec3<f32>, material: bool) -> Weighted {
+    let h = cam.heaviest;
+    if h >= min(cam.lookup_count, MAX_LOOKUPS) {
+        return Weighted(mat2x3<f32>(), 0.0);
+    }
+    let t = cube_texel(p - cam.base[h].xyz, cam.face);
+    let layer0 = u32(cam.base[h].w);
+    tally(C_LOADS_16, 1u);
+    let texel = textureLoad(cubes, t.xy, layer0 + t.z, 0);
+    return Weighted(texel_terms(t, layer0, texel, material), 1.0);
 }
 
 // Direct lookups, else the temporal-volume fallback: (terms, 1), or w = 0 for a hole.

@@ -78,6 +78,10 @@ use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 pub struct GeometryAssistedPlugin;
 
 impl Plugin for GeometryAssistedPlugin {
+    fn finish(&self, app: &mut App) {
+        screen_fill::finish(app);
+    }
+
     fn build(&self, app: &mut App) {
         // The reflection march (`plenoptic::reflect`) and the ray cast (`plenoptic::rays`).
         bevy::shader::load_shader_library!(app, "reflect.wgsl");
@@ -183,8 +187,16 @@ pub struct PlenopticMaterial {
     /// fragments of the opaque pass when the camera has the screen-space fill.
     #[storage(20, visibility(fragment))]
     pub fill_entries: Handle<ShaderBuffer>,
+    /// The camera's hole list ([`screen_fill::ScreenFill::holes`]).
+    #[storage(21, visibility(fragment))]
+    pub hole_list: Handle<ShaderBuffer>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
+    /// Whether the camera has the screen-space fill (its fragments write fill entries).
+    pub screen_fill: bool,
+    /// Whether the device can force the depth test before the fragment shader
+    /// ([`screen_fill::EarlyDepthSupport`]).
+    pub early_depth: bool,
     /// The object's diffuse albedo factors from its material in the pack: base-colour factor
     /// × (1 − metallic)(1 − transmission), and the metallic and transmission factors apart
     /// (the textures multiply per pixel); `None` for an object without a material, which
@@ -213,13 +225,30 @@ pub struct PlenopticMaterial {
 pub struct GeometryKey {
     /// Counting the cost (the `PLENOPTIC_COUNTERS` shader def).
     pub cost_counters: bool,
+    /// Writing the screen-space fill's entries (`PLENOPTIC_SCREEN_FILL`).
+    pub screen_fill: bool,
+    /// The depth test forced before the fragment shader (`PLENOPTIC_EARLY_DEPTH`,
+    /// `@early_depth_test(force)`): a shader that writes storage would otherwise run for
+    /// every fragment the depth prepass already hid, and write for it.
+    pub early_depth: bool,
+}
+
+impl GeometryKey {
+    /// The key of a material counting or not, writing fill entries or not, on a device that
+    /// can force early depth tests or not, whose fragments may discard (alpha mask: a forced
+    /// early test would write the depth of discarded fragments) or not.
+    pub fn new(cost_counters: bool, screen_fill: bool, early_depth: bool, discards: bool) -> Self {
+        Self {
+            cost_counters,
+            screen_fill,
+            early_depth: early_depth && !discards && (cost_counters || screen_fill),
+        }
+    }
 }
 
 impl From<&PlenopticMaterial> for GeometryKey {
     fn from(m: &PlenopticMaterial) -> Self {
-        Self {
-            cost_counters: m.cost_counters,
-        }
+        Self::new(m.cost_counters, m.screen_fill, m.early_depth, false)
     }
 }
 
@@ -229,10 +258,16 @@ impl GeometryKey {
         self,
         descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
     ) {
-        if let Some(fragment) = descriptor.fragment.as_mut()
-            && self.cost_counters
-        {
-            fragment.shader_defs.push("PLENOPTIC_COUNTERS".into());
+        if let Some(fragment) = descriptor.fragment.as_mut() {
+            for (on, def) in [
+                (self.cost_counters, "PLENOPTIC_COUNTERS"),
+                (self.screen_fill, "PLENOPTIC_SCREEN_FILL"),
+                (self.early_depth, "PLENOPTIC_EARLY_DEPTH"),
+            ] {
+                if on {
+                    fragment.shader_defs.push(def.into());
+                }
+            }
         }
     }
 }

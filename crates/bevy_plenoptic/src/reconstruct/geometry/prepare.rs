@@ -7,7 +7,8 @@ use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
 
 use super::{
-    ObjectParams, PlenopticMaterial, frame, material_factors, object_coverage, rays, view, volume,
+    ObjectParams, PlenopticMaterial, frame, material_factors, object_coverage, rays, screen_fill,
+    view, volume,
 };
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
@@ -31,7 +32,7 @@ pub(super) fn attach_materials(
         &view::ViewBuffer,
         &CounterBuffer,
     )>,
-    settings: Res<PlenopticSettings>,
+    (settings, early_depth): (Res<PlenopticSettings>, Res<screen_fill::EarlyDepthSupport>),
     packs: Res<Assets<RadiancePack>>,
     roots: Query<&PlenopticScene>,
     proxies: Query<(Entity, &ChildOf, &ProxyOf), With<MeshMaterial3d<StandardMaterial>>>,
@@ -80,7 +81,10 @@ pub(super) fn attach_materials(
             ray_placements: camera_rays.buffer.clone(),
             counters: counters.buffer.clone(),
             fill_entries: view_buffer.fill_entries.clone(),
+            hole_list: view_buffer.hole_list.clone(),
             cost_counters: settings.cost_counters,
+            screen_fill: view_buffer.screen_fill(),
+            early_depth: early_depth.0,
             albedo: factors,
             coverage: object_coverage(pack, of.id),
             transmissive,
@@ -141,5 +145,7 @@ impl frame::BindsView for PlenopticMaterial {
         self.view = view.buffer.clone();
         self.counters = view.counters.clone();
         self.fill_entries = view.fill_entries.clone();
+        self.hole_list = view.hole_list.clone();
+        self.screen_fill = view.screen_fill();
     }
 }

@@ -6,13 +6,16 @@
 //! reconstruction's loads (`docs/results/measurements.md`). On a camera with the screen fill
 //! ([`ScreenFill`]) every fragment drawn in the opaque pass instead leaves its pixel an entry
 //! in the camera's entry buffer (`fill_entry.wgsl`): its lighting and non-diffuse terms where
-//! its lookups answered, or its hole with its albedo and what it adds on top. After Bevy's
-//! opaque pass a compute kernel (`screen_fill.wgsl`, one thread per pixel) fills each hole
-//! from the nearest ring of pixels holding its own object, shades their mean terms with the
-//! hole's albedo as the CPU does, and writes the pixel of the view's HDR target. A ring
-//! pixel costs one 16-byte load. The entries are cleared before the opaque pass; the fill
-//! runs before the transparent pass, so glazing blends over filled pixels. Glazing and glass
-//! (drawn in the transparent pass) keep the fragment fill.
+//! its lookups answered, else its hole, whose record (its point, albedo and what it adds on
+//! top) it appends to the camera's hole list. After Bevy's opaque pass a compute kernel
+//! (`screen_fill.wgsl`, one thread per listed hole) fills each hole from the nearest ring of
+//! pixels holding its own object, shading their mean terms with the hole's albedo as the CPU
+//! does, else takes the later fallbacks (the object's nearby texels, the heaviest key's
+//! texel) from the keys itself, and writes the pixel of the view's HDR target. A ring pixel
+//! costs one 16-byte load. Entries and list are cleared before the opaque pass; the fill runs
+//! before the transparent pass, so glazing blends over filled pixels. Glazing and glass
+//! (drawn in the transparent pass) keep the fragment fill, as does a hole beyond the list's
+//! room ([`HOLE_SHARE`] of the viewport's pixels).
 //!
 //! The kernel writes the view target as a storage texture, as bevy_solari's realtime passes
 //! do, so the fill needs an HDR camera (`Hdr`, an `Rgba16Float` target) without MSAA
@@ -27,32 +30,62 @@ use bevy::camera::{CameraMainTextureUsages, Hdr};
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
-use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, storage_buffer_sized, texture_storage_2d, uniform_buffer,
+    storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array, texture_storage_2d,
+    uniform_buffer,
 };
 use bevy::render::render_resource::{
-    BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
+    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
     CachedComputePipelineId, ComputePassDescriptor, ComputePipelineDescriptor, PipelineCache,
-    ShaderStages, ShaderType, StorageTextureAccess, TextureFormat, TextureUsages, UniformBuffer,
+    ShaderStages, ShaderType, StorageTextureAccess, TextureFormat, TextureSampleType,
+    TextureUsages, UniformBuffer,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
+use bevy::render::settings::WgpuFeatures;
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
+use bevy::render::texture::GpuImage;
 use bevy::render::view::ViewTarget;
 use bevy::render::{RenderApp, RenderStartup};
+use bevy::shader::ShaderDefVal;
 
+use super::view::ViewBuffer;
 use crate::camera::PlenopticCamera;
-use crate::reconstruct::counters::{CounterBuffer, TILE};
+use crate::reconstruct::KeyTextures;
+use crate::reconstruct::counters::CounterBuffer;
 use crate::settings::{Backend, PlenopticSettings, ResolvedBackend};
 
 /// Bytes of one pixel's entry (`fill_entry.wgsl`).
 const ENTRY_BYTES: u64 = 16;
-/// The kernel's workgroup: one counter tile, 8 × 4 pixels.
-const GROUP: UVec2 = TILE;
+/// Bytes of a hole record (`HoleRecord`) and of the list's header (its count, aligned).
+const RECORD_BYTES: u64 = 48;
+const LIST_HEADER_BYTES: u64 = 16;
+/// The share of a viewport's pixels the hole list has room for (a quarter; the tour's views
+/// have 11 %, the room's densest 33 % at 8-texel faces, which then fill the rest in the
+/// fragment).
+pub const HOLE_SHARE: u64 = 1;
+/// Threads per workgroup of the kernel.
+const GROUP: u32 = 64;
+
+/// Whether the device can force the depth test before a fragment shader that writes storage
+/// (wgpu's `SHADER_EARLY_DEPTH_TEST`: Vulkan, GL). The screen fill needs it: without it every
+/// fragment hidden by the depth prepass would run the whole reconstruction and write its
+/// entry. Decided when the plugin finishes.
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct EarlyDepthSupport(pub bool);
+
+/// Inserts [`EarlyDepthSupport`] from the render device's features.
+pub(super) fn finish(app: &mut App) {
+    let supported = app
+        .get_sub_app(RenderApp)
+        .and_then(|r| r.world().get_resource::<RenderDevice>())
+        .is_some_and(|d| d.features().contains(WgpuFeatures::SHADER_EARLY_DEPTH_TEST));
+    app.insert_resource(EarlyDepthSupport(supported));
+}
 
 /// A camera's screen-space hole fill (see the module doc): its entry buffer, which its
 /// materials bind, and what the kernel needs. Extracted onto the camera's render-world view.
@@ -60,14 +93,21 @@ const GROUP: UVec2 = TILE;
 pub struct ScreenFill {
     /// One entry per pixel of the viewport (16 bytes, a placeholder while off).
     pub entries: Handle<ShaderBuffer>,
+    /// The hole list: a header and room for a [`HOLE_SHARE`] of the pixels' records.
+    pub holes: Handle<ShaderBuffer>,
     /// The viewport's size in pixels; zero while the camera uses the fragment fill.
     pub size: UVec2,
     /// The ring search's largest radius (`ReconSettings::hole_fill_radius`).
     pub radius: u32,
-    /// The camera's counter buffer, and its tiles across while counting (else 0).
+    /// What the kernel's fallbacks read as the materials do: the pack's key texture and
+    /// shading texture, the camera's view buffer and its counter buffer.
+    pub keys: Option<(Handle<Image>, Handle<Image>)>,
+    /// The camera's view buffer ([`super::view::ViewBuffer::buffer`]).
+    pub view: Handle<ShaderBuffer>,
+    /// The camera's counter buffer.
     pub counters: Handle<ShaderBuffer>,
-    /// Tiles across of the counter buffer while counting, else 0.
-    pub tiles_x: u32,
+    /// Whether the shaders count their cost ([`PlenopticSettings::cost_counters`]).
+    pub counting: bool,
 }
 
 impl ScreenFill {
@@ -83,7 +123,7 @@ struct FillParams {
     size: UVec2,
     offset: UVec2,
     radius: u32,
-    tiles_x: u32,
+    exposure: f32,
 }
 
 /// Adds the fill: the main-world entries, their extraction and the render-world passes.
@@ -123,61 +163,69 @@ fn fill_possible(backend: Backend, hdr: bool, msaa: Option<&Msaa>, prepass: bool
 pub(super) fn prepare_screen_fill(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
-    settings: Res<PlenopticSettings>,
-    mut cameras: Query<
-        (
-            Entity,
-            &Camera,
-            &PlenopticCamera,
-            &CounterBuffer,
-            (Has<Hdr>, Option<&Msaa>, Has<DepthPrepass>),
-            Option<&mut CameraMainTextureUsages>,
-            Option<&mut ScreenFill>,
-        ),
-    >,
+    (settings, early_depth): (Res<PlenopticSettings>, Option<Res<EarlyDepthSupport>>),
+    keys: Res<KeyTextures>,
+    mut cameras: Query<(
+        Entity,
+        &Camera,
+        &PlenopticCamera,
+        (&CounterBuffer, &ViewBuffer),
+        (Has<Hdr>, Option<&Msaa>, Has<DepthPrepass>),
+        Option<&mut CameraMainTextureUsages>,
+        Option<&mut ScreenFill>,
+    )>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (entity, camera, cam, counters, (hdr, msaa, prepass), usages, fill) in &mut cameras {
+    for (entity, camera, cam, (counters, view), (hdr, msaa, prepass), usages, fill) in &mut cameras
+    {
         let size = match camera.physical_viewport_size() {
-            Some(s) if settings.screen_fill && fill_possible(backend.0, hdr, msaa, prepass) => s,
+            Some(s)
+                if settings.screen_fill
+                    && early_depth.as_ref().is_some_and(|e| e.0)
+                    && fill_possible(backend.0, hdr, msaa, prepass) =>
+            {
+                s
+            }
             _ => UVec2::ZERO,
         };
-        let tiles_x = if settings.cost_counters {
-            counters.tiles.x
-        } else {
-            0
+        let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
+            let pixels = u64::from(size.x) * u64::from(size.y);
+            let list = LIST_HEADER_BYTES + (pixels / HOLE_SHARE).max(1) * RECORD_BYTES;
+            let buffer = |bytes: u64| {
+                ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
+            };
+            (
+                buffers.add(buffer((pixels * ENTRY_BYTES).max(ENTRY_BYTES))),
+                buffers.add(buffer(list)),
+            )
         };
-        let entries = |buffers: &mut Assets<ShaderBuffer>| {
-            let bytes = (u64::from(size.x) * u64::from(size.y) * ENTRY_BYTES).max(ENTRY_BYTES);
-            buffers.add(ShaderBuffer::with_size(
-                bytes as usize,
-                RenderAssetUsages::RENDER_WORLD,
-            ))
-        };
-        let wanted = |entries: Handle<ShaderBuffer>| ScreenFill {
+        let wanted = |(entries, holes): (Handle<ShaderBuffer>, Handle<ShaderBuffer>)| ScreenFill {
             entries,
+            holes,
             size,
             radius: cam.settings.hole_fill_radius,
+            keys: keys
+                .0
+                .get(&cam.pack.id())
+                .map(|k| (k.image.clone(), k.shading.clone())),
+            view: view.buffer.clone(),
             counters: counters.buffer.clone(),
-            tiles_x,
+            counting: settings.cost_counters,
         };
         match fill {
             None => {
-                commands.entity(entity).insert(wanted(entries(&mut buffers)));
+                commands
+                    .entity(entity)
+                    .insert(wanted(new_buffers(&mut buffers)));
             }
             Some(mut f) => {
-                let handle = if f.size == size {
-                    f.entries.clone()
+                let handles = if f.size == size {
+                    (f.entries.clone(), f.holes.clone())
                 } else {
-                    entries(&mut buffers)
+                    new_buffers(&mut buffers)
                 };
-                let w = wanted(handle);
-                if f.entries != w.entries
-                    || f.size != w.size
-                    || f.radius != w.radius
-                    || f.counters != w.counters
-                    || f.tiles_x != w.tiles_x
-                {
+                let w = wanted(handles);
+                if !same_fill(&f, &w) {
                     *f = w;
                 }
             }
@@ -198,10 +246,24 @@ pub(super) fn prepare_screen_fill(
     }
 }
 
-/// The kernel's pipelines (without and with the cost counters) and their layout.
+/// Whether two fills bind and size the same (written only when not, so that change detection
+/// sees only real changes).
+fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
+    a.entries == b.entries
+        && a.holes == b.holes
+        && a.size == b.size
+        && a.radius == b.radius
+        && a.keys == b.keys
+        && a.view == b.view
+        && a.counters == b.counters
+        && a.counting == b.counting
+}
+
+/// The kernel's pipelines (without and with the cost counters) and their two layouts: the
+/// fill's own bindings (group 0) and the materials' that the fallbacks read (group 1).
 #[derive(Resource)]
 struct FillPipelines {
-    layout: BindGroupLayoutDescriptor,
+    layouts: [BindGroupLayoutDescriptor; 2],
     plain: CachedComputePipelineId,
     counting: CachedComputePipelineId,
 }
@@ -212,7 +274,7 @@ fn init_pipelines(
     asset_server: Res<AssetServer>,
     pipeline_cache: Res<PipelineCache>,
 ) {
-    let layout = BindGroupLayoutDescriptor::new(
+    let own = BindGroupLayoutDescriptor::new(
         "plenoptic screen fill",
         &BindGroupLayoutEntries::sequential(
             ShaderStages::COMPUTE,
@@ -224,30 +286,46 @@ fn init_pipelines(
             ),
         ),
     );
+    // The material's binding numbers (bindings.wgsl, counters.wgsl).
+    let material = BindGroupLayoutDescriptor::new(
+        "plenoptic screen fill lookups",
+        &BindGroupLayoutEntries::with_indices(
+            ShaderStages::COMPUTE,
+            (
+                (0, texture_2d_array(TextureSampleType::Uint)),
+                (5, texture_2d_array(TextureSampleType::Uint)),
+                (10, storage_buffer_read_only_sized(false, None)),
+                (18, storage_buffer_sized(false, None)),
+            ),
+        ),
+    );
+    let layouts = [own, material];
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let pipeline = |label: &'static str, defs: Vec<bevy::shader::ShaderDefVal>| {
+    let pipeline = |label: &'static str, counting: bool| {
+        let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
+        if counting {
+            shader_defs.push("PLENOPTIC_COUNTERS".into());
+        }
         pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
             label: Some(label.into()),
-            layout: vec![layout.clone()],
+            layout: layouts.to_vec(),
             shader: shader.clone(),
-            shader_defs: defs,
+            shader_defs,
             entry_point: Some(Cow::from("fill_holes")),
             ..default()
         })
     };
-    let plain = pipeline("plenoptic screen fill", Vec::new());
-    let counting = pipeline(
-        "plenoptic screen fill (counting)",
-        vec!["PLENOPTIC_COUNTERS".into()],
-    );
+    let plain = pipeline("plenoptic screen fill", false);
+    let counting = pipeline("plenoptic screen fill (counting)", true);
     commands.insert_resource(FillPipelines {
-        layout,
+        layouts,
         plain,
         counting,
     });
 }
 
-/// Clears a view's entries before its opaque pass: a pixel no proxy covers holds nothing.
+/// Clears a view's entries and its hole list's count before its opaque pass: a pixel no
+/// proxy covers holds nothing.
 fn clear_entries(
     view: ViewQuery<&ScreenFill>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
@@ -257,18 +335,69 @@ fn clear_entries(
     if !fill.on() {
         return;
     }
-    if let Some(b) = buffers.get(&fill.entries) {
-        ctx.command_encoder().clear_buffer(&b.buffer, 0, None);
-    }
+    let (Some(entries), Some(holes)) = (buffers.get(&fill.entries), buffers.get(&fill.holes))
+    else {
+        return;
+    };
+    let encoder = ctx.command_encoder();
+    encoder.clear_buffer(&entries.buffer, 0, None);
+    encoder.clear_buffer(&holes.buffer, 0, Some(LIST_HEADER_BYTES));
 }
 
-/// Runs the kernel over a view's entries after its opaque pass, one thread per pixel.
+/// A view's two bind groups for the kernel; `None` until everything is on the GPU, or while
+/// the entries have another size than the view.
+fn bind_groups(
+    fill: &ScreenFill,
+    target: &ViewTarget,
+    params: FillParams,
+    (pipelines, pipeline_cache): (&FillPipelines, &PipelineCache),
+    (buffers, images): (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
+    (device, queue): (&RenderDevice, &RenderQueue),
+) -> Option<[BindGroup; 2]> {
+    let entries = buffers.get(&fill.entries)?;
+    let (cubes, shading) = fill.keys.as_ref()?;
+    let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
+    if !fill.on()
+        || entries.buffer.size() < pixels * ENTRY_BYTES
+        || target.main_texture_format() != TextureFormat::Rgba16Float
+        || target.sampled_main_texture().is_some()
+    {
+        return None;
+    }
+    let mut uniform = UniformBuffer::from(params);
+    uniform.write_buffer(device, queue);
+    let own = device.create_bind_group(
+        "plenoptic screen fill",
+        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[0]),
+        &BindGroupEntries::sequential((
+            entries.buffer.as_entire_binding(),
+            target.main_texture_view(),
+            uniform.binding()?,
+            buffers.get(&fill.holes)?.buffer.as_entire_binding(),
+        )),
+    );
+    let material = device.create_bind_group(
+        "plenoptic screen fill lookups",
+        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[1]),
+        &BindGroupEntries::with_indices((
+            (0, &images.get(cubes)?.texture_view),
+            (5, &images.get(shading)?.texture_view),
+            (10, buffers.get(&fill.view)?.buffer.as_entire_binding()),
+            (18, buffers.get(&fill.counters)?.buffer.as_entire_binding()),
+        )),
+    );
+    Some([own, material])
+}
+
+/// Runs the kernel over a view's hole list after its opaque pass, one thread per record of
+/// its room (those past the list's count return at once).
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn fill_holes(
     view: ViewQuery<(&ScreenFill, &ViewTarget, &ExtractedCamera)>,
     pipelines: Option<Res<FillPipelines>>,
     pipeline_cache: Res<PipelineCache>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    images: Res<RenderAssets<GpuImage>>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     mut ctx: RenderContext,
@@ -277,51 +406,34 @@ fn fill_holes(
     let Some(pipelines) = pipelines else {
         return;
     };
-    let id = if fill.tiles_x > 0 {
+    let id = if fill.counting {
         pipelines.counting
     } else {
         pipelines.plain
     };
-    // The entries of this size, a single-sampled HDR target, the pipeline compiled.
-    let (Some(entries), Some(counters), Some(pipeline)) = (
-        buffers.get(&fill.entries),
-        buffers.get(&fill.counters),
-        pipeline_cache.get_compute_pipeline(id),
+    let Some(pipeline) = pipeline_cache.get_compute_pipeline(id) else {
+        return;
+    };
+    let params = FillParams {
+        size: fill.size,
+        offset: camera
+            .viewport
+            .as_ref()
+            .map_or(UVec2::ZERO, |v| v.physical_position),
+        radius: fill.radius,
+        exposure: camera.exposure,
+    };
+    let Some(groups) = bind_groups(
+        fill,
+        target,
+        params,
+        (&pipelines, &pipeline_cache),
+        (&buffers, &images),
+        (&device, &queue),
     ) else {
         return;
     };
-    let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
-    if !fill.on()
-        || entries.buffer.size() < pixels * ENTRY_BYTES
-        || target.main_texture_format() != TextureFormat::Rgba16Float
-        || target.sampled_main_texture().is_some()
-    {
-        return;
-    }
-    let offset = camera
-        .viewport
-        .as_ref()
-        .map_or(UVec2::ZERO, |v| v.physical_position);
-    let mut uniform = UniformBuffer::from(FillParams {
-        size: fill.size,
-        offset,
-        radius: fill.radius,
-        tiles_x: fill.tiles_x,
-    });
-    uniform.write_buffer(&device, &queue);
-    let Some(params) = uniform.binding() else {
-        return;
-    };
-    let group = device.create_bind_group(
-        "plenoptic screen fill",
-        &pipeline_cache.get_bind_group_layout(&pipelines.layout),
-        &BindGroupEntries::sequential((
-            entries.buffer.as_entire_binding(),
-            target.main_texture_view(),
-            params,
-            counters.buffer.as_entire_binding(),
-        )),
-    );
+    let records = (u64::from(fill.size.x) * u64::from(fill.size.y) / HOLE_SHARE).max(1);
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -332,8 +444,9 @@ fn fill_holes(
         });
     let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill");
     pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &group, &[]);
-    pass.dispatch_workgroups(fill.size.x.div_ceil(GROUP.x), fill.size.y.div_ceil(GROUP.y), 1);
+    pass.set_bind_group(0, &groups[0], &[]);
+    pass.set_bind_group(1, &groups[1], &[]);
+    pass.dispatch_workgroups((records as u32).div_ceil(GROUP), 1, 1);
     span.end(&mut pass);
 }
 
@@ -347,7 +460,12 @@ mod tests {
         assert!(fill_possible(Backend::Gpu, true, off, true));
         assert!(!fill_possible(Backend::Cpu, true, off, true));
         assert!(!fill_possible(Backend::Gpu, false, off, true));
-        assert!(!fill_possible(Backend::Gpu, true, Some(&Msaa::Sample4), true));
+        assert!(!fill_possible(
+            Backend::Gpu,
+            true,
+            Some(&Msaa::Sample4),
+            true
+        ));
         assert!(!fill_possible(Backend::Gpu, true, None, true));
         assert!(!fill_possible(Backend::Gpu, true, off, false));
     }

@@ -1,65 +1,38 @@
-// The screen-space hole fill (thesis §8.2.3, plenoptic_recon's geometry::fill ring search),
-// a compute pass per view between Bevy's opaque and transparent passes. Each hole pixel the
-// proxies' fragments left in the entries (fill_entry.wgsl) takes the nearest ring of pixels
-// (radius 1 to `radius`) holding answered pixels of its own object, averages their terms,
-// shades them with its own albedo and non-diffuse weight, adds what its fragment added, and
-// overwrites its pixel of the view's HDR target. Where no ring has one, the fragment's own
-// fallback (the nearby texels, else the background) stays in the target. No pixel's lookups
-// are computed again: a ring pixel costs one 16-byte load.
-#import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, OBJECT_BITS, HALF_MAX, unpack_pair}
+// The screen-space hole fill (thesis §8.2.3, plenoptic_recon's geometry::fill), a compute
+// pass per view between Bevy's opaque and transparent passes, one thread per record of the
+// camera's hole list (fill_entry.wgsl). A hole takes the nearest ring of pixels (radius 1 to
+// `radius`) holding answered pixels of its own object, averages their terms and shades them
+// with its own albedo and non-diffuse weight; where no ring has one, its object's nearby
+// texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
+// fragment would take them). What its fragment added comes on top, and the pixel of the
+// view's HDR target is overwritten. No pixel's lookups are computed again: a ring pixel
+// costs one 16-byte load.
+//
+// The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
+// counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
+#import plenoptic::fill_entry::{HoleList, HOLE_NON_DIFFUSE, OBJECT_BITS, HALF_MAX, unpack_pair}
+#import plenoptic::geometry::lookup::{Weighted, nearby_texels, heaviest_texel}
+#import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
 
 struct FillParams {
-    // The entries' size (the view's viewport), its offset in the target, the ring radius.
+    // The entries' size (the view's viewport) and its offset in the target.
     size: vec2<u32>,
     offset: vec2<u32>,
+    // The ring search's largest radius; the camera's exposure.
     radius: u32,
-    // Tiles across of the counter buffer (0: not counting).
-    tiles_x: u32,
+    exposure: f32,
 }
 
 @group(0) @binding(0) var<storage, read> entries: array<vec4<u32>>;
 @group(0) @binding(1) var target_image: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(2) var<uniform> fill: FillParams;
+@group(0) @binding(3) var<storage, read_write> holes: HoleList;
 
-#ifdef PLENOPTIC_COUNTERS
-// The camera's counter buffer (counters.wgsl's layout): the kernel's loads are added to its
-// pixel's tile, counted as the fragments' own.
-@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
-const C_LOADS_16: u32 = 1u;
-const TILE_WORDS: u32 = 16u;
-const HEADER_WORDS: u32 = 4u;
-#endif
-
-// Adds `n` loads to the tile of pixel `p` (viewport coordinates), as flush_counters does a
-// fragment's.
-fn count_loads(p: vec2<u32>, n: u32) {
-#ifdef PLENOPTIC_COUNTERS
-    let tile = (fill.offset + p) / vec2<u32>(8u, 4u);
-    if tile.x >= fill.tiles_x || tile.y >= atomicLoad(&counters[1]) {
-        return;
-    }
-    let base = HEADER_WORDS + (tile.y * fill.tiles_x + tile.x) * TILE_WORDS;
-    atomicAdd(&counters[base + C_LOADS_16], n);
-#endif
-}
-
-@compute @workgroup_size(8, 4, 1)
-fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
-    let p = id.xy;
-    if any(p >= fill.size) {
-        return;
-    }
-    let w = fill.size.x;
-    let e = entries[p.y * w + p.x];
-    if (e.w & HOLE) == 0u {
-        return;
-    }
-    let object = e.w & OBJECT_BITS;
-    var loads = 1u;
-    let r_max = i32(fill.radius);
-    let c = vec2<i32>(p);
+// The mean terms of the nearest ring around pixel `c` holding answered pixels of `tag`
+// (object + 1), already times the exposure; w = 0 where no ring within the radius has one.
+fn ring_mean(c: vec2<i32>, tag: u32) -> Weighted {
     let size = vec2<i32>(fill.size);
-    for (var r = 1; r <= r_max; r++) {
+    for (var r = 1; r <= i32(fill.radius); r++) {
         var sum = mat2x3<f32>();
         var n = 0.0;
         for (var dy = -r; dy <= r; dy++) {
@@ -70,24 +43,47 @@ fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
                 if any(q < vec2<i32>(0)) || any(q >= size) {
                     continue;
                 }
-                loads += 1u;
-                let o = entries[u32(q.y) * w + u32(q.x)];
-                if o.w == object {
+                tally(C_LOADS_16, 1u);
+                let o = entries[u32(q.y) * fill.size.x + u32(q.x)];
+                if o.w == tag {
                     sum += unpack_pair(o.xyz);
                     n += 1.0;
                 }
             }
         }
         if n > 0.0 {
-            let mean = sum * (1.0 / n);
-            // What the hole's fragment added (x) and the albedo it shades with (y).
-            let own = unpack_pair(e.xyz);
-            let nd = select(0.0, 1.0, (e.w & HOLE_NON_DIFFUSE) != 0u);
-            let colour = own[1] * mean[0] + mean[1] * nd + own[0];
-            textureStore(target_image, fill.offset + p, vec4<f32>(min(colour, vec3<f32>(HALF_MAX)), 1.0));
-            count_loads(p, loads);
-            return;
+            return Weighted(sum * (1.0 / n), 1.0);
         }
     }
-    count_loads(p, loads);
+    return Weighted(mat2x3<f32>(), 0.0);
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= min(atomicLoad(&holes.count), arrayLength(&holes.records)) {
+        return;
+    }
+    tally(C_LOADS_16, 4u);
+    let record = holes.records[i];
+    let p = vec2<u32>(record.pixel % fill.size.x, record.pixel / fill.size.x);
+    let tag = entries[record.pixel].w;
+    let object = tag & OBJECT_BITS;
+    let material = record.world.w != 0.0;
+    // What the fragment added (column 0) and the albedo it shades with (column 1).
+    let own = unpack_pair(record.pair);
+    let nd = select(0.0, 1.0, (tag & HOLE_NON_DIFFUSE) != 0u);
+    let ring = ring_mean(vec2<i32>(p), object);
+    var terms = ring.terms;
+    if ring.w == 0.0 {
+        let near = nearby_texels(vec4<f32>(record.local.xyz, 1.0), object - 1u, record.local.w, material);
+        if near.w > 0.0 {
+            terms = near.terms * (fill.exposure / near.w);
+        } else {
+            terms = heaviest_texel(record.world.xyz, material).terms * fill.exposure;
+        }
+    }
+    let colour = own[1] * terms[0] + terms[1] * nd + own[0];
+    textureStore(target_image, fill.offset + p, vec4<f32>(min(colour, vec3<f32>(HALF_MAX)), 1.0));
+    flush_kernel_counters(vec2<f32>(fill.offset + p));
 }

@@ -27,12 +27,12 @@ use bevy::render::render_resource::ShaderType;
 use bevy::render::storage::ShaderBuffer;
 
 use super::frame::{CameraFrame, FrameLookups, frame_lookups, warped};
+use super::screen_fill::ScreenFill;
 use super::volume;
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconSettings;
-use super::screen_fill::ScreenFill;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentUniform;
 use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
@@ -131,12 +131,19 @@ pub struct ViewBuffer {
     pub counters: Handle<ShaderBuffer>,
     /// The camera's screen-fill entries ([`ScreenFill`]), which its materials bind too.
     pub fill_entries: Handle<ShaderBuffer>,
+    /// Its hole list ([`ScreenFill::holes`]), which its materials bind too.
+    pub hole_list: Handle<ShaderBuffer>,
 }
 
 impl ViewBuffer {
     /// What the buffer holds now.
     pub fn params(&self) -> &ViewParams {
         &self.params
+    }
+
+    /// Whether the camera's holes are left to the screen-space fill this frame.
+    pub fn screen_fill(&self) -> bool {
+        self.params.flags & ViewFlags::SCREEN_FILL != 0
     }
 }
 
@@ -175,6 +182,7 @@ pub(super) fn add_view_buffers(
                 bindings: 0,
                 counters: Handle::default(),
                 fill_entries: Handle::default(),
+                hole_list: Handle::default(),
             },
             ViewDisplay::default(),
         ));
@@ -255,8 +263,12 @@ pub(super) fn update_view_buffers(
         }
         if let Some(fill) = fill {
             fill.entries.id().hash(&mut h);
+            fill.holes.id().hash(&mut h);
             if view.fill_entries != fill.entries {
                 view.fill_entries = fill.entries.clone();
+            }
+            if view.hole_list != fill.holes {
+                view.hole_list = fill.holes.clone();
             }
         }
         let bindings = h.finish();
