@@ -14,11 +14,14 @@
 //! - `plugin/frame`: one `App::update` of a settled app at 1280 × 720 with one and with two
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes);
 //! - `plugin/costs`: the same frames with the shaders' cost counters on
-//!   (`PlenopticSettings::cost_counters`): each case prints, per fragment, its lookups, loads
-//!   by width, samples, march steps and fallback entries, the loads of a diffuse fragment,
-//!   and the mean over 32-pixel groups of the group's largest loads and work against the
-//!   mean (what divergence costs). Counts need no GPU: on lavapipe they are what a GPU
-//!   would do, which its frame times are not.
+//!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA, each case once with
+//!   the screen-space hole fill and once with the fragment fill
+//!   (`PlenopticSettings::screen_fill`): each prints, per fragment, its lookups, loads by
+//!   width, samples, march steps and fallback entries, the screen-fill kernel's loads, the
+//!   loads of a diffuse fragment, and the mean over 32-pixel groups of the group's largest
+//!   loads and work against the mean (what divergence costs), then the two fills' ratio.
+//!   Counts need no GPU: on lavapipe they are what a GPU would do, which its frame times are
+//!   not.
 //!
 //! With `PLENOPTIC_TOUR_PACK` set to the architectural tour's baked pack, both groups also
 //! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B;
@@ -41,7 +44,7 @@ use std::hint::black_box;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use bevy::camera::RenderTarget;
+use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
@@ -435,8 +438,9 @@ fn settled_frames(
     settled
 }
 
-/// The frames of `plugin/frame` with the cost counters on: `App::update` timed, and the
-/// counts printed (see the module doc).
+/// The frames of `plugin/frame` with the cost counters on, on HDR cameras without MSAA (which
+/// take the screen-space hole fill): `App::update` timed, and the counts printed with the
+/// screen fill and with the fragment fill, and their ratio (see the module doc).
 fn costs(c: &mut Criterion) {
     let dir = room_pack();
     let mut g = c.benchmark_group("plugin/costs");
@@ -444,44 +448,73 @@ fn costs(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(10));
-    counted_frames(&mut g, "room_face32_1280x720_1camera", || {
+    compared_fills(&mut g, "room_face32_1280x720_1camera", || {
         scene(dir.path(), "room.pack", &room_views(1), TOUR_SIZE)
     });
     if let Some((pack, views)) = tour() {
         let (assets, name) = tour_location(&pack);
         let mirror = vec![tour_view("room_a_mirror.json", 0.0)];
         for (case, views) in [("tour_1280x720", &views), ("tour_mirror_1280x720", &mirror)] {
-            counted_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
+            compared_fills(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
     }
     g.finish();
 }
 
-/// [`settled_frames`] with the cost counters on, then the first camera's counts printed.
+/// One case counted with the screen-space fill and with the fragment fill, and the ratio of
+/// their fetches per pixel printed.
+fn compared_fills(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    case: &str,
+    make: impl Fn() -> Scene,
+) {
+    let screen = counted_frames(g, &format!("{case}_screen_fill"), true, &make);
+    let fragment = counted_frames(g, &format!("{case}_fragment_fill"), false, &make);
+    if let (Some(s), Some(f)) = (screen, fragment) {
+        let (a, b) = (s.loads + s.kernel_loads, f.loads + f.kernel_loads);
+        eprintln!(
+            "costs {case}: fetches per pixel {a:.1} with the screen fill, {b:.1} with the \
+             fragment fill ({:.2}× fewer); largest in 32 {:.1} and {:.1}",
+            b / a.max(1e-9),
+            s.group_max_loads,
+            f.group_max_loads,
+        );
+    }
+}
+
+/// [`settled_frames`] with the cost counters on (and the screen fill on or off), on HDR
+/// cameras without MSAA; the first camera's counts printed and returned.
 fn counted_frames(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     name: &str,
+    screen_fill: bool,
     make: impl Fn() -> Scene,
-) {
+) -> Option<CostReport> {
     let settled = settled_frames(g, name, || {
         let mut s = make();
-        s.app
-            .world_mut()
-            .resource_mut::<PlenopticSettings>()
-            .cost_counters = true;
+        {
+            let mut settings = s.app.world_mut().resource_mut::<PlenopticSettings>();
+            settings.cost_counters = true;
+            settings.screen_fill = screen_fill;
+        }
+        for &camera in &s.cameras {
+            s.app
+                .world_mut()
+                .entity_mut(camera)
+                .insert((Hdr, Msaa::Off));
+        }
         s
     });
-    let Some(mut s) = settled else {
-        return;
-    };
+    let mut s = settled?;
     for _ in 0..100 {
         s.app.update();
         if let Some(r) = s.app.world().get::<CostReport>(s.cameras[0]) {
             print_costs(name, r);
-            return;
+            return Some(r.clone());
         }
     }
     eprintln!("{name}: no cost report was read back");
+    None
 }
 
 /// One case's counts, per fragment (see the module doc).
@@ -491,7 +524,7 @@ fn print_costs(name: &str, r: &CostReport) {
         "costs {name}: {} fragments; per fragment: {:.1} lookups, {:.1} loads \
          ({:.1} × 16 B, {:.1} × 8 B, {:.1} × 4 B, {:.1} gathers), {:.2} samples, {:.1} steps, \
          {:.3} volume, {:.3} fill entries, {:.2} fill lookups, {:.3} neighbour; \
-         {:.1} loads per diffuse fragment ({} of them); 32-pixel groups: largest loads \
+         {:.1} screen-fill kernel loads; {:.1} loads per diffuse fragment ({} of them); 32-pixel groups: largest loads \
          {:.1} ({:.2}× the mean), largest work {:.1} ({:.2}× the mean {:.1})",
         r.fragments,
         m("lookups"),
@@ -506,6 +539,7 @@ fn print_costs(name: &str, r: &CostReport) {
         m("fill"),
         m("fill_lookups"),
         m("neighbour"),
+        r.kernel_loads,
         r.diffuse_loads,
         r.diffuse_fragments,
         r.group_max_loads,
