@@ -183,8 +183,8 @@ fn proxies_follow_the_tracks_and_budget_holds_along_a_path() {
 /// The GPU frame (geometry-assisted material, linear HDR read back from an Rgba16Float
 /// target without tonemapping) against `plenoptic_recon`'s CPU frame of the same pack,
 /// camera and time. A sixth of this frame has no accepted lookup and is filled from
-/// neighbouring pixels of the same object (the CPU's ring search; on the GPU an in-shader
-/// search over the points the depth prepass gives the neighbouring pixels).
+/// neighbouring pixels of the same object (the CPU's ring search; on the GPU the screen-space
+/// fill kernel over what the opaque pass's fragments wrote).
 #[test]
 fn gpu_frame_matches_cpu_reconstruction() {
     let f = plugin_and_cpu_frames(Backend::Gpu, 0, None);

@@ -4,12 +4,13 @@
 // ("background"); in image mode the image-mode frame's texel.
 //
 // The hole fill runs in one of two places. On a camera with the screen-space fill
-// (VIEW_SCREEN_FILL, screen_fill.rs) a fragment drawn in the opaque pass leaves its terms, or
-// its hole, in the camera's fill entries (fill_entry.wgsl), shows its later fallbacks, and the
-// fill kernel (screen_fill.wgsl) overwrites each hole its ring search fills: no neighbour's
-// lookups are computed again. Elsewhere (glazing and glass in the transparent pass, cameras
-// without the fill) the fragment recomputes its ring pixels' lookups at the points they show
-// (from the depth prepass, or on the fragment's plane).
+// (PLENOPTIC_SCREEN_FILL, VIEW_SCREEN_FILL; screen_fill.rs) a fragment drawn in the opaque
+// pass leaves its terms in the camera's fill entries (fill_entry.wgsl), or appends its hole to
+// the camera's hole list and leaves the pixel to the fill kernel (screen_fill.wgsl), which
+// takes the ring search and the fallbacks after it: no neighbour's lookups are computed
+// again. Elsewhere (glazing and glass in the transparent pass, cameras without the fill, a
+// hole beyond the list's room) the fragment recomputes its ring pixels' lookups at the points
+// they show (from the depth prepass, or on the fragment's plane).
 #define_import_path plenoptic::geometry::fill
 
 #import bevy_pbr::forward_io::VertexOutput
@@ -176,7 +177,8 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     }
     tally(C_FILL, 1u);
     if deferred && claim_hole(p) {
-        // The fill kernel fills the pixel: its ring search, else the fallbacks below.
+        // The fill kernel fills the pixel: its ring search, else the fallbacks below
+        // (lookup.wgsl's nearby_texels and heaviest_texel, as here).
         entry_kind = ENTRY_HOLE;
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }

@@ -14,14 +14,17 @@
 //! 1. the temporal volumes ([`volume`]): samples of the object near the point's direction
 //!    from each base view, within `t ± tε`;
 //! 2. the same-object hole fill: the nearest ring of pixels (radius up to
-//!    [`ReconSettings::hole_fill_radius`]) whose points have a direct or volume lookup of this object, their
-//!    mean. A fragment cannot read its neighbours' results, so it recomputes them at the
-//!    points the neighbouring pixels show, read from the depth prepass
-//!    ([`PlenopticCamera`] requires one); a lookup accepted there means the neighbour shows
-//!    this object, as the CPU's mask test does. Without a prepass (a camera that removed it)
-//!    each ring pixel's ray is intersected with the fragment's surface plane instead, exact on
-//!    planar faces only;
-//! 3. the heaviest key's texel in the point's direction ("background").
+//!    [`ReconSettings::hole_fill_radius`]) whose points have a direct or volume lookup of this
+//!    object, their mean. On a camera with the screen-space fill ([`screen_fill`]: `Hdr`,
+//!    `Msaa::Off`, a device that forces early depth tests) a compute pass after the opaque
+//!    pass reads the ring from what the fragments wrote. Elsewhere a fragment cannot read its
+//!    neighbours' results, so it recomputes them at the points the neighbouring pixels show,
+//!    read from the depth prepass ([`PlenopticCamera`] requires one); a lookup accepted there
+//!    means the neighbour shows this object, as the CPU's mask test does. Without a prepass (a
+//!    camera that removed it) each ring pixel's ray is intersected with the fragment's surface
+//!    plane instead, exact on planar faces only;
+//! 3. the object's nearest texels around its lookups (thin objects);
+//! 4. the heaviest key's texel in the point's direction ("background").
 //!
 //! See-through glazing (objects with a pack coverage c < 1: glass exported as `alphaMode:
 //! BLEND`) is drawn in Bevy's transparent pass with alpha c over what lies behind it, the
@@ -44,8 +47,9 @@
 //!   materials to proxies and keep them bound to their camera; [`view`] and [`frame`]: the
 //!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`]
 //!   and [`sun`]: the volume fallback's buffers, the ray-cast proxies, the reflection march
-//!   and the runtime sun. The material is drawn by Bevy's own mesh passes, so this feature
-//!   has no render node of its own.
+//!   and the runtime sun; [`screen_fill`] (`screen_fill.wgsl`, `fill_entry.wgsl`): the
+//!   hole-fill kernel. The material is drawn by Bevy's own mesh passes; the kernel runs
+//!   between its opaque and transparent passes.
 //!
 //! On a pack 3 whose lighting leaves the sun to the runtime, lit objects add the sun's direct
 //! light per fragment through their BSDF, shadowed by Bevy's shadow map of a directional

@@ -8,7 +8,8 @@
 //! in the camera's entry buffer (`fill_entry.wgsl`): its lighting and non-diffuse terms where
 //! its lookups answered, else its hole, whose record (its point, albedo and what it adds on
 //! top) it appends to the camera's hole list. After Bevy's opaque pass a compute kernel
-//! (`screen_fill.wgsl`, one thread per listed hole) fills each hole from the nearest ring of
+//! (`screen_fill.wgsl`, one thread per listed hole, dispatched indirectly from the list's
+//! count) fills each hole from the nearest ring of
 //! pixels holding its own object, shading their mean terms with the hole's albedo as the CPU
 //! does, else takes the later fallbacks (the object's nearby texels, the heaviest key's
 //! texel) from the keys itself, and writes the pixel of the view's HDR target. A ring pixel
@@ -40,7 +41,7 @@ use bevy::render::render_resource::binding_types::{
     uniform_buffer,
 };
 use bevy::render::render_resource::{
-    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
+    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, BufferUsages,
     CachedComputePipelineId, ComputePassDescriptor, ComputePipelineDescriptor, PipelineCache,
     ShaderStages, ShaderType, StorageTextureAccess, TextureFormat, TextureSampleType,
     TextureUsages, UniformBuffer,
@@ -68,8 +69,6 @@ const LIST_HEADER_BYTES: u64 = 16;
 /// have 11 %, the room's densest 33 % at 8-texel faces, which then fill the rest in the
 /// fragment).
 pub const HOLE_SHARE: u64 = 1;
-/// Threads per workgroup of the kernel.
-const GROUP: u32 = 64;
 
 /// Whether the device can force the depth test before a fragment shader that writes storage
 /// (wgpu's `SHADER_EARLY_DEPTH_TEST`: Vulkan, GL). The screen fill needs it: without it every
@@ -95,6 +94,8 @@ pub struct ScreenFill {
     pub entries: Handle<ShaderBuffer>,
     /// The hole list: a header and room for a [`HOLE_SHARE`] of the pixels' records.
     pub holes: Handle<ShaderBuffer>,
+    /// The kernel's indirect dispatch arguments, written from the list's count.
+    pub dispatch: Handle<ShaderBuffer>,
     /// The viewport's size in pixels; zero while the camera uses the fragment fill.
     pub size: UVec2,
     /// The ring search's largest radius (`ReconSettings::hole_fill_radius`).
@@ -194,14 +195,18 @@ pub(super) fn prepare_screen_fill(
             let buffer = |bytes: u64| {
                 ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
             };
-            (
+            let mut dispatch = buffer(16);
+            dispatch.buffer_description.usage |= BufferUsages::INDIRECT;
+            [
                 buffers.add(buffer((pixels * ENTRY_BYTES).max(ENTRY_BYTES))),
                 buffers.add(buffer(list)),
-            )
+                buffers.add(dispatch),
+            ]
         };
-        let wanted = |(entries, holes): (Handle<ShaderBuffer>, Handle<ShaderBuffer>)| ScreenFill {
+        let wanted = |[entries, holes, dispatch]: [Handle<ShaderBuffer>; 3]| ScreenFill {
             entries,
             holes,
+            dispatch,
             size,
             radius: cam.settings.hole_fill_radius,
             keys: keys
@@ -220,7 +225,7 @@ pub(super) fn prepare_screen_fill(
             }
             Some(mut f) => {
                 let handles = if f.size == size {
-                    (f.entries.clone(), f.holes.clone())
+                    [f.entries.clone(), f.holes.clone(), f.dispatch.clone()]
                 } else {
                     new_buffers(&mut buffers)
                 };
@@ -251,6 +256,7 @@ pub(super) fn prepare_screen_fill(
 fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
     a.entries == b.entries
         && a.holes == b.holes
+        && a.dispatch == b.dispatch
         && a.size == b.size
         && a.radius == b.radius
         && a.keys == b.keys
@@ -259,13 +265,15 @@ fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
         && a.counting == b.counting
 }
 
-/// The kernel's pipelines (without and with the cost counters) and their two layouts: the
-/// fill's own bindings (group 0) and the materials' that the fallbacks read (group 1).
+/// The kernel's pipelines (without and with the cost counters, and the one writing its
+/// dispatch) and their layouts: the fill's own bindings (group 0), the materials' that the
+/// fallbacks read (group 1) and the dispatch arguments (group 1 of `fill_args`).
 #[derive(Resource)]
 struct FillPipelines {
-    layouts: [BindGroupLayoutDescriptor; 2],
+    layouts: [BindGroupLayoutDescriptor; 3],
     plain: CachedComputePipelineId,
     counting: CachedComputePipelineId,
+    args: CachedComputePipelineId,
 }
 
 /// Queues the kernel's two pipelines.
@@ -299,28 +307,38 @@ fn init_pipelines(
             ),
         ),
     );
-    let layouts = [own, material];
+    let args = BindGroupLayoutDescriptor::new(
+        "plenoptic screen fill dispatch",
+        &BindGroupLayoutEntries::with_indices(
+            ShaderStages::COMPUTE,
+            ((30, storage_buffer_sized(false, None)),),
+        ),
+    );
+    let layouts = [own, material, args];
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let pipeline = |label: &'static str, counting: bool| {
+    let pipeline = |label: &'static str, entry: &'static str, counting: bool| {
         let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
         if counting {
             shader_defs.push("PLENOPTIC_COUNTERS".into());
         }
+        let groups = if entry == "fill_args" { [0, 2] } else { [0, 1] };
         pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
             label: Some(label.into()),
-            layout: layouts.to_vec(),
+            layout: groups.map(|g| layouts[g].clone()).to_vec(),
             shader: shader.clone(),
             shader_defs,
-            entry_point: Some(Cow::from("fill_holes")),
+            entry_point: Some(Cow::from(entry)),
             ..default()
         })
     };
-    let plain = pipeline("plenoptic screen fill", false);
-    let counting = pipeline("plenoptic screen fill (counting)", true);
+    let plain = pipeline("plenoptic screen fill", "fill_holes", false);
+    let counting = pipeline("plenoptic screen fill (counting)", "fill_holes", true);
+    let args = pipeline("plenoptic screen fill dispatch", "fill_args", false);
     commands.insert_resource(FillPipelines {
         layouts,
         plain,
         counting,
+        args,
     });
 }
 
@@ -344,8 +362,8 @@ fn clear_entries(
     encoder.clear_buffer(&holes.buffer, 0, Some(LIST_HEADER_BYTES));
 }
 
-/// A view's two bind groups for the kernel; `None` until everything is on the GPU, or while
-/// the entries have another size than the view.
+/// A view's bind groups for the kernel (its own, the lookups', the dispatch's); `None` until
+/// everything is on the GPU, or while the entries have another size than the view.
 fn bind_groups(
     fill: &ScreenFill,
     target: &ViewTarget,
@@ -353,7 +371,7 @@ fn bind_groups(
     (pipelines, pipeline_cache): (&FillPipelines, &PipelineCache),
     (buffers, images): (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
     (device, queue): (&RenderDevice, &RenderQueue),
-) -> Option<[BindGroup; 2]> {
+) -> Option<[BindGroup; 3]> {
     let entries = buffers.get(&fill.entries)?;
     let (cubes, shading) = fill.keys.as_ref()?;
     let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
@@ -386,11 +404,19 @@ fn bind_groups(
             (18, buffers.get(&fill.counters)?.buffer.as_entire_binding()),
         )),
     );
-    Some([own, material])
+    let args = device.create_bind_group(
+        "plenoptic screen fill dispatch",
+        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[2]),
+        &BindGroupEntries::with_indices(((
+            30,
+            buffers.get(&fill.dispatch)?.buffer.as_entire_binding(),
+        ),)),
+    );
+    Some([own, material, args])
 }
 
-/// Runs the kernel over a view's hole list after its opaque pass, one thread per record of
-/// its room (those past the list's count return at once).
+/// Runs the kernel over a view's hole list after its opaque pass: one thread writes the
+/// dispatch from the list's count, then one thread per listed hole.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn fill_holes(
     view: ViewQuery<(&ScreenFill, &ViewTarget, &ExtractedCamera)>,
@@ -411,7 +437,13 @@ fn fill_holes(
     } else {
         pipelines.plain
     };
-    let Some(pipeline) = pipeline_cache.get_compute_pipeline(id) else {
+    let (Some(pipeline), Some(args)) = (
+        pipeline_cache.get_compute_pipeline(id),
+        pipeline_cache.get_compute_pipeline(pipelines.args),
+    ) else {
+        return;
+    };
+    let Some(dispatch) = buffers.get(&fill.dispatch) else {
         return;
     };
     let params = FillParams {
@@ -433,7 +465,6 @@ fn fill_holes(
     ) else {
         return;
     };
-    let records = (u64::from(fill.size.x) * u64::from(fill.size.y) / HOLE_SHARE).max(1);
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -443,10 +474,13 @@ fn fill_holes(
             ..default()
         });
     let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill");
-    pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &groups[0], &[]);
+    pass.set_pipeline(args);
+    pass.set_bind_group(1, &groups[2], &[]);
+    pass.dispatch_workgroups(1, 1, 1);
+    pass.set_pipeline(pipeline);
     pass.set_bind_group(1, &groups[1], &[]);
-    pass.dispatch_workgroups((records as u32).div_ceil(GROUP), 1, 1);
+    pass.dispatch_workgroups_indirect(&dispatch.buffer, 0);
     span.end(&mut pass);
 }
 

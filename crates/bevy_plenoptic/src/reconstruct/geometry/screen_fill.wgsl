@@ -1,6 +1,6 @@
 // The screen-space hole fill (thesis §8.2.3, plenoptic_recon's geometry::fill), a compute
 // pass per view between Bevy's opaque and transparent passes, one thread per record of the
-// camera's hole list (fill_entry.wgsl). A hole takes the nearest ring of pixels (radius 1 to
+// camera's hole list (fill_entry.wgsl), dispatched indirectly for the holes listed (fill_args). A hole takes the nearest ring of pixels (radius 1 to
 // `radius`) holding answered pixels of its own object, averages their terms and shades them
 // with its own albedo and non-diffuse weight; where no ring has one, its object's nearby
 // texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
@@ -27,6 +27,26 @@ struct FillParams {
 @group(0) @binding(1) var target_image: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(2) var<uniform> fill: FillParams;
 @group(0) @binding(3) var<storage, read_write> holes: HoleList;
+// The fill's indirect dispatch (workgroups x, y, z), written by fill_args; bound apart, in
+// group 1 (whose material bindings fill_args does not use), as a buffer read as dispatch
+// arguments may not be bound to the dispatch itself.
+@group(1) @binding(30) var<storage, read_write> dispatch: array<u32, 3>;
+
+// Threads per workgroup of fill_holes.
+const GROUP: u32 = 64u;
+
+// The holes listed this frame (the count may pass the list's room).
+fn listed() -> u32 {
+    return min(atomicLoad(&holes.count), arrayLength(&holes.records));
+}
+
+// One workgroup of fill_holes per GROUP listed holes, as the indirect dispatch's arguments.
+@compute @workgroup_size(1, 1, 1)
+fn fill_args() {
+    dispatch[0] = (listed() + GROUP - 1u) / GROUP;
+    dispatch[1] = 1u;
+    dispatch[2] = 1u;
+}
 
 // The mean terms of the nearest ring around pixel `c` holding answered pixels of `tag`
 // (object + 1), already times the exposure; w = 0 where no ring within the radius has one.
@@ -58,10 +78,10 @@ fn ring_mean(c: vec2<i32>, tag: u32) -> Weighted {
     return Weighted(mat2x3<f32>(), 0.0);
 }
 
-@compute @workgroup_size(64, 1, 1)
+@compute @workgroup_size(GROUP, 1, 1)
 fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if i >= min(atomicLoad(&holes.count), arrayLength(&holes.records)) {
+    if i >= listed() {
         return;
     }
     tally(C_LOADS_16, 4u);
