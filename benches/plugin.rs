@@ -27,7 +27,10 @@
 //! measure the tour (`tour_1280x720`: one camera at 35 % of its camera path, in room B;
 //! `plugin/frame` also room A with its mirror in view, `tour_mirror_1280x720`, and the same
 //! with the baked specular instead of reflections marched for the camera,
-//! `tour_mirror_baked_specular_1280x720`). With `PLENOPTIC_BENCH_PASSES` set, each
+//! `tour_mirror_baked_specular_1280x720`). The `plugin/frame` cameras render to an 8-bit
+//! target with Bevy's default MSAA, so they take the fragment hole fill; its
+//! `tour_hdr_screen_fill_1280x720` and `tour_hdr_fragment_fill_1280x720` cases are the tour
+//! on an HDR camera without MSAA with the screen-space fill and with the fragment fill. With `PLENOPTIC_BENCH_PASSES` set, each
 //! frame case also prints its passes' CPU and GPU times (Bevy's render diagnostics).
 //!
 //! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
@@ -409,8 +412,33 @@ fn frame(c: &mut Criterion) {
         ] {
             settled_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
+        // An HDR camera without MSAA, with the screen-space fill and with the fragment fill.
+        for (case, fill) in [
+            ("tour_hdr_screen_fill_1280x720", true),
+            ("tour_hdr_fragment_fill_1280x720", false),
+        ] {
+            settled_frames(&mut g, case, || {
+                hdr_scene(scene(assets, name, &views, TOUR_SIZE), fill)
+            });
+        }
     }
     g.finish();
+}
+
+/// `s` with HDR cameras without MSAA (which can take the screen-space hole fill), and the
+/// screen fill on or off (`PlenopticSettings::screen_fill`).
+fn hdr_scene(mut s: Scene, screen_fill: bool) -> Scene {
+    s.app
+        .world_mut()
+        .resource_mut::<PlenopticSettings>()
+        .screen_fill = screen_fill;
+    for &camera in &s.cameras {
+        s.app
+            .world_mut()
+            .entity_mut(camera)
+            .insert((Hdr, Msaa::Off));
+    }
+    s
 }
 
 /// Measures `App::update` of the scene `make` builds, once it shows its reconstruction; says
@@ -491,18 +519,11 @@ fn counted_frames(
     make: impl Fn() -> Scene,
 ) -> Option<CostReport> {
     let settled = settled_frames(g, name, || {
-        let mut s = make();
-        {
-            let mut settings = s.app.world_mut().resource_mut::<PlenopticSettings>();
-            settings.cost_counters = true;
-            settings.screen_fill = screen_fill;
-        }
-        for &camera in &s.cameras {
-            s.app
-                .world_mut()
-                .entity_mut(camera)
-                .insert((Hdr, Msaa::Off));
-        }
+        let mut s = hdr_scene(make(), screen_fill);
+        s.app
+            .world_mut()
+            .resource_mut::<PlenopticSettings>()
+            .cost_counters = true;
         s
     });
     let mut s = settled?;
