@@ -191,6 +191,7 @@ pub(super) fn add_view_buffers(
 
 /// Fills each camera's view buffer for this frame (rewritten only when it changed) and says
 /// what it shows in its [`ViewDisplay`].
+#[expect(clippy::type_complexity, reason = "a Bevy system's query")]
 pub(super) fn update_view_buffers(
     keys: Res<KeyTextures>,
     volumes: Res<volume::VolumeBuffers>,
