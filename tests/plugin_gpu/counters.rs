@@ -4,6 +4,7 @@
 //! counts must be exact where they can be checked (every reconstruction of a point tries each
 //! of the camera's lookups once, and loads its texel), and counting must not change the frame.
 
+use crate::harness::cpu_as_gpu;
 use crate::many_cameras::{
     Eye, assert_each_matches, cpu_frame, plugin_cameras_with, settled_frames,
 };
@@ -24,12 +25,24 @@ fn eye() -> Eye {
 }
 
 /// The settled frames of `eye()` over the room pack in `dir` with counters on (and the
-/// screen-space fill on or off), its first cost report and the view's lookup count.
-fn counted(dir: &std::path::Path, screen_fill: bool) -> (Vec<Vec<Vec3>>, CostReport, f64) {
+/// screen-space fill on or off, the camera's settings changed by `tweak`), its first cost
+/// report and the view's lookup count.
+fn counted(
+    dir: &std::path::Path,
+    screen_fill: bool,
+    tweak: impl Fn(&mut ReconSettings),
+) -> (Vec<Vec<Vec3>>, CostReport, f64) {
     let (mut app, cameras, targets) = plugin_cameras_with(dir, &[eye()], |s| {
         s.cost_counters = true;
         s.screen_fill = screen_fill;
     });
+    tweak(
+        &mut app
+            .world_mut()
+            .get_mut::<PlenopticCamera>(cameras[0])
+            .unwrap()
+            .settings,
+    );
     let frames = settled_frames(&mut app, &targets);
     let mut report = None;
     for _ in 0..200 {
@@ -66,7 +79,10 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
         &path,
     );
     let cpu = cpu_frame(&path, eye());
-    let (screen, fragment) = (counted(dir.path(), true), counted(dir.path(), false));
+    let (screen, fragment) = (
+        counted(dir.path(), true, |_| {}),
+        counted(dir.path(), false, |_| {}),
+    );
     for (frames, report, lookups) in [&screen, &fragment] {
         let (w, h) = (crate::common::WIDTH as u64, crate::common::HEIGHT as u64);
         assert!(
@@ -102,4 +118,43 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
     );
     assert!(s.kernel_loads > 0.0 && f.kernel_loads == 0.0);
     assert!(s.loads + s.kernel_loads < f.loads);
+}
+
+/// With a negative depth tolerance no lookup is accepted: every pixel is a hole and no ring holds
+/// an answered pixel. The hole list fills to its room (a quarter of the pixels) and the kernel
+/// takes its holes' later fallbacks from the keys (the object's nearby texels, else the
+/// heaviest key's texel); the holes past the room fill themselves in their fragments. The
+/// frame still equals the CPU's.
+#[test]
+fn every_pixel_a_hole_fills_as_on_the_cpu() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("room.pack");
+    write_pack(
+        &room(true),
+        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
+        &path,
+    );
+    let (frames, report, _) = counted(dir.path(), true, |s| s.depth_tolerance = -1.0);
+    let m = |n: &str| report.mean_of(n).unwrap();
+    // Every fragment a hole, each taking the nearby texels: a quarter in the kernel, the
+    // rest after reconstructing its ring in the fragment.
+    assert!(m("fill") > 0.99 && m("neighbour") > 0.99, "{report:?}");
+    assert!(
+        report.kernel_loads > 0.0 && m("fill_lookups") > 1.0,
+        "{report:?}"
+    );
+
+    let mut rec = cpu_as_gpu(&path);
+    rec.settings.depth_tolerance = -1.0;
+    let e = eye();
+    let cam = plenoptic_recon::Camera::new(
+        e.at,
+        e.transform().rotation,
+        std::f32::consts::FRAC_PI_4,
+        crate::common::WIDTH,
+        crate::common::HEIGHT,
+    )
+    .unwrap();
+    let (cpu, _) = rec.render(&cam, e.t, e.mode.into()).unwrap();
+    assert_each_matches(&frames, &[cpu.radiance], 0.003, 0.995);
 }

@@ -68,7 +68,7 @@ const LIST_HEADER_BYTES: u64 = 16;
 /// The share of a viewport's pixels the hole list has room for (a quarter; the tour's views
 /// have 11 %, the room's densest 33 % at 8-texel faces, which then fill the rest in the
 /// fragment).
-pub const HOLE_SHARE: u64 = 1;
+pub const HOLE_SHARE: u64 = 4;
 
 /// Whether the device can force the depth test before a fragment shader that writes storage
 /// (wgpu's `SHADER_EARLY_DEPTH_TEST`: Vulkan, GL). The screen fill needs it: without it every
