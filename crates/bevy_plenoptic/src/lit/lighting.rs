@@ -63,6 +63,13 @@ pub struct PlenopticLighting {
     /// The camera's hole list.
     #[storage(117, visibility(fragment))]
     pub hole_list: Handle<ShaderBuffer>,
+    /// The camera's blended keys' geometry: per pair and face the first key's id,
+    /// distance and normal.
+    #[texture(118, dimension = "2d_array", sample_type = "u_int")]
+    pub blended_geometry: Handle<Image>,
+    /// Their blended lighting and non-diffuse terms.
+    #[texture(119, dimension = "2d_array", sample_type = "u_int")]
+    pub blended_terms: Handle<Image>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
     /// Whether the camera has the screen-space fill (its fragments write fill entries).
@@ -130,5 +137,9 @@ impl frame::BindsView for LitMaterial {
         e.fill_entries = view.fill_entries.clone();
         e.hole_list = view.hole_list.clone();
         e.screen_fill = view.screen_fill();
+        if let Some((geometry, terms)) = &view.blended {
+            e.blended_geometry = geometry.clone();
+            e.blended_terms = terms.clone();
+        }
     }
 }

@@ -62,6 +62,7 @@ use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::cpu::CpuFrameMaterial;
 use crate::reconstruct::environment::EnvironmentImages;
 use crate::reconstruct::frames::{CpuFrameImage, ImageFrame};
+use crate::reconstruct::geometry::blend::BlendedKeys;
 use crate::reconstruct::geometry::frame;
 use crate::reconstruct::geometry::rays::{CameraRays, PackRays};
 use crate::reconstruct::geometry::screen_fill::EarlyDepthSupport;
@@ -289,6 +290,7 @@ fn attach_lit_materials(
         &CameraRays,
         &ViewBuffer,
         &CounterBuffer,
+        &BlendedKeys,
     )>,
     packs: Res<Assets<RadiancePack>>,
     standard: Res<Assets<StandardMaterial>>,
@@ -306,7 +308,9 @@ fn attach_lit_materials(
         return;
     }
     for (root, scene) in &roots {
-        let Ok((cam, image_frame, camera_rays, view, counters)) = cameras.get(scene.camera) else {
+        let Ok((cam, image_frame, camera_rays, view, counters, blended)) =
+            cameras.get(scene.camera)
+        else {
             continue;
         };
         let id = cam.pack.id();
@@ -356,6 +360,8 @@ fn attach_lit_materials(
                     counters: counters.buffer.clone(),
                     fill_entries: view.fill_entries.clone(),
                     hole_list: view.hole_list.clone(),
+                    blended_geometry: blended.geometry.clone(),
+                    blended_terms: blended.terms.clone(),
                     cost_counters: settings.cost_counters,
                     screen_fill: view.screen_fill(),
                     early_depth: early_depth.0,

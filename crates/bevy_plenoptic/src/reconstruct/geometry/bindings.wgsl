@@ -12,6 +12,10 @@ const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
 // Face size of the volume samples' direction bins (plenoptic_recon's VolumeIndex).
 const BIN_FACE: u32 = 16u;
+// Key pairs blended at most (blend.rs, MAX_PAIRS).
+const MAX_PAIRS: u32 = 8u;
+// The id of a blended texel that changes between its pair's two keys.
+const PAIR_CHANGING: u32 = 0xffffffffu;
 
 // Bits of ViewParams.flags (view.rs, ViewFlags).
 // Accepted lookups filtered seamlessly bilinear (ReconSettings::cube_filter).
@@ -47,6 +51,8 @@ struct ViewParams {
     // The roughest glossy surface marched (−1: ideal mirrors only); how far rays are marched.
     glossy_roughness: f32,
     march_distance: f32,
+    // Key pairs blended this frame (blend.rs).
+    pair_count: u32,
     // The runtime sun: direction towards it (xyz), with VIEW_SUN.
     sun: vec4<f32>,
     // Its illuminance at the camera's time (xyz).
@@ -57,8 +63,11 @@ struct ViewParams {
     lamps: array<vec4<f32>, 12>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
-    // Per lookup: weight (x), whether the key has normals (y).
+    // Per lookup: weight (x), whether the key has normals (y), 1 + its pair where it is the
+    // first key of a blended pair (z, 0: none).
     weight: array<vec4<f32>, 16>,
+    // Per blended pair: its two lookups (x, y); its layers in the blended keys are 6 × pair.
+    pairs: array<vec4<u32>, 8>,
     // Per volume block: base view position (xyz), view weight (w).
     volume: array<vec4<f32>, 8>,
     // Per volume block: first sample (x), first bin offset (y).
@@ -116,6 +125,8 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(111) var env_image: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(116) var<storage, read_write> fill_entries: array<vec4<u32>>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(117) var<storage, read_write> hole_list: HoleList;
+@group(#{MATERIAL_BIND_GROUP}) @binding(118) var blended_geometry: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(119) var blended_terms: texture_2d_array<u32>;
 #else
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var cubes: texture_2d_array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<uniform> params: ObjectParams;
@@ -146,6 +157,10 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(20) var<storage, read_write> fill_entries: array<vec4<u32>>;
 // Its hole list (fill_entry.wgsl): the holes left to the fill kernel.
 @group(#{MATERIAL_BIND_GROUP}) @binding(21) var<storage, read_write> hole_list: HoleList;
+// The camera's blended keys (blend.rs): per pair and face, the first key's id, distance and
+// normal (PAIR_CHANGING where the keys differ); the pair's blended terms (pack_pair).
+@group(#{MATERIAL_BIND_GROUP}) @binding(22) var blended_geometry: texture_2d_array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(23) var blended_terms: texture_2d_array<u32>;
 #endif
 
 // The fragment's diffuse albedo (set once per fragment, before any lookup).

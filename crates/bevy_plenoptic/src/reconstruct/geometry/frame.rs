@@ -105,6 +105,24 @@ pub(crate) fn frame_lookups(
     out
 }
 
+/// Pairs the lookups of one base view's two time keys (consecutive in `lookups`, with the
+/// same normals) for the blended keys ([`super::blend`]), at most `MAX_PAIRS`.
+fn pair_keys(params: &mut ViewParams, lookups: &[Lookup]) {
+    let mut k = 0;
+    while k + 1 < lookups.len() && params.pair_count < super::blend::MAX_PAIRS {
+        let (a, b) = (&lookups[k], &lookups[k + 1]);
+        if a.base == b.base && a.normals == b.normals {
+            let pair = params.pair_count;
+            params.pairs[pair as usize] = UVec4::new(k as u32, k as u32 + 1, 0, 0);
+            params.weight[k].z = (pair + 1) as f32;
+            params.pair_count += 1;
+            k += 2;
+        } else {
+            k += 1;
+        }
+    }
+}
+
 /// Whether `mode` shows the frame of the image-mode passes (image and volume modes).
 pub(crate) fn warped(mode: ReconMode) -> bool {
     matches!(mode, ReconMode::Image | ReconMode::Volume)
@@ -239,6 +257,7 @@ impl CameraFrame<'_> {
             params.base[n] = l.base.extend((l.slot * 6) as f32);
             params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
         }
+        pair_keys(&mut params, &f.lookups);
         let taus: Vec<f32> = f.lookups.iter().map(|l| l.tau).collect();
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {

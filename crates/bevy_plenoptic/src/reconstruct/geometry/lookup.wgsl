@@ -8,10 +8,12 @@
 #define_import_path plenoptic::geometry::lookup
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap, Footprint, footprint, tap_weight}
+#import plenoptic::fill_entry::unpack_pair
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
     volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit, view_has, VIEW_BILINEAR,
+    blended_geometry, blended_terms, PAIR_CHANGING,
 }
 
 // Point `p` of this object in the object's own frame (homogeneous): local_from_world · p
@@ -218,27 +220,61 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
     }
 }
 
-// The bilinear filter of lookup `l`, whose nearest texel was accepted, over its footprint
-// `fp` on one face, from gathers: the footprint's object ids and distances (two gathers),
-// its normals only where a tap of the object misses the distance test on a key with normals,
-// and its colours from one gather (radiance) or two (lighting, non-diffuse radiance). The
-// same tests, weights and order as `filtered`: 3 to 5 gathers where its other three taps
-// take 3 loads (radiance) or 7 (lighting, with their shading texels).
-fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> mat2x3<f32> {
-    let corner = vec2<u32>(fp.corner);
-    let uv = (fp.corner + 1.0) / f32(n);
-    let layer = layer0 + fp.face;
+// A footprint's geometry from gathers: its object ids and distances (two gathers), and its
+// normals only where a tap of `object` misses the distance test of lookup `l` on a key with
+// normals (else zero). `tex`: the key texture, or a camera's blended keys (blend.rs).
+struct Gathered {
+    ids: vec4<u32>,
+    dists: vec4<u32>,
+    nrms: vec4<u32>,
+}
+
+fn gather_geometry(tex: texture_2d_array<u32>, uv: vec2<f32>, layer: u32, l: Lookup, object: u32, tol: f32, normals: bool) -> Gathered {
     tally(C_GATHERS, 2u);
-    let ids = textureGather(2, cubes, cube_sampler, uv, layer);
-    let dists = textureGather(1, cubes, cube_sampler, uv, layer);
+    var g: Gathered;
+    g.ids = textureGather(2, tex, cube_sampler, uv, layer);
+    g.dists = textureGather(1, tex, cube_sampler, uv, layer);
+    let fd = bitcast<vec4<f32>>(g.dists);
+    if normals && any((g.ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist))) {
+        tally(C_GATHERS, 1u);
+        g.nrms = textureGather(3, tex, cube_sampler, uv, layer);
+    }
+    return g;
+}
+
+// The bilinear filter of lookup `l`, whose nearest texel was accepted, over its footprint
+// `fp` on one face, given the footprint's geometry `g` and each tap's terms: the taps that
+// show the lookup's surface, weighted; the nearest tap's terms where none has weight. The
+// same tests, weights and order as `filtered`.
+fn filter_taps(l: Lookup, fp: Footprint, n: u32, object: u32, tol: f32, normals: bool, g: Gathered, terms: array<mat2x3<f32>, 4>) -> mat2x3<f32> {
+    let corner = vec2<u32>(fp.corner);
     let kt = min(l.t.xy - corner, vec2<u32>(1u));
     let kn = kt.x + 2u * kt.y;
-    let fd = bitcast<vec4<f32>>(dists);
-    var nrms = vec4<u32>(0u);
-    if normals && any((ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist))) {
-        tally(C_GATHERS, 1u);
-        nrms = textureGather(3, cubes, cube_sampler, uv, layer);
+    var acc = mat2x3<f32>();
+    var aw = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let w = tap_weight(fp.f, k);
+        let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
+        let texel = vec4<u32>(0u, lane(g.dists, k), lane(g.ids, k), lane(g.nrms, k));
+        if k == kn || same_surface(c, n, texel, object, l.d, l.dist, tol, normals) {
+            acc += terms[k] * w;
+            aw += w;
+        }
     }
+    if aw > 0.0 {
+        return acc * (1.0 / aw);
+    }
+    return terms[kn];
+}
+
+// The bilinear filter of lookup `l` over its footprint `fp` on one face of the key at
+// `layer0`, from gathers: the geometry (gather_geometry) and the colours from one gather
+// (radiance) or two (lighting, non-diffuse radiance): 3 to 5 gathers where its other three
+// taps take 3 loads (radiance) or 7 (lighting, with their shading texels).
+fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, tol: f32, normals: bool) -> mat2x3<f32> {
+    let uv = (fp.corner + 1.0) / f32(n);
+    let layer = layer0 + fp.face;
+    let g = gather_geometry(cubes, uv, layer, l, object, tol, normals);
     var c0 = vec4<u32>(0u);
     var c1 = vec4<u32>(0u);
     if lit() {
@@ -249,21 +285,48 @@ fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
         tally(C_GATHERS, 1u);
         c0 = textureGather(0, cubes, cube_sampler, uv, layer);
     }
-    var acc = mat2x3<f32>();
-    var aw = 0.0;
+    var terms: array<mat2x3<f32>, 4>;
     for (var k = 0u; k < 4u; k++) {
-        let w = tap_weight(fp.f, k);
-        let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
-        let texel = vec4<u32>(lane(c0, k), lane(dists, k), lane(ids, k), lane(nrms, k));
-        if k == kn || same_surface(c, n, texel, object, l.d, l.dist, tol, normals) {
-            acc += gathered_colour(lane(c0, k), lane(c1, k)) * w;
-            aw += w;
-        }
+        terms[k] = gathered_colour(lane(c0, k), lane(c1, k));
     }
-    if aw > 0.0 {
-        return acc * (1.0 / aw);
+    return filter_taps(l, fp, n, object, tol, normals, g, terms);
+}
+
+// Lookup `l` of key pair `pair` in the camera's blended keys (blend.rs): (terms, 1) where
+// both keys accept it, w = 0 where both refuse it, w = −1 where a texel of its footprint
+// changes between the two keys or the footprint crosses a seam (then each key is looked up
+// on its own). For a static object shaded from its material: 1 load and 5 or 6 gathers for
+// the two keys.
+fn pair_lookup(l: Lookup, pair: u32, n: u32, object: u32, tol: f32, normals: bool) -> Weighted {
+    let undecided = Weighted(mat2x3<f32>(), -1.0);
+    let layer0 = pair * 6u;
+    tally(C_LOADS_16, 1u);
+    let texel = textureLoad(blended_geometry, l.t.xy, layer0 + l.t.z, 0);
+    if texel.z == PAIR_CHANGING {
+        return undecided;
     }
-    return gathered_colour(lane(c0, kn), lane(c1, kn));
+    if texel.z != object || !nearest_accepts(l, n, bitcast<f32>(texel.y), texel.w, tol, normals) {
+        return Weighted(mat2x3<f32>(), 0.0);
+    }
+    let fp = footprint(l.d, n);
+    if !fp.inside {
+        return undecided;
+    }
+    let uv = (fp.corner + 1.0) / f32(n);
+    let layer = layer0 + fp.face;
+    let g = gather_geometry(blended_geometry, uv, layer, l, object, tol, normals);
+    if any(g.ids == vec4<u32>(PAIR_CHANGING)) {
+        return undecided;
+    }
+    tally(C_GATHERS, 3u);
+    let a = textureGather(0, blended_terms, cube_sampler, uv, layer);
+    let b = textureGather(1, blended_terms, cube_sampler, uv, layer);
+    let c = textureGather(2, blended_terms, cube_sampler, uv, layer);
+    var terms: array<mat2x3<f32>, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        terms[k] = unpack_pair(vec3<u32>(lane(a, k), lane(b, k), lane(c, k)));
+    }
+    return Weighted(filter_taps(l, fp, n, object, tol, normals, g, terms), 1.0);
 }
 
 // A gathered texel's terms: its lighting and non-diffuse radiance for an object shaded from
@@ -273,6 +336,15 @@ fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
         return shaded(vec2<u32>(a, b));
     }
     return radiance_terms(a);
+}
+
+// The angular weight ((1 + cos θ)/2)^p of lookup `l` seen from the direction `to_eye`.
+fn angular(l: Lookup, to_eye: vec3<f32>, power: f32) -> f32 {
+    if power <= 0.0 {
+        return 1.0;
+    }
+    let c = max((1.0 - dot(l.d, to_eye) / l.dist) * 0.5, 1e-3);
+    return pow(c, power);
 }
 
 // The accepted lookups of point `p` of `object` (seen from `eye`): (Σ w·terms, Σ w). With
@@ -288,24 +360,36 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     let local = object_point(p);
     var sum = mat2x3<f32>();
     var ws = 0.0;
+    // A static object shaded from its material looks a view's two keys up once where they
+    // agree (blend.rs).
+    let paired = params.object.y < 0.0 && lit();
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let l = lookup_of(local, k, n, params.object.y);
         if !l.ok {
             continue;
         }
-        tally(C_LOOKUPS, 1u);
-        let layer0 = u32(cam.base[k].w);
         let normals = cam.weight[k].y != 0.0;
-        let got = key_lookup(l, layer0, n, object, tol, normals, bilinear);
+        let pair = u32(cam.weight[k].z);
+        if paired && pair > 0u {
+            let got = pair_lookup(l, pair - 1u, n, object, tol, normals);
+            if got.w >= 0.0 {
+                tally(C_LOOKUPS, 2u);
+                if got.w > 0.0 {
+                    let w = (cam.weight[k].x + cam.weight[k + 1u].x) * angular(l, to_eye, power);
+                    sum += got.terms * w;
+                    ws += w;
+                }
+                // The pair's second key is decided with the first.
+                k += 1u;
+                continue;
+            }
+        }
+        tally(C_LOOKUPS, 1u);
+        let got = key_lookup(l, u32(cam.base[k].w), n, object, tol, normals, bilinear);
         if got.w == 0.0 {
             continue;
         }
-        var wa = 1.0;
-        if power > 0.0 {
-            let c = max((1.0 - dot(l.d, to_eye) / l.dist) * 0.5, 1e-3);
-            wa = pow(c, power);
-        }
-        let w = cam.weight[k].x * wa;
+        let w = cam.weight[k].x * angular(l, to_eye, power);
         sum += got.terms * w;
         ws += w;
     }

@@ -56,6 +56,7 @@
 //! light the plugin keeps aimed along the pack's sun ([`sun`]). Proxies are drawn with both
 //! faces in every pass (the CPU's raster and shadow rays see both).
 
+pub mod blend;
 pub mod frame;
 pub mod prepare;
 pub mod rays;
@@ -101,6 +102,7 @@ impl Plugin for GeometryAssistedPlugin {
         bevy::shader::load_shader_library!(app, "specular.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         screen_fill::build(app);
+        blend::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<volume::VolumeBuffers>()
             .init_resource::<rays::PackRays>()
@@ -118,7 +120,9 @@ impl Plugin for GeometryAssistedPlugin {
                         .in_set(ReconstructSystems::Resources),
                     prepare::attach_materials.in_set(ReconstructSystems::Attach),
                     sun::update_suns.in_set(ReconstructSystems::Jobs),
-                    view::update_view_buffers.in_set(ReconstructSystems::Views),
+                    (view::update_view_buffers, blend::prepare_blended_keys)
+                        .chain()
+                        .in_set(ReconstructSystems::Views),
                     prepare::update_materials.in_set(ReconstructSystems::Materials),
                 ),
             );
@@ -194,6 +198,13 @@ pub struct PlenopticMaterial {
     /// The camera's hole list ([`screen_fill::ScreenFill::holes`]).
     #[storage(21, visibility(fragment))]
     pub hole_list: Handle<ShaderBuffer>,
+    /// The camera's blended keys' geometry ([`blend::BlendedKeys`]): per pair and face the
+    /// first key's id, distance and normal.
+    #[texture(22, dimension = "2d_array", sample_type = "u_int")]
+    pub blended_geometry: Handle<Image>,
+    /// Their blended lighting and non-diffuse terms.
+    #[texture(23, dimension = "2d_array", sample_type = "u_int")]
+    pub blended_terms: Handle<Image>,
     /// Whether the shader counts its cost ([`crate::PlenopticSettings::cost_counters`]).
     pub cost_counters: bool,
     /// Whether the camera has the screen-space fill (its fragments write fill entries).

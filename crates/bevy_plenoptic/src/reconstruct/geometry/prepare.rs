@@ -7,8 +7,8 @@ use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
 
 use super::{
-    ObjectParams, PlenopticMaterial, frame, material_factors, object_coverage, rays, screen_fill,
-    view, volume,
+    ObjectParams, PlenopticMaterial, blend, frame, material_factors, object_coverage, rays,
+    screen_fill, view, volume,
 };
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
@@ -31,6 +31,7 @@ pub(super) fn attach_materials(
         &rays::CameraRays,
         &view::ViewBuffer,
         &CounterBuffer,
+        &blend::BlendedKeys,
     )>,
     (settings, early_depth): (Res<PlenopticSettings>, Res<screen_fill::EarlyDepthSupport>),
     packs: Res<Assets<RadiancePack>>,
@@ -48,7 +49,8 @@ pub(super) fn attach_materials(
         let Ok(scene) = roots.get(parent.parent()) else {
             continue;
         };
-        let Ok((image_frame, camera_rays, view_buffer, counters)) = cameras.get(scene.camera)
+        let Ok((image_frame, camera_rays, view_buffer, counters, blended)) =
+            cameras.get(scene.camera)
         else {
             continue;
         };
@@ -82,6 +84,8 @@ pub(super) fn attach_materials(
             counters: counters.buffer.clone(),
             fill_entries: view_buffer.fill_entries.clone(),
             hole_list: view_buffer.hole_list.clone(),
+            blended_geometry: blended.geometry.clone(),
+            blended_terms: blended.terms.clone(),
             cost_counters: settings.cost_counters,
             screen_fill: view_buffer.screen_fill(),
             early_depth: early_depth.0,
@@ -147,5 +151,9 @@ impl frame::BindsView for PlenopticMaterial {
         self.fill_entries = view.fill_entries.clone();
         self.hole_list = view.hole_list.clone();
         self.screen_fill = view.screen_fill();
+        if let Some((geometry, terms)) = &view.blended {
+            self.blended_geometry = geometry.clone();
+            self.blended_terms = terms.clone();
+        }
     }
 }

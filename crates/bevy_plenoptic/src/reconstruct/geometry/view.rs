@@ -26,6 +26,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;
 use bevy::render::storage::ShaderBuffer;
 
+use super::blend::BlendedKeys;
 use super::frame::{CameraFrame, FrameLookups, frame_lookups, warped};
 use super::screen_fill::ScreenFill;
 use super::volume;
@@ -72,6 +73,8 @@ pub struct ViewParams {
     pub glossy_roughness: f32,
     /// How far reflected rays are marched.
     pub march_distance: f32,
+    /// Key pairs blended this frame (of `pairs`; [`super::blend`]).
+    pub pair_count: u32,
     /// The runtime sun: unit direction towards it (xyz; w unused), with [`ViewFlags::SUN`].
     pub sun: Vec4,
     /// The runtime sun's illuminance at the camera's time (xyz).
@@ -83,8 +86,11 @@ pub struct ViewParams {
     pub lamps: [Vec4; 3 * MAX_RUNTIME_LAMPS],
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
-    /// Weight (x) and whether the key has normals (y: 1 or 0) per lookup.
+    /// Weight (x), whether the key has normals (y: 1 or 0) and, for the first key of a
+    /// blended pair, 1 + the pair's index (z; 0: none) per lookup.
     pub weight: [Vec4; MAX_LOOKUPS],
+    /// Per blended pair: its two lookups (x, y) ([`super::blend`]).
+    pub pairs: [UVec4; super::blend::MAX_PAIRS as usize],
     /// Base view position (xyz) and view weight (w) per volume block.
     pub volume: [Vec4; volume::MAX_VOLUMES],
     /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
@@ -133,6 +139,8 @@ pub struct ViewBuffer {
     pub fill_entries: Handle<ShaderBuffer>,
     /// Its hole list ([`ScreenFill::holes`]), which its materials bind too.
     pub hole_list: Handle<ShaderBuffer>,
+    /// Its blended keys' two textures ([`BlendedKeys`]), which its materials bind too.
+    pub blended: Option<(Handle<Image>, Handle<Image>)>,
 }
 
 impl ViewBuffer {
@@ -183,6 +191,7 @@ pub(super) fn add_view_buffers(
                 counters: Handle::default(),
                 fill_entries: Handle::default(),
                 hole_list: Handle::default(),
+                blended: None,
             },
             ViewDisplay::default(),
         ));
@@ -202,14 +211,14 @@ pub(super) fn update_view_buffers(
         &GlobalTransform,
         &ImageFrame,
         &CounterBuffer,
-        Option<&ScreenFill>,
+        (Option<&ScreenFill>, Option<&BlendedKeys>),
         &mut ViewBuffer,
         &mut ViewDisplay,
     )>,
     images: Res<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (cam, transform, frame, counters, fill, mut view, mut display) in &mut cameras {
+    for (cam, transform, frame, counters, (fill, blended), mut view, mut display) in &mut cameras {
         let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
@@ -270,6 +279,14 @@ pub(super) fn update_view_buffers(
             }
             if view.hole_list != fill.holes {
                 view.hole_list = fill.holes.clone();
+            }
+        }
+        if let Some(b) = blended {
+            let textures = (b.geometry.clone(), b.terms.clone());
+            textures.0.id().hash(&mut h);
+            textures.1.id().hash(&mut h);
+            if view.blended.as_ref() != Some(&textures) {
+                view.blended = Some(textures);
             }
         }
         let bindings = h.finish();

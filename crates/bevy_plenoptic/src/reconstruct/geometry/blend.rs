@@ -1,0 +1,258 @@
+//! A view's two time keys blended once per frame where they agree (thesis §8.2.3's time
+//! blend, `w_time`, moved out of the pixel).
+//!
+//! A camera looks up each base view it blends in the two time keys around its time, and a
+//! static object's point falls on the same texel of both. Where that texel (and the rest of a
+//! lookup's footprint) shows the same surface in both keys, same object, distance and normal,
+//! the two lookups pass and refuse together, and their blend is the keys' colours blended with
+//! their time weights. Once per frame, before the camera's opaque pass, a compute pass
+//! (`blend.wgsl`) writes each such pair of keys into the camera's blended keys: per texel the
+//! first key's id, distance and normal (or an id that marks the texel as changing), and the
+//! two keys' lighting and non-diffuse terms blended, as half floats. A lit static object's
+//! fragment then looks a pair up once (`lookup.wgsl`, `pair_lookup`) instead of twice, and
+//! takes the two keys apart only where a texel of its footprint changes between them.
+//! The result is the same blend: weights `w_0 + w_1` and colours `(w_0 c_0 + w_1 c_1) /
+//! (w_0 + w_1)`, to the precision of half floats.
+
+use std::borrow::Cow;
+
+use bevy::asset::{RenderAssetUsages, load_embedded_asset};
+use bevy::core_pipeline::core_3d::main_opaque_pass_3d;
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::image::ImageSampler;
+use bevy::prelude::*;
+use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::binding_types::{
+    storage_buffer_read_only_sized, texture_2d_array, texture_storage_2d_array,
+};
+use bevy::render::render_resource::{
+    BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedComputePipelineId,
+    ComputePassDescriptor, ComputePipelineDescriptor, Extent3d, PipelineCache, ShaderStages,
+    StorageTextureAccess, TextureDimension, TextureFormat, TextureSampleType, TextureUsages,
+};
+use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
+use bevy::render::texture::GpuImage;
+use bevy::render::{RenderApp, RenderStartup};
+use bevy::shader::ShaderDefVal;
+
+use super::view::ViewBuffer;
+use crate::camera::PlenopticCamera;
+use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
+
+/// Key pairs a camera blends at most (two lookups each).
+pub const MAX_PAIRS: u32 = (MAX_LOOKUPS / 2) as u32;
+/// The kernel's workgroup, 8 × 8 texels of one face.
+const GROUP: u32 = 8;
+
+/// A camera's blended keys (see the module doc), which its materials bind. Extracted onto
+/// its render-world view with what the pass reads.
+#[derive(Component, Debug, Clone, ExtractComponent)]
+pub struct BlendedKeys {
+    /// Per pair, six faces: the first key's id, distance and normal (x: unused).
+    pub geometry: Handle<Image>,
+    /// Per pair, six faces: the blended lighting and non-diffuse terms (`fill_entry.wgsl`'s
+    /// `pack_pair`).
+    pub terms: Handle<Image>,
+    /// The keys' face size.
+    pub face: u32,
+    /// Pairs to blend this frame (the view buffer's `pair_count`).
+    pub pairs: u32,
+    /// The pack's key texture and shading texture.
+    pub keys: Option<(Handle<Image>, Handle<Image>)>,
+    /// The camera's view buffer (the pairs, their keys and weights).
+    pub view: Handle<ShaderBuffer>,
+}
+
+/// Adds the blended keys, their extraction and the pass.
+pub(super) fn build(app: &mut App) {
+    bevy::asset::embedded_asset!(app, "blend.wgsl");
+    app.add_plugins(ExtractComponentPlugin::<BlendedKeys>::default());
+    let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+        return;
+    };
+    render_app
+        .add_systems(RenderStartup, init_pipeline)
+        .add_systems(
+            Core3d,
+            blend_keys
+                .in_set(Core3dSystems::MainPass)
+                .before(main_opaque_pass_3d),
+        );
+}
+
+/// A texture of `layers` layers of `face` × `face` 16-byte texels, written by the pass.
+fn blended_image(face: u32, layers: u32) -> Image {
+    let mut image = Image::new_uninit(
+        Extent3d {
+            width: face,
+            height: face,
+            depth_or_array_layers: layers,
+        },
+        TextureDimension::D2,
+        TextureFormat::Rgba32Uint,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    image.texture_descriptor.usage =
+        TextureUsages::STORAGE_BINDING | TextureUsages::TEXTURE_BINDING;
+    image.texture_view_descriptor = None;
+    image.sampler = ImageSampler::nearest();
+    image
+}
+
+/// Gives every plenoptic camera its [`BlendedKeys`] at its pack's face size, and keeps what
+/// the pass reads up to date.
+pub(super) fn prepare_blended_keys(
+    mut commands: Commands,
+    keys: Res<KeyTextures>,
+    mut cameras: Query<(
+        Entity,
+        &PlenopticCamera,
+        &ViewBuffer,
+        Option<&mut BlendedKeys>,
+    )>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    for (entity, cam, view, blended) in &mut cameras {
+        let tex = keys.0.get(&cam.pack.id());
+        let face = tex.map_or(1, |t| t.face);
+        let new_images = |images: &mut Assets<Image>| {
+            let layers = 6 * MAX_PAIRS;
+            (
+                images.add(blended_image(face, layers)),
+                images.add(blended_image(face, layers)),
+            )
+        };
+        let pairs = view.params().pair_count;
+        let key_images = tex.map(|t| (t.image.clone(), t.shading.clone()));
+        match blended {
+            None => {
+                let (geometry, terms) = new_images(&mut images);
+                commands.entity(entity).insert(BlendedKeys {
+                    geometry,
+                    terms,
+                    face,
+                    pairs,
+                    keys: key_images,
+                    view: view.buffer.clone(),
+                });
+            }
+            Some(mut b) => {
+                if b.face != face {
+                    let (geometry, terms) = new_images(&mut images);
+                    b.geometry = geometry;
+                    b.terms = terms;
+                    b.face = face;
+                }
+                if b.pairs != pairs || b.keys != key_images || b.view != view.buffer {
+                    b.pairs = pairs;
+                    b.keys = key_images;
+                    b.view = view.buffer.clone();
+                }
+            }
+        }
+    }
+}
+
+/// The pass's pipeline and layouts: its outputs (group 0) and the keys and view buffer at
+/// the materials' binding numbers (group 1).
+#[derive(Resource)]
+struct BlendPipeline {
+    layouts: [BindGroupLayoutDescriptor; 2],
+    id: CachedComputePipelineId,
+}
+
+/// Queues the pass's pipeline.
+fn init_pipeline(
+    mut commands: Commands,
+    asset_server: Res<AssetServer>,
+    pipeline_cache: Res<PipelineCache>,
+) {
+    let out =
+        || texture_storage_2d_array(TextureFormat::Rgba32Uint, StorageTextureAccess::WriteOnly);
+    let outputs = BindGroupLayoutDescriptor::new(
+        "plenoptic key blend",
+        &BindGroupLayoutEntries::sequential(ShaderStages::COMPUTE, (out(), out())),
+    );
+    // The material's binding numbers (bindings.wgsl).
+    let keys = BindGroupLayoutDescriptor::new(
+        "plenoptic key blend keys",
+        &BindGroupLayoutEntries::with_indices(
+            ShaderStages::COMPUTE,
+            (
+                (0, texture_2d_array(TextureSampleType::Uint)),
+                (5, texture_2d_array(TextureSampleType::Uint)),
+                (10, storage_buffer_read_only_sized(false, None)),
+            ),
+        ),
+    );
+    let layouts = [outputs, keys];
+    let id = pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
+        label: Some("plenoptic key blend".into()),
+        layout: layouts.to_vec(),
+        shader: load_embedded_asset!(asset_server.as_ref(), "blend.wgsl"),
+        shader_defs: vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)],
+        entry_point: Some(Cow::from("blend_keys")),
+        ..default()
+    });
+    commands.insert_resource(BlendPipeline { layouts, id });
+}
+
+/// Blends a view's key pairs before its opaque pass: one thread per texel of each pair's six
+/// faces.
+fn blend_keys(
+    view: ViewQuery<&BlendedKeys>,
+    pipeline: Option<Res<BlendPipeline>>,
+    pipeline_cache: Res<PipelineCache>,
+    buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    images: Res<RenderAssets<GpuImage>>,
+    device: Res<RenderDevice>,
+    mut ctx: RenderContext,
+) {
+    let blended = view.into_inner();
+    let (Some(p), Some((cubes, shading))) = (pipeline, blended.keys.as_ref()) else {
+        return;
+    };
+    if blended.pairs == 0 {
+        return;
+    }
+    let (Some(compute), Some(cubes), Some(shading), Some(view), Some(geometry), Some(terms)) = (
+        pipeline_cache.get_compute_pipeline(p.id),
+        images.get(cubes),
+        images.get(shading),
+        buffers.get(&blended.view),
+        images.get(&blended.geometry),
+        images.get(&blended.terms),
+    ) else {
+        return;
+    };
+    if geometry.texture_descriptor.size.width != blended.face {
+        return;
+    }
+    let outputs = device.create_bind_group(
+        "plenoptic key blend",
+        &pipeline_cache.get_bind_group_layout(&p.layouts[0]),
+        &BindGroupEntries::sequential((&geometry.texture_view, &terms.texture_view)),
+    );
+    let keys = device.create_bind_group(
+        "plenoptic key blend keys",
+        &pipeline_cache.get_bind_group_layout(&p.layouts[1]),
+        &BindGroupEntries::with_indices((
+            (0, &cubes.texture_view),
+            (5, &shading.texture_view),
+            (10, view.buffer.as_entire_binding()),
+        )),
+    );
+    let mut pass = ctx
+        .command_encoder()
+        .begin_compute_pass(&ComputePassDescriptor {
+            label: Some("plenoptic key blend"),
+            ..default()
+        });
+    pass.set_pipeline(compute);
+    pass.set_bind_group(0, &outputs, &[]);
+    pass.set_bind_group(1, &keys, &[]);
+    let n = blended.face.div_ceil(GROUP);
+    pass.dispatch_workgroups(n, n, 6 * blended.pairs.min(MAX_PAIRS));
+}
