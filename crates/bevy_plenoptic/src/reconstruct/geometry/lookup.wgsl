@@ -295,8 +295,8 @@ fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
 // Lookup `l` of key pair `pair` in the camera's blended keys (blend.rs): (terms, 1) where
 // both keys accept it, w = 0 where both refuse it, w = −1 where a texel of its footprint
 // changes between the two keys or the footprint crosses a seam (then each key is looked up
-// on its own). For a static object shaded from its material: 1 load and 5 or 6 gathers for
-// the two keys.
+// on its own). For an object shaded from its material and still between the keys' times: 1
+// load and 5 or 6 gathers for the two keys.
 fn pair_lookup(l: Lookup, pair: u32, n: u32, object: u32, tol: f32, normals: bool) -> Weighted {
     let undecided = Weighted(mat2x3<f32>(), -1.0);
     let layer0 = pair * 6u;
@@ -338,6 +338,18 @@ fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
     return radiance_terms(a);
 }
 
+// Whether this object stands still between the key times of lookups k and k + 1 (static, or
+// animated with the same transform at both): its point falls on the same texel of both keys.
+fn still_between(k: u32) -> bool {
+    let slot = params.object.y;
+    if slot < 0.0 {
+        return true;
+    }
+    let a = cam.motion[u32(slot) * MAX_LOOKUPS + k];
+    let b = cam.motion[u32(slot) * MAX_LOOKUPS + k + 1u];
+    return all(a[0] == b[0]) && all(a[1] == b[1]) && all(a[2] == b[2]) && all(a[3] == b[3]);
+}
+
 // The angular weight ((1 + cos θ)/2)^p of lookup `l` seen from the direction `to_eye`.
 fn angular(l: Lookup, to_eye: vec3<f32>, power: f32) -> f32 {
     if power <= 0.0 {
@@ -360,9 +372,9 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     let local = object_point(p);
     var sum = mat2x3<f32>();
     var ws = 0.0;
-    // A static object shaded from its material looks a view's two keys up once where they
-    // agree (blend.rs).
-    let paired = params.object.y < 0.0 && lit();
+    // An object shaded from its material looks a view's two keys up once where it stands
+    // still between their times and the keys agree (blend.rs).
+    let paired = lit();
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let l = lookup_of(local, k, n, params.object.y);
         if !l.ok {
@@ -370,7 +382,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
         }
         let normals = cam.weight[k].y != 0.0;
         let pair = u32(cam.weight[k].z);
-        if paired && pair > 0u {
+        if paired && pair > 0u && still_between(k) {
             let got = pair_lookup(l, pair - 1u, n, object, tol, normals);
             if got.w >= 0.0 {
                 tally(C_LOOKUPS, 2u);
