@@ -8,7 +8,7 @@ use crate::harness::cpu_as_gpu;
 use crate::many_cameras::{
     Eye, assert_each_matches, cpu_frame, plugin_cameras_with, settled_frames,
 };
-use crate::pack::{PackSpec, room, write_pack};
+use crate::pack::{Materials, PackSpec, room, write_pack};
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::counters::CostReport;
@@ -157,4 +157,28 @@ fn every_pixel_a_hole_fills_as_on_the_cpu() {
     .unwrap();
     let (cpu, _) = rec.render(&cam, e.t, e.mode.into()).unwrap();
     assert_each_matches(&frames, &[cpu.radiance], 0.003, 0.995);
+}
+
+/// A pack with materials: each view's two time keys are blended once per frame where they
+/// agree (`bevy_plenoptic::reconstruct::geometry::blend`), and a lookup of the still walls
+/// reads its pair once, so the frame loads fewer key texels than it tries lookups; the slider,
+/// which moves between the keys, takes them apart. The frame still equals the CPU's.
+#[test]
+fn blended_pairs_load_still_objects_once_for_both_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("room.pack");
+    write_pack(
+        &room(true),
+        &PackSpec {
+            materials: Materials::Factors,
+            ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
+        },
+        &path,
+    );
+    let (frames, report, _) = counted(dir.path(), true, |_| {});
+    let m = |n: &str| report.mean_of(n).unwrap();
+    // One nearest-texel load per pair where it decides (two lookups), one per lookup where
+    // the keys are taken apart.
+    assert!(m("loads_16") < 0.75 * m("lookups"), "{report:?}");
+    assert_each_matches(&frames, &[cpu_frame(&path, eye())], 0.003, 0.995);
 }

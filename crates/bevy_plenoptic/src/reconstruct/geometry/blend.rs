@@ -1,15 +1,16 @@
 //! A view's two time keys blended once per frame where they agree (thesis §8.2.3's time
 //! blend, `w_time`, moved out of the pixel).
 //!
-//! A camera looks up each base view it blends in the two time keys around its time, and a
-//! static object's point falls on the same texel of both. Where that texel (and the rest of a
+//! A camera looks up each base view it blends in the two time keys around its time, and the
+//! point of an object that stands still between the two key times (a static object, or an
+//! animated one with the same transform at both) falls on the same texel of both. Where that texel (and the rest of a
 //! lookup's footprint) shows the same surface in both keys, same object, distance and normal,
 //! the two lookups pass and refuse together, and their blend is the keys' colours blended with
 //! their time weights. Once per frame, before the camera's opaque pass, a compute pass
 //! (`blend.wgsl`) writes each such pair of keys into the camera's blended keys: per texel the
 //! first key's id, distance and normal (or an id that marks the texel as changing), and the
-//! two keys' lighting and non-diffuse terms blended, as half floats. A lit static object's
-//! fragment then looks a pair up once (`lookup.wgsl`, `pair_lookup`) instead of twice, and
+//! two keys' lighting and non-diffuse terms blended, as half floats. The fragment of such an
+//! object shaded from its material then looks a pair up once (`lookup.wgsl`, `pair_lookup`) instead of twice, and
 //! takes the two keys apart only where a texel of its footprint changes between them.
 //! The result is the same blend: weights `w_0 + w_1` and colours `(w_0 c_0 + w_1 c_1) /
 //! (w_0 + w_1)`, to the precision of half floats.
@@ -21,6 +22,7 @@ use bevy::core_pipeline::core_3d::main_opaque_pass_3d;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::image::ImageSampler;
 use bevy::prelude::*;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
@@ -38,7 +40,7 @@ use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
 use super::view::ViewBuffer;
-use crate::camera::PlenopticCamera;
+use crate::camera::{PlenopticCamera, ReconSettings};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 
 /// Key pairs a camera blends at most (two lookups each).
@@ -46,8 +48,9 @@ pub const MAX_PAIRS: u32 = (MAX_LOOKUPS / 2) as u32;
 /// The kernel's workgroup, 8 × 8 texels of one face.
 const GROUP: u32 = 8;
 
-/// A camera's blended keys (see the module doc), which its materials bind. Extracted onto
-/// its render-world view with what the pass reads.
+/// A camera's blended keys (see the module doc), which its materials bind: two textures of
+/// 16 bytes per texel, six faces per pair (at face 64 and 4 views, 1.5 MiB each). Extracted
+/// onto its render-world view with what the pass reads.
 #[derive(Component, Debug, Clone, ExtractComponent)]
 pub struct BlendedKeys {
     /// Per pair, six faces: the first key's id, distance and normal (x: unused).
@@ -57,12 +60,20 @@ pub struct BlendedKeys {
     pub terms: Handle<Image>,
     /// The keys' face size.
     pub face: u32,
+    /// Pairs the textures have room for: the camera's `max_views`, at most [`MAX_PAIRS`].
+    pub room: u32,
     /// Pairs to blend this frame (the view buffer's `pair_count`).
     pub pairs: u32,
     /// The pack's key texture and shading texture.
     pub keys: Option<(Handle<Image>, Handle<Image>)>,
     /// The camera's view buffer (the pairs, their keys and weights).
     pub view: Handle<ShaderBuffer>,
+}
+
+/// Pairs a camera's blended keys have room for: one per base view it blends, at most
+/// [`MAX_PAIRS`].
+pub(crate) fn pair_room(settings: &ReconSettings) -> u32 {
+    (settings.max_views as u32).clamp(1, MAX_PAIRS)
 }
 
 /// Adds the blended keys, their extraction and the pass.
@@ -117,8 +128,9 @@ pub(super) fn prepare_blended_keys(
     for (entity, cam, view, blended) in &mut cameras {
         let tex = keys.0.get(&cam.pack.id());
         let face = tex.map_or(1, |t| t.face);
+        let room = pair_room(&cam.settings);
         let new_images = |images: &mut Assets<Image>| {
-            let layers = 6 * MAX_PAIRS;
+            let layers = 6 * room;
             (
                 images.add(blended_image(face, layers)),
                 images.add(blended_image(face, layers)),
@@ -133,17 +145,19 @@ pub(super) fn prepare_blended_keys(
                     geometry,
                     terms,
                     face,
+                    room,
                     pairs,
                     keys: key_images,
                     view: view.buffer.clone(),
                 });
             }
             Some(mut b) => {
-                if b.face != face {
+                if b.face != face || b.room != room {
                     let (geometry, terms) = new_images(&mut images);
                     b.geometry = geometry;
                     b.terms = terms;
                     b.face = face;
+                    b.room = room;
                 }
                 if b.pairs != pairs || b.keys != key_images || b.view != view.buffer {
                     b.pairs = pairs;
@@ -227,7 +241,9 @@ fn blend_keys(
     ) else {
         return;
     };
-    if geometry.texture_descriptor.size.width != blended.face {
+    if geometry.texture_descriptor.size.width != blended.face
+        || geometry.texture_descriptor.size.depth_or_array_layers != 6 * blended.room
+    {
         return;
     }
     let outputs = device.create_bind_group(
@@ -244,15 +260,19 @@ fn blend_keys(
             (10, view.buffer.as_entire_binding()),
         )),
     );
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
         .command_encoder()
         .begin_compute_pass(&ComputePassDescriptor {
             label: Some("plenoptic key blend"),
             ..default()
         });
+    let span = diagnostics.pass_span(&mut pass, "plenoptic/key_blend");
     pass.set_pipeline(compute);
     pass.set_bind_group(0, &outputs, &[]);
     pass.set_bind_group(1, &keys, &[]);
     let n = blended.face.div_ceil(GROUP);
-    pass.dispatch_workgroups(n, n, 6 * blended.pairs.min(MAX_PAIRS));
+    pass.dispatch_workgroups(n, n, 6 * blended.pairs.min(blended.room));
+    span.end(&mut pass);
 }

@@ -106,10 +106,10 @@ pub(crate) fn frame_lookups(
 }
 
 /// Pairs the lookups of one base view's two time keys (consecutive in `lookups`, with the
-/// same normals) for the blended keys ([`super::blend`]), at most `MAX_PAIRS`.
-fn pair_keys(params: &mut ViewParams, lookups: &[Lookup]) {
+/// same normals) for the blended keys ([`super::blend`]), at most `room`.
+fn pair_keys(params: &mut ViewParams, lookups: &[Lookup], room: u32) {
     let mut k = 0;
-    while k + 1 < lookups.len() && params.pair_count < super::blend::MAX_PAIRS {
+    while k + 1 < lookups.len() && params.pair_count < room {
         let (a, b) = (&lookups[k], &lookups[k + 1]);
         if a.base == b.base && a.normals == b.normals {
             let pair = params.pair_count;
@@ -257,7 +257,11 @@ impl CameraFrame<'_> {
             params.base[n] = l.base.extend((l.slot * 6) as f32);
             params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
         }
-        pair_keys(&mut params, &f.lookups);
+        pair_keys(
+            &mut params,
+            &f.lookups,
+            super::blend::pair_room(&cam.settings),
+        );
         let taus: Vec<f32> = f.lookups.iter().map(|l| l.tau).collect();
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {

@@ -48,8 +48,10 @@
 //!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`]
 //!   and [`sun`]: the volume fallback's buffers, the ray-cast proxies, the reflection march
 //!   and the runtime sun; [`screen_fill`] (`screen_fill.wgsl`, `fill_entry.wgsl`): the
-//!   hole-fill kernel. The material is drawn by Bevy's own mesh passes; the kernel runs
-//!   between its opaque and transparent passes.
+//!   hole-fill kernel; [`blend`] (`blend.wgsl`): each view's two time keys blended once per
+//!   frame where they agree, which a lit object still between the keys' times looks up once.
+//!   The material is drawn by Bevy's own mesh passes; the key blend runs before its opaque
+//!   pass, the fill kernel between its opaque and transparent passes.
 //!
 //! On a pack 3 whose lighting leaves the sun to the runtime, lit objects add the sun's direct
 //! light per fragment through their BSDF, shadowed by Bevy's shadow map of a directional
