@@ -28,10 +28,27 @@ struct HoleRecord {
 }
 
 // A camera's hole list: records appended, the first `count` of them written (count may pass
-// the list's length: those holes were filled by their fragments).
+// the list's length: those holes were filled by their fragments). The fill kernel writes each
+// record's filled colour over its `pair` (column 0).
 struct HoleList {
     count: atomic<u32>,
     records: array<HoleRecord>,
+}
+
+// The same list, read.
+struct HoleRecords {
+    count: u32,
+    records: array<HoleRecord>,
+}
+
+// The fill passes' uniform (screen_fill.rs, FillParams).
+struct FillParams {
+    // The entries' size (the view's viewport) and its offset in the target.
+    size: vec2<u32>,
+    offset: vec2<u32>,
+    // The ring search's largest radius; the camera's exposure.
+    radius: u32,
+    exposure: f32,
 }
 
 // The largest half float.

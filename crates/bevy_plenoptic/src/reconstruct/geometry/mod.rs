@@ -59,6 +59,7 @@
 //! faces in every pass (the CPU's raster and shadow rays see both).
 
 pub mod blend;
+pub mod fill_composite;
 pub mod frame;
 pub mod prepare;
 pub mod rays;

@@ -12,22 +12,24 @@
 //! count) fills each hole from the nearest ring of
 //! pixels holding its own object, shading their mean terms with the hole's albedo as the CPU
 //! does, else takes the later fallbacks (the object's nearby texels, the heaviest key's
-//! texel) from the keys itself, and writes the pixel of the view's HDR target. A ring pixel
-//! costs one 16-byte load. Entries and list are cleared before the opaque pass; the fill runs
-//! before the transparent pass, so glazing blends over filled pixels. Glazing and glass
-//! (drawn in the transparent pass) keep the fragment fill, as does a hole beyond the list's
-//! room ([`HOLE_SHARE`] of the viewport's pixels).
+//! texel) from the keys itself, and writes the filled colour over the hole's record; a
+//! full-screen pass ([`super::fill_composite`]) then writes the listed holes' pixels of the
+//! view's target, every sample of them where the camera has MSAA. A ring pixel costs one
+//! 16-byte load. Entries and list are cleared before the opaque pass; the fill runs before
+//! the transparent pass, so glazing blends over filled pixels. Glazing and glass (drawn in the
+//! transparent pass) keep the fragment fill, as does a hole beyond the list's room
+//! ([`HOLE_SHARE`] of the viewport's pixels).
 //!
-//! The kernel writes the view target as a storage texture, as bevy_solari's realtime passes
-//! do, so the fill needs an HDR camera (`Hdr`, an `Rgba16Float` target) without MSAA
-//! (`Msaa::Off`), with its [`DepthPrepass`] (a fragment writes its entry only where the
-//! prepass kept it). Other cameras use the fragment fill; both give the CPU's result.
+//! The fill needs an HDR camera (`Hdr`: the composite writes linear radiance, which an 8-bit
+//! target would need tonemapped) with its [`DepthPrepass`], on a device that forces early
+//! depth tests ([`EarlyDepthSupport`]): a fragment writes its entry only where the prepass
+//! kept it. Other cameras use the fragment fill; both give the CPU's result.
 //! [`ScreenFill::size`] is zero on them.
 
 use std::borrow::Cow;
 
 use bevy::asset::{RenderAssetUsages, load_embedded_asset};
-use bevy::camera::{CameraMainTextureUsages, Hdr};
+use bevy::camera::Hdr;
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
@@ -37,20 +39,17 @@ use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array, texture_storage_2d,
-    uniform_buffer,
+    storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array, uniform_buffer,
 };
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, BufferUsages,
     CachedComputePipelineId, ComputePassDescriptor, ComputePipelineDescriptor, PipelineCache,
-    ShaderStages, ShaderType, StorageTextureAccess, TextureFormat, TextureSampleType,
-    TextureUsages, UniformBuffer,
+    ShaderStages, ShaderType, TextureSampleType, UniformBuffer,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::settings::WgpuFeatures;
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
 use bevy::render::texture::GpuImage;
-use bevy::render::view::ViewTarget;
 use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
@@ -118,32 +117,52 @@ impl ScreenFill {
     }
 }
 
-/// The kernel's uniform (`screen_fill.wgsl`'s `FillParams`).
+/// The fill passes' uniform (`fill_entry.wgsl`'s `FillParams`).
 #[derive(ShaderType, Clone, Debug)]
-struct FillParams {
+pub(super) struct FillParams {
     size: UVec2,
     offset: UVec2,
     radius: u32,
     exposure: f32,
 }
 
+impl FillParams {
+    /// The uniform of `fill` on `camera`'s view.
+    pub(super) fn new(fill: &ScreenFill, camera: &ExtractedCamera) -> Self {
+        Self {
+            size: fill.size,
+            offset: camera
+                .viewport
+                .as_ref()
+                .map_or(UVec2::ZERO, |v| v.physical_position),
+            radius: fill.radius,
+            exposure: camera.exposure,
+        }
+    }
+}
+
 /// Adds the fill: the main-world entries, their extraction and the render-world passes.
 pub(super) fn build(app: &mut App) {
     bevy::shader::load_shader_library!(app, "fill_entry.wgsl");
     bevy::asset::embedded_asset!(app, "screen_fill.wgsl");
+    bevy::asset::embedded_asset!(app, "fill_composite.wgsl");
     app.add_plugins(ExtractComponentPlugin::<ScreenFill>::default());
     let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
         return;
     };
     render_app
-        .add_systems(RenderStartup, init_pipelines)
+        .add_systems(
+            RenderStartup,
+            (init_pipelines, super::fill_composite::init_composite),
+        )
         .add_systems(
             Core3d,
             (
                 clear_entries
                     .in_set(Core3dSystems::MainPass)
                     .before(main_opaque_pass_3d),
-                fill_holes
+                (fill_holes, super::fill_composite::composite_fill)
+                    .chain()
                     .in_set(Core3dSystems::MainPass)
                     .after(main_opaque_pass_3d)
                     .before(main_transparent_pass_3d),
@@ -151,15 +170,15 @@ pub(super) fn build(app: &mut App) {
         );
 }
 
-/// Whether a camera can take the screen fill: the GPU backend, an HDR target without MSAA,
-/// a depth prepass.
-fn fill_possible(backend: Backend, hdr: bool, msaa: Option<&Msaa>, prepass: bool) -> bool {
-    backend == Backend::Gpu && hdr && msaa == Some(&Msaa::Off) && prepass
+/// Whether a camera can take the screen fill: the GPU backend, an HDR target, a depth
+/// prepass.
+fn fill_possible(backend: Backend, hdr: bool, prepass: bool) -> bool {
+    backend == Backend::Gpu && hdr && prepass
 }
 
 /// Gives every plenoptic camera its [`ScreenFill`], sized to its viewport where the app wants
-/// the fill ([`PlenopticSettings::screen_fill`]) and the camera can take it (a new entry buffer when the size changes), and lets its main texture be written
-/// by the kernel.
+/// the fill ([`PlenopticSettings::screen_fill`]) and the camera can take it (new buffers when
+/// the size changes).
 #[expect(clippy::type_complexity, reason = "a Bevy system's query")]
 pub(super) fn prepare_screen_fill(
     mut commands: Commands,
@@ -171,19 +190,17 @@ pub(super) fn prepare_screen_fill(
         &Camera,
         &PlenopticCamera,
         (&CounterBuffer, &ViewBuffer),
-        (Has<Hdr>, Option<&Msaa>, Has<DepthPrepass>),
-        Option<&mut CameraMainTextureUsages>,
+        (Has<Hdr>, Has<DepthPrepass>),
         Option<&mut ScreenFill>,
     )>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (entity, camera, cam, (counters, view), (hdr, msaa, prepass), usages, fill) in &mut cameras
-    {
+    for (entity, camera, cam, (counters, view), (hdr, prepass), fill) in &mut cameras {
         let size = match camera.physical_viewport_size() {
             Some(s)
                 if settings.screen_fill
                     && early_depth.as_ref().is_some_and(|e| e.0)
-                    && fill_possible(backend.0, hdr, msaa, prepass) =>
+                    && fill_possible(backend.0, hdr, prepass) =>
             {
                 s
             }
@@ -235,19 +252,6 @@ pub(super) fn prepare_screen_fill(
                 }
             }
         }
-        if size != UVec2::ZERO {
-            match usages {
-                Some(mut u) if !u.0.contains(TextureUsages::STORAGE_BINDING) => {
-                    u.0 |= TextureUsages::STORAGE_BINDING;
-                }
-                Some(_) => {}
-                None => {
-                    commands.entity(entity).insert(
-                        CameraMainTextureUsages::default().with(TextureUsages::STORAGE_BINDING),
-                    );
-                }
-            }
-        }
     }
 }
 
@@ -288,7 +292,6 @@ fn init_pipelines(
             ShaderStages::COMPUTE,
             (
                 storage_buffer_read_only_sized(false, None),
-                texture_storage_2d(TextureFormat::Rgba16Float, StorageTextureAccess::WriteOnly),
                 uniform_buffer::<FillParams>(false),
                 storage_buffer_sized(false, None),
             ),
@@ -366,7 +369,6 @@ fn clear_entries(
 /// everything is on the GPU, or while the entries have another size than the view.
 fn bind_groups(
     fill: &ScreenFill,
-    target: &ViewTarget,
     params: FillParams,
     (pipelines, pipeline_cache): (&FillPipelines, &PipelineCache),
     (buffers, images): (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
@@ -375,11 +377,7 @@ fn bind_groups(
     let entries = buffers.get(&fill.entries)?;
     let (cubes, shading) = fill.keys.as_ref()?;
     let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
-    if !fill.on()
-        || entries.buffer.size() < pixels * ENTRY_BYTES
-        || target.main_texture_format() != TextureFormat::Rgba16Float
-        || target.sampled_main_texture().is_some()
-    {
+    if !fill.on() || entries.buffer.size() < pixels * ENTRY_BYTES {
         return None;
     }
     let mut uniform = UniformBuffer::from(params);
@@ -389,7 +387,6 @@ fn bind_groups(
         &pipeline_cache.get_bind_group_layout(&pipelines.layouts[0]),
         &BindGroupEntries::sequential((
             entries.buffer.as_entire_binding(),
-            target.main_texture_view(),
             uniform.binding()?,
             buffers.get(&fill.holes)?.buffer.as_entire_binding(),
         )),
@@ -419,7 +416,7 @@ fn bind_groups(
 /// dispatch from the list's count, then one thread per listed hole.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn fill_holes(
-    view: ViewQuery<(&ScreenFill, &ViewTarget, &ExtractedCamera)>,
+    view: ViewQuery<(&ScreenFill, &ExtractedCamera)>,
     pipelines: Option<Res<FillPipelines>>,
     pipeline_cache: Res<PipelineCache>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
@@ -428,7 +425,7 @@ fn fill_holes(
     queue: Res<RenderQueue>,
     mut ctx: RenderContext,
 ) {
-    let (fill, target, camera) = view.into_inner();
+    let (fill, camera) = view.into_inner();
     let Some(pipelines) = pipelines else {
         return;
     };
@@ -446,19 +443,9 @@ fn fill_holes(
     let Some(dispatch) = buffers.get(&fill.dispatch) else {
         return;
     };
-    let params = FillParams {
-        size: fill.size,
-        offset: camera
-            .viewport
-            .as_ref()
-            .map_or(UVec2::ZERO, |v| v.physical_position),
-        radius: fill.radius,
-        exposure: camera.exposure,
-    };
     let Some(groups) = bind_groups(
         fill,
-        target,
-        params,
+        FillParams::new(fill, camera),
         (&pipelines, &pipeline_cache),
         (&buffers, &images),
         (&device, &queue),
@@ -489,18 +476,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_fill_needs_the_gpu_an_hdr_target_without_msaa_and_a_prepass() {
-        let off = Some(&Msaa::Off);
-        assert!(fill_possible(Backend::Gpu, true, off, true));
-        assert!(!fill_possible(Backend::Cpu, true, off, true));
-        assert!(!fill_possible(Backend::Gpu, false, off, true));
-        assert!(!fill_possible(
-            Backend::Gpu,
-            true,
-            Some(&Msaa::Sample4),
-            true
-        ));
-        assert!(!fill_possible(Backend::Gpu, true, None, true));
-        assert!(!fill_possible(Backend::Gpu, true, off, false));
+    fn the_fill_needs_the_gpu_an_hdr_target_and_a_prepass() {
+        assert!(fill_possible(Backend::Gpu, true, true));
+        assert!(!fill_possible(Backend::Cpu, true, true));
+        assert!(!fill_possible(Backend::Gpu, false, true));
+        assert!(!fill_possible(Backend::Gpu, true, false));
     }
 }

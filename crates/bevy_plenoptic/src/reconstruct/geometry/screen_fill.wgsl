@@ -4,29 +4,19 @@
 // `radius`) holding answered pixels of its own object, averages their terms and shades them
 // with its own albedo and non-diffuse weight; where no ring has one, its object's nearby
 // texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
-// fragment would take them). What its fragment added comes on top, and the pixel of the
-// view's HDR target is overwritten. No pixel's lookups are computed again: a ring pixel
-// costs one 16-byte load.
+// fragment would take them). What its fragment added comes on top, and the colour is written
+// over the hole's record, which the composite pass (fill_composite.wgsl) draws into the
+// view's target. No pixel's lookups are computed again: a ring pixel costs one 16-byte load.
 //
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
-#import plenoptic::fill_entry::{HoleList, HOLE_NON_DIFFUSE, OBJECT_BITS, HALF_MAX, unpack_pair}
+#import plenoptic::fill_entry::{HoleList, FillParams, HOLE_NON_DIFFUSE, OBJECT_BITS, unpack_pair, pack_pair}
 #import plenoptic::geometry::lookup::{Weighted, nearby_texels, heaviest_texel}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
 
-struct FillParams {
-    // The entries' size (the view's viewport) and its offset in the target.
-    size: vec2<u32>,
-    offset: vec2<u32>,
-    // The ring search's largest radius; the camera's exposure.
-    radius: u32,
-    exposure: f32,
-}
-
 @group(0) @binding(0) var<storage, read> entries: array<vec4<u32>>;
-@group(0) @binding(1) var target_image: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(2) var<uniform> fill: FillParams;
-@group(0) @binding(3) var<storage, read_write> holes: HoleList;
+@group(0) @binding(1) var<uniform> fill: FillParams;
+@group(0) @binding(2) var<storage, read_write> holes: HoleList;
 // The fill's indirect dispatch (workgroups x, y, z), written by fill_args; bound apart, in
 // group 1 (whose material bindings fill_args does not use), as a buffer read as dispatch
 // arguments may not be bound to the dispatch itself.
@@ -104,6 +94,6 @@ fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let colour = own[1] * terms[0] + terms[1] * nd + own[0];
-    textureStore(target_image, fill.offset + p, vec4<f32>(min(colour, vec3<f32>(HALF_MAX)), 1.0));
+    holes.records[i].pair = pack_pair(colour, vec3<f32>(0.0));
     flush_kernel_counters(vec2<f32>(fill.offset + p));
 }

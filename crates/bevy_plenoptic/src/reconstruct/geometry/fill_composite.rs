@@ -1,0 +1,174 @@
+//! The screen-space fill's composite ([`super::screen_fill`]): after the fill kernel, a
+//! full-screen pass over the view's target writes each listed hole's filled colour into its
+//! pixel, every sample of it where the camera has MSAA, and discards every other pixel
+//! (`fill_composite.wgsl`). A render pass rather than a storage write, so that it works on a
+//! multisampled target as on a single-sampled one.
+
+use bevy::asset::load_embedded_asset;
+use bevy::core_pipeline::FullscreenShader;
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
+use bevy::render::diagnostic::RecordDiagnostics;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::binding_types::{
+    storage_buffer_read_only_sized, storage_buffer_sized, uniform_buffer,
+};
+use bevy::render::render_resource::{
+    BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedRenderPipelineId,
+    ColorTargetState, ColorWrites, FragmentState, MultisampleState, PipelineCache,
+    RenderPassDescriptor, RenderPipelineDescriptor, ShaderStages, TextureFormat, UniformBuffer,
+    VertexState,
+};
+use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
+use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::view::ViewTarget;
+use bevy::shader::{Shader, ShaderDefVal};
+
+use super::screen_fill::{FillParams, ScreenFill};
+
+/// The composite's layouts (its own bindings; the counters at the materials' binding), its
+/// shaders, and its pipelines by (samples, counting), queued as views need them.
+#[derive(Resource)]
+pub(super) struct CompositePipelines {
+    layouts: [BindGroupLayoutDescriptor; 2],
+    vertex: VertexState,
+    shader: Handle<Shader>,
+    ids: HashMap<(u32, bool), CachedRenderPipelineId>,
+}
+
+impl CompositePipelines {
+    /// The pipeline for a target of `samples` samples, counting or not.
+    fn id(
+        &mut self,
+        cache: &PipelineCache,
+        samples: u32,
+        counting: bool,
+    ) -> CachedRenderPipelineId {
+        *self.ids.entry((samples, counting)).or_insert_with(|| {
+            let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
+            if counting {
+                shader_defs.push("PLENOPTIC_COUNTERS".into());
+            }
+            cache.queue_render_pipeline(RenderPipelineDescriptor {
+                label: Some("plenoptic screen fill composite".into()),
+                layout: self.layouts.to_vec(),
+                vertex: self.vertex.clone(),
+                fragment: Some(FragmentState {
+                    shader: self.shader.clone(),
+                    shader_defs,
+                    entry_point: Some("composite".into()),
+                    targets: vec![Some(ColorTargetState {
+                        format: TextureFormat::Rgba16Float,
+                        blend: None,
+                        write_mask: ColorWrites::ALL,
+                    })],
+                }),
+                multisample: MultisampleState {
+                    count: samples,
+                    ..default()
+                },
+                ..default()
+            })
+        })
+    }
+}
+
+/// Makes the composite's layouts; its pipelines are queued per view.
+pub(super) fn init_composite(
+    mut commands: Commands,
+    asset_server: Res<AssetServer>,
+    fullscreen: Res<FullscreenShader>,
+) {
+    let own = BindGroupLayoutDescriptor::new(
+        "plenoptic screen fill composite",
+        &BindGroupLayoutEntries::sequential(
+            ShaderStages::FRAGMENT,
+            (
+                storage_buffer_read_only_sized(false, None),
+                uniform_buffer::<FillParams>(false),
+                storage_buffer_read_only_sized(false, None),
+            ),
+        ),
+    );
+    let counters = BindGroupLayoutDescriptor::new(
+        "plenoptic screen fill composite counters",
+        &BindGroupLayoutEntries::with_indices(
+            ShaderStages::FRAGMENT,
+            ((18, storage_buffer_sized(false, None)),),
+        ),
+    );
+    commands.insert_resource(CompositePipelines {
+        layouts: [own, counters],
+        vertex: fullscreen.to_vertex_state(),
+        shader: load_embedded_asset!(asset_server.as_ref(), "fill_composite.wgsl"),
+        ids: HashMap::default(),
+    });
+}
+
+/// Draws a view's filled holes into its HDR target after the fill kernel.
+pub(super) fn composite_fill(
+    view: ViewQuery<(&ScreenFill, &ViewTarget, &ExtractedCamera, Option<&Msaa>)>,
+    pipelines: Option<ResMut<CompositePipelines>>,
+    pipeline_cache: Res<PipelineCache>,
+    buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    mut ctx: RenderContext,
+) {
+    let (fill, target, camera, msaa) = view.into_inner();
+    let Some(mut pipelines) = pipelines else {
+        return;
+    };
+    if !fill.on() || target.main_texture_format() != TextureFormat::Rgba16Float {
+        return;
+    }
+    let samples = msaa.map_or(1, Msaa::samples);
+    let id = pipelines.id(&pipeline_cache, samples, fill.counting);
+    let (Some(pipeline), Some(entries), Some(holes), Some(counters)) = (
+        pipeline_cache.get_render_pipeline(id),
+        buffers.get(&fill.entries),
+        buffers.get(&fill.holes),
+        buffers.get(&fill.counters),
+    ) else {
+        return;
+    };
+    let mut uniform = UniformBuffer::from(FillParams::new(fill, camera));
+    uniform.write_buffer(&device, &queue);
+    let Some(params) = uniform.binding() else {
+        return;
+    };
+    let own = device.create_bind_group(
+        "plenoptic screen fill composite",
+        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[0]),
+        &BindGroupEntries::sequential((
+            entries.buffer.as_entire_binding(),
+            params,
+            holes.buffer.as_entire_binding(),
+        )),
+    );
+    let counting = device.create_bind_group(
+        "plenoptic screen fill composite counters",
+        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[1]),
+        &BindGroupEntries::with_indices(((18, counters.buffer.as_entire_binding()),)),
+    );
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
+    let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
+        label: Some("plenoptic screen fill composite"),
+        color_attachments: &[Some(target.get_color_attachment())],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill_composite");
+    if let Some(viewport) = camera.viewport.as_ref() {
+        pass.set_camera_viewport(viewport);
+    }
+    pass.set_render_pipeline(pipeline);
+    pass.set_bind_group(0, &own, &[]);
+    pass.set_bind_group(1, &counting, &[]);
+    pass.draw(0..3, 0..1);
+    span.end(&mut pass);
+}
