@@ -14,8 +14,8 @@
 //! - `plugin/frame`: one `App::update` of a settled app at 1280 × 720 with one and with two
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes);
 //! - `plugin/costs`: the same frames with the shaders' cost counters on
-//!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA, each case once with
-//!   the screen-space hole fill and once with the fragment fill
+//!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA (as the tests' frames),
+//!   each case once with the screen-space hole fill and once with the fragment fill
 //!   (`PlenopticSettings::screen_fill`): each prints, per fragment, its lookups, loads by
 //!   width, samples, march steps and fallback entries, the screen-fill kernel's loads, the
 //!   loads of a diffuse fragment, and the mean over 32-pixel groups of the group's largest
@@ -425,7 +425,7 @@ fn frame(c: &mut Criterion) {
     g.finish();
 }
 
-/// `s` with HDR cameras without MSAA (which can take the screen-space hole fill), and the
+/// `s` with HDR cameras (which can take the screen-space hole fill) without MSAA, and the
 /// screen fill on or off (`PlenopticSettings::screen_fill`).
 fn hdr_scene(mut s: Scene, screen_fill: bool) -> Scene {
     s.app
@@ -467,7 +467,7 @@ fn settled_frames(
 }
 
 /// The frames of `plugin/frame` with the cost counters on, on HDR cameras without MSAA (which
-/// take the screen-space hole fill): `App::update` timed, and the counts printed with the
+/// can take the screen-space hole fill): `App::update` timed, and the counts printed with the
 /// screen fill and with the fragment fill, and their ratio (see the module doc).
 fn costs(c: &mut Criterion) {
     let dir = room_pack();
