@@ -8,8 +8,7 @@
 //! in the camera's entry buffer (`fill_entry.wgsl`): its lighting and non-diffuse terms where
 //! its lookups answered, else its hole, whose record (its point, albedo and what it adds on
 //! top) it appends to the camera's hole list. After Bevy's opaque pass a compute kernel
-//! (`screen_fill.wgsl`, one thread per listed hole, dispatched indirectly from the list's
-//! count) fills each hole from the nearest ring of
+//! (`screen_fill.wgsl`, one thread per listed hole) fills each hole from the nearest ring of
 //! pixels holding its own object, shading their mean terms with the hole's albedo as the CPU
 //! does, else takes the later fallbacks (the object's nearby texels, the heaviest key's
 //! texel) from the keys itself, and writes the filled colour over the hole's record; a
@@ -42,7 +41,7 @@ use bevy::render::render_resource::binding_types::{
     storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array, uniform_buffer,
 };
 use bevy::render::render_resource::{
-    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, BufferUsages,
+    BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
     CachedComputePipelineId, ComputePassDescriptor, ComputePipelineDescriptor, PipelineCache,
     ShaderStages, ShaderType, TextureSampleType, UniformBuffer,
 };
@@ -59,6 +58,8 @@ use crate::reconstruct::KeyTextures;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::settings::{Backend, PlenopticSettings, ResolvedBackend};
 
+/// Threads per workgroup of the kernel (`screen_fill.wgsl`'s `GROUP`).
+const GROUP: u32 = 64;
 /// Bytes of one pixel's entry (`fill_entry.wgsl`).
 const ENTRY_BYTES: u64 = 16;
 /// Bytes of a hole record (`HoleRecord`) and of the list's header (its count, aligned).
@@ -93,8 +94,6 @@ pub struct ScreenFill {
     pub entries: Handle<ShaderBuffer>,
     /// The hole list: a header and room for a [`HOLE_SHARE`] of the pixels' records.
     pub holes: Handle<ShaderBuffer>,
-    /// The kernel's indirect dispatch arguments, written from the list's count.
-    pub dispatch: Handle<ShaderBuffer>,
     /// The viewport's size in pixels; zero while the camera uses the fragment fill.
     pub size: UVec2,
     /// The ring search's largest radius (`ReconSettings::hole_fill_radius`).
@@ -212,18 +211,14 @@ pub(super) fn prepare_screen_fill(
             let buffer = |bytes: u64| {
                 ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
             };
-            let mut dispatch = buffer(16);
-            dispatch.buffer_description.usage |= BufferUsages::INDIRECT;
             [
                 buffers.add(buffer((pixels * ENTRY_BYTES).max(ENTRY_BYTES))),
                 buffers.add(buffer(list)),
-                buffers.add(dispatch),
             ]
         };
-        let wanted = |[entries, holes, dispatch]: [Handle<ShaderBuffer>; 3]| ScreenFill {
+        let wanted = |[entries, holes]: [Handle<ShaderBuffer>; 2]| ScreenFill {
             entries,
             holes,
-            dispatch,
             size,
             radius: cam.settings.hole_fill_radius,
             keys: keys
@@ -242,7 +237,7 @@ pub(super) fn prepare_screen_fill(
             }
             Some(mut f) => {
                 let handles = if f.size == size {
-                    [f.entries.clone(), f.holes.clone(), f.dispatch.clone()]
+                    [f.entries.clone(), f.holes.clone()]
                 } else {
                     new_buffers(&mut buffers)
                 };
@@ -260,7 +255,6 @@ pub(super) fn prepare_screen_fill(
 fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
     a.entries == b.entries
         && a.holes == b.holes
-        && a.dispatch == b.dispatch
         && a.size == b.size
         && a.radius == b.radius
         && a.keys == b.keys
@@ -269,15 +263,13 @@ fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
         && a.counting == b.counting
 }
 
-/// The kernel's pipelines (without and with the cost counters, and the one writing its
-/// dispatch) and their layouts: the fill's own bindings (group 0), the materials' that the
-/// fallbacks read (group 1) and the dispatch arguments (group 1 of `fill_args`).
+/// The kernel's pipelines (without and with the cost counters) and their layouts: the fill's
+/// own bindings (group 0) and the materials' that the fallbacks read (group 1).
 #[derive(Resource)]
 struct FillPipelines {
-    layouts: [BindGroupLayoutDescriptor; 3],
+    layouts: [BindGroupLayoutDescriptor; 2],
     plain: CachedComputePipelineId,
     counting: CachedComputePipelineId,
-    args: CachedComputePipelineId,
 }
 
 /// Queues the kernel's two pipelines.
@@ -310,38 +302,28 @@ fn init_pipelines(
             ),
         ),
     );
-    let args = BindGroupLayoutDescriptor::new(
-        "plenoptic screen fill dispatch",
-        &BindGroupLayoutEntries::with_indices(
-            ShaderStages::COMPUTE,
-            ((30, storage_buffer_sized(false, None)),),
-        ),
-    );
-    let layouts = [own, material, args];
+    let layouts = [own, material];
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let pipeline = |label: &'static str, entry: &'static str, counting: bool| {
+    let pipeline = |label: &'static str, counting: bool| {
         let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
         if counting {
             shader_defs.push("PLENOPTIC_COUNTERS".into());
         }
-        let groups = if entry == "fill_args" { [0, 2] } else { [0, 1] };
         pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
             label: Some(label.into()),
-            layout: groups.map(|g| layouts[g].clone()).to_vec(),
+            layout: layouts.to_vec(),
             shader: shader.clone(),
             shader_defs,
-            entry_point: Some(Cow::from(entry)),
+            entry_point: Some(Cow::from("fill_holes")),
             ..default()
         })
     };
-    let plain = pipeline("plenoptic screen fill", "fill_holes", false);
-    let counting = pipeline("plenoptic screen fill (counting)", "fill_holes", true);
-    let args = pipeline("plenoptic screen fill dispatch", "fill_args", false);
+    let plain = pipeline("plenoptic screen fill", false);
+    let counting = pipeline("plenoptic screen fill (counting)", true);
     commands.insert_resource(FillPipelines {
         layouts,
         plain,
         counting,
-        args,
     });
 }
 
@@ -365,7 +347,7 @@ fn clear_entries(
     encoder.clear_buffer(&holes.buffer, 0, Some(LIST_HEADER_BYTES));
 }
 
-/// A view's bind groups for the kernel (its own, the lookups', the dispatch's); `None` until
+/// A view's bind groups for the kernel (its own, the lookups'); `None` until
 /// everything is on the GPU, or while the entries have another size than the view.
 fn bind_groups(
     fill: &ScreenFill,
@@ -373,7 +355,7 @@ fn bind_groups(
     (pipelines, pipeline_cache): (&FillPipelines, &PipelineCache),
     (buffers, images): (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
     (device, queue): (&RenderDevice, &RenderQueue),
-) -> Option<[BindGroup; 3]> {
+) -> Option<[BindGroup; 2]> {
     let entries = buffers.get(&fill.entries)?;
     let (cubes, shading) = fill.keys.as_ref()?;
     let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
@@ -401,19 +383,11 @@ fn bind_groups(
             (18, buffers.get(&fill.counters)?.buffer.as_entire_binding()),
         )),
     );
-    let args = device.create_bind_group(
-        "plenoptic screen fill dispatch",
-        &pipeline_cache.get_bind_group_layout(&pipelines.layouts[2]),
-        &BindGroupEntries::with_indices(((
-            30,
-            buffers.get(&fill.dispatch)?.buffer.as_entire_binding(),
-        ),)),
-    );
-    Some([own, material, args])
+    Some([own, material])
 }
 
-/// Runs the kernel over a view's hole list after its opaque pass: one thread writes the
-/// dispatch from the list's count, then one thread per listed hole.
+/// Runs the kernel over a view's hole list after its opaque pass, one thread per record of the
+/// list's room.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn fill_holes(
     view: ViewQuery<(&ScreenFill, &ExtractedCamera)>,
@@ -434,13 +408,7 @@ fn fill_holes(
     } else {
         pipelines.plain
     };
-    let (Some(pipeline), Some(args)) = (
-        pipeline_cache.get_compute_pipeline(id),
-        pipeline_cache.get_compute_pipeline(pipelines.args),
-    ) else {
-        return;
-    };
-    let Some(dispatch) = buffers.get(&fill.dispatch) else {
+    let Some(pipeline) = pipeline_cache.get_compute_pipeline(id) else {
         return;
     };
     let Some(groups) = bind_groups(
@@ -452,6 +420,8 @@ fn fill_holes(
     ) else {
         return;
     };
+    // One thread per record of the list's room; those past the holes listed return at once.
+    let records = (u64::from(fill.size.x) * u64::from(fill.size.y) / HOLE_SHARE).max(1);
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -461,13 +431,10 @@ fn fill_holes(
             ..default()
         });
     let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill");
-    pass.set_bind_group(0, &groups[0], &[]);
-    pass.set_pipeline(args);
-    pass.set_bind_group(1, &groups[2], &[]);
-    pass.dispatch_workgroups(1, 1, 1);
     pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &groups[0], &[]);
     pass.set_bind_group(1, &groups[1], &[]);
-    pass.dispatch_workgroups_indirect(&dispatch.buffer, 0);
+    pass.dispatch_workgroups((records as u32).div_ceil(GROUP), 1, 1);
     span.end(&mut pass);
 }
 

@@ -1,7 +1,8 @@
 // The screen-space hole fill (thesis §8.2.3, plenoptic_recon's geometry::fill), a compute
 // pass per view between Bevy's opaque and transparent passes, one thread per record of the
-// camera's hole list (fill_entry.wgsl), dispatched indirectly for the holes listed (fill_args). A hole takes the nearest ring of pixels (radius 1 to
-// `radius`) holding answered pixels of its own object, averages their terms and shades them
+// room of the camera's hole list (fill_entry.wgsl); the threads past the holes listed return
+// at once. A hole takes the nearest ring of pixels (radius 1 to `radius`) holding answered
+// pixels of its own object, averages their terms and shades them
 // with its own albedo and non-diffuse weight; where no ring has one, its object's nearby
 // texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
 // fragment would take them). What its fragment added comes on top, and the colour is written
@@ -17,11 +18,6 @@
 @group(0) @binding(0) var<storage, read> entries: array<vec4<u32>>;
 @group(0) @binding(1) var<uniform> fill: FillParams;
 @group(0) @binding(2) var<storage, read_write> holes: HoleList;
-// The fill's indirect dispatch (workgroups x, y, z), written by fill_args; bound apart, in
-// group 1 (whose material bindings fill_args does not use), as a buffer read as dispatch
-// arguments may not be bound to the dispatch itself.
-@group(1) @binding(30) var<storage, read_write> dispatch: array<u32, 3>;
-
 // Threads per workgroup of fill_holes.
 const GROUP: u32 = 64u;
 
@@ -30,13 +26,6 @@ fn listed() -> u32 {
     return min(atomicLoad(&holes.count), arrayLength(&holes.records));
 }
 
-// One workgroup of fill_holes per GROUP listed holes, as the indirect dispatch's arguments.
-@compute @workgroup_size(1, 1, 1)
-fn fill_args() {
-    dispatch[0] = (listed() + GROUP - 1u) / GROUP;
-    dispatch[1] = 1u;
-    dispatch[2] = 1u;
-}
 
 // The mean terms of the nearest ring around pixel `c` holding answered pixels of `tag`
 // (object + 1), already times the exposure; w = 0 where no ring within the radius has one.
