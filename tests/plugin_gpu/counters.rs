@@ -14,6 +14,22 @@ use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::counters::CostReport;
 use bevy_plenoptic::reconstruct::geometry::view::ViewBuffer;
 
+/// The room with its moving slider, three views of keys at 0, 1 and 2 s, objects with
+/// `materials`, written as `room.pack` in a new temporary folder.
+fn room_pack(materials: Materials) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("room.pack");
+    write_pack(
+        &room(true),
+        &PackSpec {
+            materials,
+            ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
+        },
+        &path,
+    );
+    (dir, path)
+}
+
 /// The first cost report `camera` reads back.
 fn first_report(app: &mut App, camera: Entity) -> CostReport {
     for _ in 0..200 {
@@ -76,13 +92,7 @@ fn counted(
 /// and the frame is the same.
 #[test]
 fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("room.pack");
-    write_pack(
-        &room(true),
-        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
-        &path,
-    );
+    let (dir, path) = room_pack(Materials::None);
     let cpu = cpu_frame(&path, eye());
     let (screen, fragment) = (
         counted(dir.path(), true, |_| {}),
@@ -132,13 +142,7 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
 /// frame still equals the CPU's.
 #[test]
 fn every_pixel_a_hole_fills_as_on_the_cpu() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("room.pack");
-    write_pack(
-        &room(true),
-        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
-        &path,
-    );
+    let (dir, path) = room_pack(Materials::None);
     let (frames, report, _) = counted(dir.path(), true, |s| s.depth_tolerance = -1.0);
     let m = |n: &str| report.mean_of(n).unwrap();
     // Every fragment a hole, each taking the nearby texels: a quarter in the kernel, the
@@ -170,16 +174,7 @@ fn every_pixel_a_hole_fills_as_on_the_cpu() {
 /// which moves between the keys, takes them apart. The frame still equals the CPU's.
 #[test]
 fn blended_pairs_load_still_objects_once_for_both_keys() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("room.pack");
-    write_pack(
-        &room(true),
-        &PackSpec {
-            materials: Materials::Factors,
-            ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
-        },
-        &path,
-    );
+    let (dir, path) = room_pack(Materials::Factors);
     let (frames, report, _) = counted(dir.path(), true, |_| {});
     let m = |n: &str| report.mean_of(n).unwrap();
     // One nearest-texel load per pair where it decides (two lookups), one per lookup where
@@ -193,13 +188,7 @@ fn blended_pairs_load_still_objects_once_for_both_keys() {
 /// CPU's but at silhouettes, where MSAA blends two objects.
 #[test]
 fn the_screen_fill_takes_msaa_cameras_too() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("room.pack");
-    write_pack(
-        &room(true),
-        &PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8),
-        &path,
-    );
+    let (dir, path) = room_pack(Materials::None);
     let (mut app, cameras, targets) =
         plugin_cameras_with(dir.path(), &[eye()], |s| s.cost_counters = true);
     app.world_mut().entity_mut(cameras[0]).insert(Msaa::Sample4);
