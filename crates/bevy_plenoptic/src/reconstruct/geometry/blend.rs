@@ -42,6 +42,7 @@ use bevy::shader::ShaderDefVal;
 use super::view::ViewBuffer;
 use crate::camera::{PlenopticCamera, ReconSettings};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
+use crate::settings::{Backend, ResolvedBackend};
 
 /// Key pairs a camera blends at most (two lookups each).
 pub const MAX_PAIRS: u32 = (MAX_LOOKUPS / 2) as u32;
@@ -116,6 +117,7 @@ fn blended_image(face: u32, layers: u32) -> Image {
 /// the pass reads up to date.
 pub(super) fn prepare_blended_keys(
     mut commands: Commands,
+    backend: Res<ResolvedBackend>,
     keys: Res<KeyTextures>,
     mut cameras: Query<(
         Entity,
@@ -136,7 +138,12 @@ pub(super) fn prepare_blended_keys(
                 images.add(blended_image(face, layers)),
             )
         };
-        let pairs = view.params().pair_count;
+        // The CPU backend draws no proxy material that would read them.
+        let pairs = if backend.0 == Backend::Gpu {
+            view.params().pair_count
+        } else {
+            0
+        };
         let key_images = tex.map(|t| (t.image.clone(), t.shading.clone()));
         match blended {
             None => {

@@ -24,6 +24,7 @@
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
 #import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, pack_pair}
 #endif
+#import plenoptic::fill_entry::ring_step
 #import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, heaviest_texel, object_point, shade}
 #import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
 
@@ -205,9 +206,7 @@ fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>
         var sum = mat2x3<f32>();
         var count = 0.0;
         for (var dy = -r; dy <= r; dy++) {
-            // Whole rows at the ring's top and bottom, the two ends elsewhere.
-            let step = select(2 * r, 1, abs(dy) == r);
-            for (var dx = -r; dx <= r; dx += step) {
+            for (var dx = -r; dx <= r; dx += ring_step(r, dy)) {
                 let c = centre + vec2<f32>(f32(dx), f32(dy));
                 if any(c < view.viewport.xy) || any(c >= view.viewport.xy + view.viewport.zw) {
                     continue;

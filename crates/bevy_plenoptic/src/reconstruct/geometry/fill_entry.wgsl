@@ -51,6 +51,12 @@ struct FillParams {
     exposure: f32,
 }
 
+// The step along row `dy` of the ring of radius `r` around a pixel (plenoptic_recon's ring
+// search): whole rows at the ring's top and bottom, the two ends elsewhere.
+fn ring_step(r: i32, dy: i32) -> i32 {
+    return select(2 * r, 1, abs(dy) == r);
+}
+
 // The largest half float.
 const HALF_MAX: f32 = 65504.0;
 

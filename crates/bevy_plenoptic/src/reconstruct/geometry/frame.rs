@@ -257,11 +257,14 @@ impl CameraFrame<'_> {
             params.base[n] = l.base.extend((l.slot * 6) as f32);
             params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
         }
-        pair_keys(
-            &mut params,
-            &f.lookups,
-            super::blend::pair_room(&cam.settings),
-        );
+        // Only lookups of lighting read the blended pairs: none for radiance or image mode.
+        if cam.settings.shading == plenoptic_recon::Shading::Materials && !self.image_mode {
+            pair_keys(
+                &mut params,
+                &f.lookups,
+                super::blend::pair_room(&cam.settings),
+            );
+        }
         let taus: Vec<f32> = f.lookups.iter().map(|l| l.tau).collect();
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {

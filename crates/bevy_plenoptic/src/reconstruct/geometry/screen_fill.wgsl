@@ -2,8 +2,8 @@
 // pass per view between Bevy's opaque and transparent passes, one thread per record of the
 // room of the camera's hole list (fill_entry.wgsl); the threads past the holes listed return
 // at once. A hole takes the nearest ring of pixels (radius 1 to `radius`) holding answered
-// pixels of its own object, averages their terms and shades them
-// with its own albedo and non-diffuse weight; where no ring has one, its object's nearby
+// pixels of its own object, averages their terms and shades them with its own albedo and
+// non-diffuse weight; where no ring has one, its object's nearby
 // texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
 // fragment would take them). What its fragment added comes on top, and the colour is written
 // over the hole's record, which the composite pass (fill_composite.wgsl) draws into the
@@ -11,7 +11,9 @@
 //
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
-#import plenoptic::fill_entry::{HoleList, FillParams, HOLE_NON_DIFFUSE, OBJECT_BITS, unpack_pair, pack_pair}
+#import plenoptic::fill_entry::{
+    HoleList, FillParams, HOLE_NON_DIFFUSE, OBJECT_BITS, unpack_pair, pack_pair, ring_step,
+}
 #import plenoptic::geometry::lookup::{Weighted, nearby_texels, heaviest_texel}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
 
@@ -26,7 +28,6 @@ fn listed() -> u32 {
     return min(atomicLoad(&holes.count), arrayLength(&holes.records));
 }
 
-
 // The mean terms of the nearest ring around pixel `c` holding answered pixels of `tag`
 // (object + 1), already times the exposure; w = 0 where no ring within the radius has one.
 fn ring_mean(c: vec2<i32>, tag: u32) -> Weighted {
@@ -35,9 +36,7 @@ fn ring_mean(c: vec2<i32>, tag: u32) -> Weighted {
         var sum = mat2x3<f32>();
         var n = 0.0;
         for (var dy = -r; dy <= r; dy++) {
-            // Whole rows at the ring's top and bottom, the two ends elsewhere.
-            let step = select(2 * r, 1, abs(dy) == r);
-            for (var dx = -r; dx <= r; dx += step) {
+            for (var dx = -r; dx <= r; dx += ring_step(r, dy)) {
                 let q = c + vec2<i32>(dx, dy);
                 if any(q < vec2<i32>(0)) || any(q >= size) {
                     continue;
