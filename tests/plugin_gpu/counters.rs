@@ -183,24 +183,46 @@ fn blended_pairs_load_still_objects_once_for_both_keys() {
     assert_each_matches(&frames, &[cpu_frame(&path, eye())], 0.003, 0.995);
 }
 
-/// With Bevy's 4× MSAA the screen fill fills the holes as without it (its composite writes
-/// every sample of a hole's pixel): no fragment reconstructs a neighbour, and the frame is the
+/// The settled frame of `eye()` over the room pack in `dir` with Bevy's 4× MSAA on the
+/// camera, counters on and the screen-space fill on or off, and its first cost report.
+fn msaa_frame(dir: &std::path::Path, screen_fill: bool) -> (Vec<Vec3>, CostReport) {
+    let (mut app, cameras, targets) = plugin_cameras_with(dir, &[eye()], |s| {
+        s.cost_counters = true;
+        s.screen_fill = screen_fill;
+    });
+    app.world_mut().entity_mut(cameras[0]).insert(Msaa::Sample4);
+    let mut frames = settled_frames(&mut app, &targets);
+    let report = first_report(&mut app, cameras[0]);
+    (frames.swap_remove(0), report)
+}
+
+/// With Bevy's 4× MSAA the screen fill fills the holes as the fragment fill does: its
+/// composite draws each hole's samples (the fragment's coverage) at the hole surface's depth,
+/// so a sample of the pixel that an occluder covers keeps the occluder, and no fragment
+/// reconstructs a neighbour. The frame equals the fragment fill's at the same MSAA, and the
 /// CPU's but at silhouettes, where MSAA blends two objects.
 #[test]
 fn the_screen_fill_takes_msaa_cameras_too() {
     let (dir, path) = room_pack(Materials::None);
-    let (mut app, cameras, targets) =
-        plugin_cameras_with(dir.path(), &[eye()], |s| s.cost_counters = true);
-    app.world_mut().entity_mut(cameras[0]).insert(Msaa::Sample4);
-    let frames = settled_frames(&mut app, &targets);
-    let report = first_report(&mut app, cameras[0]);
+    let (screen, report) = msaa_frame(dir.path(), true);
     let m = |n: &str| report.mean_of(n).unwrap();
     assert!(m("fill") > 0.1 && m("fill_lookups") == 0.0, "{report:?}");
     assert!(report.kernel_loads > 0.0, "{report:?}");
-    let cpu = cpu_frame(&path, eye());
-    let (mean, f5, f20) = compare(&frames[0], &cpu);
-    eprintln!("4× MSAA: GPU against CPU mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}");
-    // Measured on lavapipe: mean 0.0148, 97.4 % within 5 %, 97.9 % within 20 % (the
-    // silhouettes' blended pixels); without MSAA the frame matches within 0.1 %.
-    assert!(mean < 0.03 && f5 > 0.93 && f20 > 0.95, "{mean} {f5} {f20}");
+    let (fragment, _) = msaa_frame(dir.path(), false);
+    let (mean, f5, f20) = compare(&screen, &fragment);
+    eprintln!(
+        "4× MSAA: screen fill against fragment fill mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
+    // Measured on lavapipe: mean 0.0055, 99.15 % within 5 %, 99.64 % within 20 %. The pixels
+    // apart lie along a silhouette over a hole: a pixel there keeps one entry for its two
+    // objects, so the kernel's search misses a neighbour the fragment fill reconstructs.
+    assert!(mean < 0.012 && f5 > 0.98 && f20 > 0.99, "{mean} {f5} {f20}");
+    let (mean, f5, f20) = compare(&screen, &cpu_frame(&path, eye()));
+    eprintln!(
+        "4× MSAA: screen fill against CPU mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
+    // Measured on lavapipe: mean 0.0201, 96.7 % within 5 %, 97.6 % within 20 % (the fragment
+    // fill: 0.0230, 95.8 %, 97.2 %). The mean is left out: MSAA's blends of a bright and a dark
+    // object at silhouettes dominate it, and it varies between lavapipe's builds.
+    assert!(f5 > 0.93 && f20 > 0.95, "{mean} {f5} {f20}");
 }

@@ -22,7 +22,7 @@
 }
 #ifdef PLENOPTIC_SCREEN_FILL
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
-#import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, pack_pair}
+#import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair}
 #endif
 #import plenoptic::fill_entry::ring_step
 #import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, heaviest_texel, object_point, shade}
@@ -38,6 +38,21 @@ var<private> entry_terms: mat2x3<f32>;
 // With ENTRY_HOLE: its record's index in the hole list and its point.
 var<private> hole_index: u32;
 var<private> hole_point: vec3<f32>;
+// The fragment's sample mask and the nearest depth its surface reaches in its pixel
+// (note_fragment), for its hole's record.
+var<private> fragment_coverage: u32 = 1u;
+var<private> fragment_near_depth: f32 = 0.0;
+
+// Notes the fragment's sample mask and the nearest depth of its surface in its pixel: its
+// centre's depth plus half the depth's change across the pixel, and a margin of 1e-4 of it
+// (Bevy's depth is reversed, nearer is larger). Called by the fragment entry points before
+// any non-uniform branch (it takes a derivative).
+fn note_fragment(position: vec4<f32>, coverage: u32) {
+#ifdef PLENOPTIC_SCREEN_FILL
+    fragment_coverage = coverage;
+    fragment_near_depth = (position.z + 0.5 * fwidth(position.z)) * (1.0 + 1e-4);
+#endif
+}
 
 // Whether this fragment's hole is left to the screen-space fill kernel: the camera has it
 // (PLENOPTIC_SCREEN_FILL, compiled with the depth test forced before the fragment shader, so
@@ -88,19 +103,22 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
         return;
     }
     var albedo = vec3<f32>(1.0);
-    var tag = object | HOLE;
+    var tag = object;
     if lit() {
         albedo = pixel_albedo;
+        tag |= HOLE_MATERIAL;
         if non_diffuse_weight != 0.0 {
             tag |= HOLE_NON_DIFFUSE;
         }
     }
-    fill_entries[i] = vec4<u32>(hole_index, 0u, 0u, tag);
+    fill_entries[i] = vec4<u32>(0u, 0u, 0u, object | HOLE);
     let r = &hole_list.records[hole_index];
     (*r).pair = pack_pair(added * e, albedo);
     (*r).pixel = i;
     (*r).local = vec4<f32>(object_point(hole_point).xyz, params.object.y);
-    (*r).world = vec4<f32>(hole_point, select(0.0, 1.0, lit()));
+    (*r).world = vec4<f32>(hole_point, fragment_near_depth);
+    (*r).tag = tag;
+    (*r).coverage = fragment_coverage;
 #endif
 }
 

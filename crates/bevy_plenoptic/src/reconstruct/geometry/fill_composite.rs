@@ -1,11 +1,13 @@
-//! The screen-space fill's composite ([`super::screen_fill`]): after the fill kernel, a
-//! full-screen pass over the view's target writes each listed hole's filled colour into its
-//! pixel, every sample of it where the camera has MSAA, and discards every other pixel
-//! (`fill_composite.wgsl`). A render pass rather than a storage write, so that it works on a
-//! multisampled target as on a single-sampled one.
+//! The screen-space fill's composite ([`super::screen_fill`]): after the fill kernel, one point
+//! per record of the room of the view's hole list, drawn into its target with its depth
+//! buffer (`fill_composite.wgsl`). A listed hole's point writes its filled colour to the
+//! samples of its pixel that its fragment covered and that are no nearer than its surface; the
+//! other points fall outside the view. A render pass rather than a storage write, so that it
+//! works on a multisampled target as on a single-sampled one, and so that where MSAA puts two
+//! objects in one pixel each keeps its own samples.
 
 use bevy::asset::load_embedded_asset;
-use bevy::core_pipeline::FullscreenShader;
+use bevy::core_pipeline::core_3d::CORE_3D_DEPTH_FORMAT;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
@@ -16,13 +18,13 @@ use bevy::render::render_resource::binding_types::{
 };
 use bevy::render::render_resource::{
     BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedRenderPipelineId,
-    ColorTargetState, ColorWrites, FragmentState, MultisampleState, PipelineCache,
-    RenderPassDescriptor, RenderPipelineDescriptor, ShaderStages, TextureFormat, UniformBuffer,
-    VertexState,
+    ColorTargetState, ColorWrites, CompareFunction, DepthStencilState, FragmentState,
+    MultisampleState, PipelineCache, PrimitiveState, PrimitiveTopology, RenderPassDescriptor,
+    RenderPipelineDescriptor, ShaderStages, StoreOp, TextureFormat, UniformBuffer, VertexState,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::storage::GpuShaderBuffer;
-use bevy::render::view::ViewTarget;
+use bevy::render::view::{ViewDepthTexture, ViewTarget};
 use bevy::shader::{Shader, ShaderDefVal};
 
 use super::screen_fill::{FillParams, ScreenFill};
@@ -32,7 +34,6 @@ use super::screen_fill::{FillParams, ScreenFill};
 #[derive(Resource)]
 pub(super) struct CompositePipelines {
     layouts: [BindGroupLayoutDescriptor; 2],
-    vertex: VertexState,
     shader: Handle<Shader>,
     ids: HashMap<(u32, bool), CachedRenderPipelineId>,
 }
@@ -53,7 +54,25 @@ impl CompositePipelines {
             cache.queue_render_pipeline(RenderPipelineDescriptor {
                 label: Some("plenoptic screen fill composite".into()),
                 layout: self.layouts.to_vec(),
-                vertex: self.vertex.clone(),
+                vertex: VertexState {
+                    shader: self.shader.clone(),
+                    shader_defs: shader_defs.clone(),
+                    entry_point: Some("hole_point".into()),
+                    buffers: Vec::new(),
+                },
+                primitive: PrimitiveState {
+                    topology: PrimitiveTopology::PointList,
+                    ..default()
+                },
+                // Bevy's reversed depth: a sample is written where the hole's surface is at
+                // least as near as what the opaque pass left there.
+                depth_stencil: Some(DepthStencilState {
+                    format: CORE_3D_DEPTH_FORMAT,
+                    depth_write_enabled: Some(false),
+                    depth_compare: Some(CompareFunction::GreaterEqual),
+                    stencil: default(),
+                    bias: default(),
+                }),
                 fragment: Some(FragmentState {
                     shader: self.shader.clone(),
                     shader_defs,
@@ -75,17 +94,12 @@ impl CompositePipelines {
 }
 
 /// Makes the composite's layouts; its pipelines are queued per view.
-pub(super) fn init_composite(
-    mut commands: Commands,
-    asset_server: Res<AssetServer>,
-    fullscreen: Res<FullscreenShader>,
-) {
+pub(super) fn init_composite(mut commands: Commands, asset_server: Res<AssetServer>) {
     let own = BindGroupLayoutDescriptor::new(
         "plenoptic screen fill composite",
         &BindGroupLayoutEntries::sequential(
-            ShaderStages::FRAGMENT,
+            ShaderStages::VERTEX_FRAGMENT,
             (
-                storage_buffer_read_only_sized(false, None),
                 uniform_buffer::<FillParams>(false),
                 storage_buffer_read_only_sized(false, None),
             ),
@@ -100,7 +114,6 @@ pub(super) fn init_composite(
     );
     commands.insert_resource(CompositePipelines {
         layouts: [own, counters],
-        vertex: fullscreen.to_vertex_state(),
         shader: load_embedded_asset!(asset_server.as_ref(), "fill_composite.wgsl"),
         ids: HashMap::default(),
     });
@@ -108,7 +121,13 @@ pub(super) fn init_composite(
 
 /// Draws a view's filled holes into its HDR target after the fill kernel.
 pub(super) fn composite_fill(
-    view: ViewQuery<(&ScreenFill, &ViewTarget, &ExtractedCamera, Option<&Msaa>)>,
+    view: ViewQuery<(
+        &ScreenFill,
+        &ViewTarget,
+        &ViewDepthTexture,
+        &ExtractedCamera,
+        Option<&Msaa>,
+    )>,
     pipelines: Option<ResMut<CompositePipelines>>,
     pipeline_cache: Res<PipelineCache>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
@@ -116,7 +135,7 @@ pub(super) fn composite_fill(
     queue: Res<RenderQueue>,
     mut ctx: RenderContext,
 ) {
-    let (fill, target, camera, msaa) = view.into_inner();
+    let (fill, target, depth, camera, msaa) = view.into_inner();
     let Some(mut pipelines) = pipelines else {
         return;
     };
@@ -125,9 +144,8 @@ pub(super) fn composite_fill(
     }
     let samples = msaa.map_or(1, Msaa::samples);
     let id = pipelines.id(&pipeline_cache, samples, fill.counting);
-    let (Some(pipeline), Some(entries), Some(holes), Some(counters)) = (
+    let (Some(pipeline), Some(holes), Some(counters)) = (
         pipeline_cache.get_render_pipeline(id),
-        buffers.get(&fill.entries),
         buffers.get(&fill.holes),
         buffers.get(&fill.counters),
     ) else {
@@ -141,11 +159,7 @@ pub(super) fn composite_fill(
     let own = device.create_bind_group(
         "plenoptic screen fill composite",
         &pipeline_cache.get_bind_group_layout(&pipelines.layouts[0]),
-        &BindGroupEntries::sequential((
-            entries.buffer.as_entire_binding(),
-            params,
-            holes.buffer.as_entire_binding(),
-        )),
+        &BindGroupEntries::sequential((params, holes.buffer.as_entire_binding())),
     );
     let counting = device.create_bind_group(
         "plenoptic screen fill composite counters",
@@ -157,7 +171,7 @@ pub(super) fn composite_fill(
     let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
         label: Some("plenoptic screen fill composite"),
         color_attachments: &[Some(target.get_color_attachment())],
-        depth_stencil_attachment: None,
+        depth_stencil_attachment: Some(depth.get_attachment(StoreOp::Store)),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,
@@ -169,6 +183,6 @@ pub(super) fn composite_fill(
     pass.set_render_pipeline(pipeline);
     pass.set_bind_group(0, &own, &[]);
     pass.set_bind_group(1, &counting, &[]);
-    pass.draw(0..3, 0..1);
+    pass.draw(0..fill.room(), 0..1);
     span.end(&mut pass);
 }

@@ -1,30 +1,43 @@
-// The screen-space fill's composite (screen_fill.rs): a full-screen pass over the view's
-// target, after the fill kernel, that writes each listed hole's filled colour (its record,
-// screen_fill.wgsl) into the hole's pixel, every sample of it, and leaves every other pixel
-// as the opaque pass drew it. It reads one entry per pixel of the viewport.
-#import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
-#import plenoptic::fill_entry::{HoleRecords, FillParams, HOLE, unpack_pair}
+// The screen-space fill's composite (screen_fill.rs): after the fill kernel, one point per
+// record of the room of the camera's hole list, drawn into the view's target with its depth
+// buffer. A listed hole's point covers its pixel and writes its filled colour to the samples
+// its fragment covered (the record's sample mask) that are no nearer than its surface (the
+// record's depth, tested against the depth buffer): where MSAA puts two objects in a pixel,
+// each keeps its own samples. Points past the holes listed fall outside the view and are not
+// drawn.
+#import plenoptic::fill_entry::{HoleRecords, FillParams, unpack_pair}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
 
-@group(0) @binding(0) var<storage, read> entries: array<vec4<u32>>;
-@group(0) @binding(1) var<uniform> fill: FillParams;
-@group(0) @binding(2) var<storage, read> holes: HoleRecords;
+@group(0) @binding(0) var<uniform> fill: FillParams;
+@group(0) @binding(1) var<storage, read> holes: HoleRecords;
+
+struct HolePoint {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) record: u32,
+}
+
+// The point of record `i`: its pixel's centre in the viewport's clip space.
+@vertex
+fn hole_point(@builtin(vertex_index) i: u32) -> HolePoint {
+    if i >= min(holes.count, arrayLength(&holes.records)) {
+        return HolePoint(vec4<f32>(2.0, 2.0, 2.0, 1.0), i);
+    }
+    let pixel = holes.records[i].pixel;
+    let p = vec2<f32>(vec2<u32>(pixel % fill.size.x, pixel / fill.size.x)) + 0.5;
+    let uv = p / vec2<f32>(fill.size);
+    return HolePoint(vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.5, 1.0), i);
+}
+
+struct Filled {
+    @location(0) colour: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+    @builtin(sample_mask) coverage: u32,
+}
 
 @fragment
-fn composite(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
-    let p = vec2<u32>(in.position.xy) - fill.offset;
-    if any(p >= fill.size) {
-        discard;
-    }
-    tally(C_LOADS_16, 1u);
-    let e = entries[p.y * fill.size.x + p.x];
-    let listed = (e.w & HOLE) != 0u && e.x < min(holes.count, arrayLength(&holes.records));
-    if listed {
-        tally(C_LOADS_16, 1u);
-    }
+fn composite(in: HolePoint) -> Filled {
+    tally(C_LOADS_16, 3u);
+    let r = holes.records[in.record];
     flush_kernel_counters(in.position.xy);
-    if !listed {
-        discard;
-    }
-    return vec4<f32>(unpack_pair(holes.records[e.x].pair)[0], 1.0);
+    return Filled(vec4<f32>(unpack_pair(r.pair)[0], 1.0), r.world.w, r.coverage);
 }

@@ -3,9 +3,11 @@
 // kernel (screen_fill.wgsl). Per pixel an entry of 16 bytes:
 // - a pixel its lookups answered: its terms (lighting and non-diffuse, or radiance and 0;
 //   lookup.wgsl's Weighted) times the camera's exposure (xyz), its object + 1 (w);
-// - a hole: its object + 1 with HOLE (w), the index of its record (x);
+// - a hole: its object + 1 with HOLE (w);
 // - nothing drawn there: 0.
-// Per hole a record in the camera's hole list (HoleRecord), appended by its fragment.
+// Per hole fragment a record in the camera's hole list (HoleRecord), appended by the fragment.
+// With MSAA two fragments may share a pixel and its entry (the last write stays); a record is
+// the fragment's own, so the kernel and the composite read only records.
 // Colours are kept as half floats (the HDR target's own precision), two per word.
 #define_import_path plenoptic::fill_entry
 
@@ -23,9 +25,17 @@ struct HoleRecord {
     pixel: u32,
     // Its point in its object's frame (lookup.wgsl's object_point) and its motion slot (w).
     local: vec4<f32>,
-    // Its world point, and 1 when its object is shaded from its material (w).
+    // Its world point, and the nearest depth its surface reaches in the pixel (w; Bevy's
+    // reversed depth): the composite writes only samples no nearer than that.
     world: vec4<f32>,
+    // Its object + 1, with HOLE_NON_DIFFUSE and HOLE_MATERIAL.
+    tag: u32,
+    // The samples its fragment covers (its sample mask; 1 without MSAA).
+    coverage: u32,
 }
+
+// A record's tag bit: its object is shaded from its material.
+const HOLE_MATERIAL: u32 = 0x80000000u;
 
 // A camera's hole list: records appended, the first `count` of them written (count may pass
 // the list's length: those holes were filled by their fragments). The fill kernel writes each

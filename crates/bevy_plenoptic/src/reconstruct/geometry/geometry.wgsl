@@ -29,7 +29,7 @@
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
 }
-#import plenoptic::geometry::fill::{radiance, write_fill_entry}
+#import plenoptic::geometry::fill::{radiance, write_fill_entry, note_fragment}
 #import plenoptic::geometry::sun::sun_light
 #import plenoptic::geometry::specular::{marched, see_through, reflection}
 #import plenoptic::counters::flush_counters
@@ -46,8 +46,13 @@
 @early_depth_test(force)
 #endif
 @fragment
-fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+fn fragment(
+    vertex: VertexOutput,
+    @builtin(front_facing) is_front: bool,
+    @builtin(sample_mask) coverage: u32,
+) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(vertex.instance_index);
+    note_fragment(vertex.position, coverage);
     let ng = cross(dpdx(vertex.world_position.xyz), dpdy(vertex.world_position.xyz));
     var pbr = pbr_input_from_standard_material(vertex, is_front);
     pbr.material.base_color = alpha_discard(pbr.material, pbr.material.base_color);
@@ -68,8 +73,9 @@ fn fragment(vertex: VertexOutput, @builtin(front_facing) is_front: bool) -> @loc
 @early_depth_test(force)
 #endif
 @fragment
-fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+fn fragment(in: VertexOutput, @builtin(sample_mask) coverage: u32) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(in.instance_index);
+    note_fragment(in.position, coverage);
     // The triangle's plane, before any non-uniform branch.
     let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));
     // The material's albedo at the pixel (derivatives are taken before any non-uniform

@@ -12,8 +12,9 @@
 //! pixels holding its own object, shading their mean terms with the hole's albedo as the CPU
 //! does, else takes the later fallbacks (the object's nearby texels, the heaviest key's
 //! texel) from the keys itself, and writes the filled colour over the hole's record; a
-//! full-screen pass ([`super::fill_composite`]) then writes the listed holes' pixels of the
-//! view's target, every sample of them where the camera has MSAA. A ring pixel costs one
+//! point per record ([`super::fill_composite`]) then writes it into the view's target, to the
+//! samples its fragment covered that are no nearer than its surface (with MSAA two
+//! fragments may share a pixel; a record is its fragment's own). A ring pixel costs one
 //! 16-byte load. Entries and list are cleared before the opaque pass; the fill runs before
 //! the transparent pass, so glazing blends over filled pixels. Glazing and glass (drawn in the
 //! transparent pass) keep the fragment fill, as does a hole beyond the list's room
@@ -63,7 +64,7 @@ const GROUP: u32 = 64;
 /// Bytes of one pixel's entry (`fill_entry.wgsl`).
 const ENTRY_BYTES: u64 = 16;
 /// Bytes of a hole record (`HoleRecord`) and of the list's header (its count, aligned).
-const RECORD_BYTES: u64 = 48;
+const RECORD_BYTES: u64 = 64;
 const LIST_HEADER_BYTES: u64 = 16;
 /// The share of a viewport's pixels the hole list has room for (a quarter; the tour's views
 /// have 11 %, the room's densest 33 % at 8-texel faces, which then fill the rest in the
@@ -113,6 +114,16 @@ impl ScreenFill {
     /// Whether the camera's opaque holes are filled by the kernel.
     pub fn on(&self) -> bool {
         self.size != UVec2::ZERO
+    }
+
+    /// The hole list's room: how many records it holds.
+    pub(super) fn room(&self) -> u32 {
+        (self.pixels() / HOLE_SHARE).max(1) as u32
+    }
+
+    /// The viewport's pixels.
+    fn pixels(&self) -> u64 {
+        u64::from(self.size.x) * u64::from(self.size.y)
     }
 }
 
@@ -421,7 +432,6 @@ fn fill_holes(
         return;
     };
     // One thread per record of the list's room; those past the holes listed return at once.
-    let records = (u64::from(fill.size.x) * u64::from(fill.size.y) / HOLE_SHARE).max(1);
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -434,7 +444,7 @@ fn fill_holes(
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &groups[0], &[]);
     pass.set_bind_group(1, &groups[1], &[]);
-    pass.dispatch_workgroups((records as u32).div_ceil(GROUP), 1, 1);
+    pass.dispatch_workgroups(fill.room().div_ceil(GROUP), 1, 1);
     span.end(&mut pass);
 }
 

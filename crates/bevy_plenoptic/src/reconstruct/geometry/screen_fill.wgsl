@@ -12,7 +12,8 @@
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
 #import plenoptic::fill_entry::{
-    HoleList, FillParams, HOLE_NON_DIFFUSE, OBJECT_BITS, unpack_pair, pack_pair, ring_step,
+    HoleList, FillParams, HOLE_NON_DIFFUSE, HOLE_MATERIAL, OBJECT_BITS, unpack_pair, pack_pair,
+    ring_step,
 }
 #import plenoptic::geometry::lookup::{Weighted, nearby_texels, heaviest_texel}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
@@ -65,12 +66,11 @@ fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
     tally(C_LOADS_16, 4u);
     let record = holes.records[i];
     let p = vec2<u32>(record.pixel % fill.size.x, record.pixel / fill.size.x);
-    let tag = entries[record.pixel].w;
-    let object = tag & OBJECT_BITS;
-    let material = record.world.w != 0.0;
+    let object = record.tag & OBJECT_BITS;
+    let material = (record.tag & HOLE_MATERIAL) != 0u;
     // What the fragment added (column 0) and the albedo it shades with (column 1).
     let own = unpack_pair(record.pair);
-    let nd = select(0.0, 1.0, (tag & HOLE_NON_DIFFUSE) != 0u);
+    let nd = select(0.0, 1.0, (record.tag & HOLE_NON_DIFFUSE) != 0u);
     let ring = ring_mean(vec2<i32>(p), object);
     var terms = ring.terms;
     if ring.w == 0.0 {
