@@ -9,6 +9,8 @@ use crate::many_cameras::{
     Eye, assert_each_matches, cpu_frame, plugin_cameras_with, settled_frames,
 };
 use crate::pack::{Materials, PackSpec, room, write_pack};
+use bevy::camera::Hdr;
+use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::counters::CostReport;
@@ -184,13 +186,22 @@ fn blended_pairs_load_still_objects_once_for_both_keys() {
 }
 
 /// The settled frame of `eye()` over the room pack in `dir` with Bevy's 4× MSAA on the
-/// camera, counters on and the screen-space fill on or off, and its first cost report.
-fn msaa_frame(dir: &std::path::Path, screen_fill: bool) -> (Vec<Vec3>, CostReport) {
+/// camera, counters on and the screen-space fill on or off, and its first cost report; with
+/// `tonemapping`, on an 8-bit target tonemapped so (the camera's `Hdr` taken off).
+fn msaa_frame(
+    dir: &std::path::Path,
+    screen_fill: bool,
+    tonemapping: Option<Tonemapping>,
+) -> (Vec<Vec3>, CostReport) {
     let (mut app, cameras, targets) = plugin_cameras_with(dir, &[eye()], |s| {
         s.cost_counters = true;
         s.screen_fill = screen_fill;
     });
-    app.world_mut().entity_mut(cameras[0]).insert(Msaa::Sample4);
+    let mut camera = app.world_mut().entity_mut(cameras[0]);
+    camera.insert(Msaa::Sample4);
+    if let Some(t) = tonemapping {
+        camera.remove::<Hdr>().insert(t);
+    }
     let mut frames = settled_frames(&mut app, &targets);
     let report = first_report(&mut app, cameras[0]);
     (frames.swap_remove(0), report)
@@ -204,11 +215,11 @@ fn msaa_frame(dir: &std::path::Path, screen_fill: bool) -> (Vec<Vec3>, CostRepor
 #[test]
 fn the_screen_fill_takes_msaa_cameras_too() {
     let (dir, path) = room_pack(Materials::None);
-    let (screen, report) = msaa_frame(dir.path(), true);
+    let (screen, report) = msaa_frame(dir.path(), true, None);
     let m = |n: &str| report.mean_of(n).unwrap();
     assert!(m("fill") > 0.1 && m("fill_lookups") == 0.0, "{report:?}");
     assert!(report.kernel_loads > 0.0, "{report:?}");
-    let (fragment, _) = msaa_frame(dir.path(), false);
+    let (fragment, _) = msaa_frame(dir.path(), false, None);
     let (mean, f5, f20) = compare(&screen, &fragment);
     eprintln!(
         "4× MSAA: screen fill against fragment fill mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
@@ -225,4 +236,23 @@ fn the_screen_fill_takes_msaa_cameras_too() {
     // fill: 0.0230, 95.8 %, 97.2 %). The mean is left out: MSAA's blends of a bright and a dark
     // object at silhouettes dominate it, and it varies between lavapipe's builds.
     assert!(f5 > 0.93 && f20 > 0.95, "{mean} {f5} {f20}");
+}
+
+/// On a camera without an HDR target (Bevy's default, here with 4× MSAA and Reinhard
+/// tonemapping) the screen fill's composite tonemaps the filled holes as the proxies'
+/// fragments tonemap theirs: the frame equals the fragment fill's on the same camera.
+#[test]
+fn the_screen_fill_tonemaps_on_an_8_bit_target() {
+    let (dir, _) = room_pack(Materials::None);
+    let ldr = Some(Tonemapping::Reinhard);
+    let (screen, report) = msaa_frame(dir.path(), true, ldr);
+    let m = |n: &str| report.mean_of(n).unwrap();
+    assert!(m("fill") > 0.1 && m("fill_lookups") == 0.0, "{report:?}");
+    let (fragment, report) = msaa_frame(dir.path(), false, ldr);
+    assert!(report.mean_of("fill_lookups").unwrap() > 0.0, "{report:?}");
+    let (mean, f5, f20) = compare(&screen, &fragment);
+    eprintln!(
+        "8-bit, Reinhard, 4× MSAA: screen fill against fragment fill mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
+    assert!(mean < 0.012 && f5 > 0.98 && f20 > 0.99, "{mean} {f5} {f20}");
 }

@@ -32,7 +32,7 @@ pub struct PlenopticSettings {
     pub cost_counters: bool,
     /// Fill the holes of the geometry-assisted reconstruction with a compute pass over the
     /// opaque pass's output ([`crate::reconstruct::geometry::screen_fill`]) on every camera
-    /// that can take it (an `Hdr` camera, on Vulkan or GL), instead of in the fragment shader,
+    /// that can take it (on Vulkan or GL, HDR or not), instead of in the fragment shader,
     /// which reconstructs each ring pixel again. The same frame, for a fraction of the loads;
     /// off only to compare the two.
     pub screen_fill: bool,

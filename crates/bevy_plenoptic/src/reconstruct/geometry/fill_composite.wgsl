@@ -4,12 +4,22 @@
 // its fragment covered (the record's sample mask) that are no nearer than its surface (the
 // record's depth, tested against the depth buffer): where MSAA puts two objects in a pixel,
 // each keeps its own samples. Points past the holes listed fall outside the view and are not
-// drawn.
+// drawn. On a camera without an HDR target (TONEMAP_IN_SHADER) the colour is tonemapped with
+// the view's tonemapping and colour grading, as geometry.wgsl's fragments are.
 #import plenoptic::fill_entry::{HoleRecords, FillParams, unpack_pair}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
+#ifdef TONEMAP_IN_SHADER
+#import bevy_render::view::View
+#import bevy_core_pipeline::tonemapping::tone_mapping
+#endif
 
 @group(0) @binding(0) var<uniform> fill: FillParams;
 @group(0) @binding(1) var<storage, read> holes: HoleRecords;
+// Bindings 2 and 3: the tonemapping LUT (bevy_core_pipeline's lut_bindings.wgsl, at the
+// indices the pipeline gives TONEMAPPING_LUT_TEXTURE/SAMPLER_BINDING_INDEX).
+#ifdef TONEMAP_IN_SHADER
+@group(0) @binding(4) var<uniform> view: View;
+#endif
 
 struct HolePoint {
     @builtin(position) position: vec4<f32>,
@@ -39,5 +49,9 @@ fn composite(in: HolePoint) -> Filled {
     tally(C_LOADS_16, 3u);
     let r = holes.records[in.record];
     flush_kernel_counters(in.position.xy);
-    return Filled(vec4<f32>(unpack_pair(r.pair)[0], 1.0), r.world.w, r.coverage);
+    var colour = vec4<f32>(unpack_pair(r.pair)[0], 1.0);
+#ifdef TONEMAP_IN_SHADER
+    colour = tone_mapping(colour, view.color_grading);
+#endif
+    return Filled(colour, r.world.w, r.coverage);
 }

@@ -15,8 +15,8 @@
 //!    from each base view, within `t ± tε`;
 //! 2. the same-object hole fill: the nearest ring of pixels (radius up to
 //!    [`ReconSettings::hole_fill_radius`]) whose points have a direct or volume lookup of this
-//!    object, their mean. On a camera with the screen-space fill ([`screen_fill`]: `Hdr`, a
-//!    device that forces early depth tests) a compute pass after the opaque
+//!    object, their mean. On a camera with the screen-space fill ([`screen_fill`]: a device
+//!    that forces early depth tests) a compute pass after the opaque
 //!    pass reads the ring from what the fragments wrote. Elsewhere a fragment cannot read its
 //!    neighbours' results, so it recomputes them at the points the neighbouring pixels show,
 //!    read from the depth prepass ([`PlenopticCamera`] requires one); a lookup accepted there

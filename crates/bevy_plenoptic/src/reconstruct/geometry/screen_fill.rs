@@ -20,16 +20,16 @@
 //! transparent pass) keep the fragment fill, as does a hole beyond the list's room
 //! ([`HOLE_SHARE`] of the viewport's pixels).
 //!
-//! The fill needs an HDR camera (`Hdr`: the composite writes linear radiance, which an 8-bit
-//! target would need tonemapped) with its [`DepthPrepass`], on a device that forces early
-//! depth tests ([`EarlyDepthSupport`]): a fragment writes its entry only where the prepass
-//! kept it. Other cameras use the fragment fill; both give the CPU's result.
+//! The fill needs the camera's [`DepthPrepass`] (every [`PlenopticCamera`] requires one), on a
+//! device that forces early depth tests ([`EarlyDepthSupport`]): a fragment writes its entry
+//! only where the prepass kept it. It takes HDR and 8-bit targets alike (the composite
+//! tonemaps for the latter) and any MSAA. Other cameras use the fragment fill; both give the
+//! CPU's result.
 //! [`ScreenFill::size`] is zero on them.
 
 use std::borrow::Cow;
 
 use bevy::asset::{RenderAssetUsages, load_embedded_asset};
-use bevy::camera::Hdr;
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
@@ -180,10 +180,9 @@ pub(super) fn build(app: &mut App) {
         );
 }
 
-/// Whether a camera can take the screen fill: the GPU backend, an HDR target, a depth
-/// prepass.
-fn fill_possible(backend: Backend, hdr: bool, prepass: bool) -> bool {
-    backend == Backend::Gpu && hdr && prepass
+/// Whether a camera can take the screen fill: the GPU backend and a depth prepass.
+fn fill_possible(backend: Backend, prepass: bool) -> bool {
+    backend == Backend::Gpu && prepass
 }
 
 /// Gives every plenoptic camera its [`ScreenFill`], sized to its viewport where the app wants
@@ -200,17 +199,17 @@ pub(super) fn prepare_screen_fill(
         &Camera,
         &PlenopticCamera,
         (&CounterBuffer, &ViewBuffer),
-        (Has<Hdr>, Has<DepthPrepass>),
+        Has<DepthPrepass>,
         Option<&mut ScreenFill>,
     )>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (entity, camera, cam, (counters, view), (hdr, prepass), fill) in &mut cameras {
+    for (entity, camera, cam, (counters, view), prepass, fill) in &mut cameras {
         let size = match camera.physical_viewport_size() {
             Some(s)
                 if settings.screen_fill
                     && early_depth.as_ref().is_some_and(|e| e.0)
-                    && fill_possible(backend.0, hdr, prepass) =>
+                    && fill_possible(backend.0, prepass) =>
             {
                 s
             }
@@ -453,10 +452,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_fill_needs_the_gpu_an_hdr_target_and_a_prepass() {
-        assert!(fill_possible(Backend::Gpu, true, true));
-        assert!(!fill_possible(Backend::Cpu, true, true));
-        assert!(!fill_possible(Backend::Gpu, false, true));
-        assert!(!fill_possible(Backend::Gpu, true, false));
+    fn the_fill_needs_the_gpu_and_a_prepass() {
+        assert!(fill_possible(Backend::Gpu, true));
+        assert!(!fill_possible(Backend::Cpu, true));
+        assert!(!fill_possible(Backend::Gpu, false));
     }
 }
