@@ -185,7 +185,11 @@ pub(super) struct CompositeInputs<'w> {
 }
 
 /// Draws a view's filled holes into its target after the fill kernel.
-#[expect(clippy::too_many_arguments, reason = "a Bevy render system")]
+#[expect(
+    clippy::too_many_arguments,
+    clippy::type_complexity,
+    reason = "a Bevy render system"
+)]
 pub(super) fn composite_fill(
     view: ViewQuery<(
         (&ScreenFill, &ViewTarget, &ViewDepthTexture),
