@@ -28,10 +28,11 @@
 //! `plugin/frame` also room A with its mirror in view, `tour_mirror_1280x720`, and the same
 //! with the baked specular instead of reflections marched for the camera,
 //! `tour_mirror_baked_specular_1280x720`). The `plugin/frame` cameras render to an 8-bit
-//! target with Bevy's default MSAA, so they take the fragment hole fill; its
+//! target with Bevy's default MSAA and take the screen-space hole fill; its
 //! `tour_hdr_screen_fill_1280x720` and `tour_hdr_fragment_fill_1280x720` cases are the tour
-//! on an HDR camera without MSAA with the screen-space fill and with the fragment fill. With `PLENOPTIC_BENCH_PASSES` set, each
-//! frame case also prints its passes' CPU and GPU times (Bevy's render diagnostics).
+//! on an HDR camera without MSAA with the screen-space fill and with the fragment fill. With
+//! `PLENOPTIC_BENCH_PASSES` set, each frame case also prints its passes' CPU and GPU times
+//! (Bevy's render diagnostics).
 //!
 //! On CI the only adapter is Mesa's software Vulkan driver (lavapipe): its frame times say
 //! how the cost grows with pixels and cameras, not what a real GPU takes, and time to first
@@ -425,7 +426,7 @@ fn frame(c: &mut Criterion) {
     g.finish();
 }
 
-/// `s` with HDR cameras (which can take the screen-space hole fill) without MSAA, and the
+/// `s` with HDR cameras without MSAA (one sample per pixel, as the counted frames), and the
 /// screen fill on or off (`PlenopticSettings::screen_fill`).
 fn hdr_scene(mut s: Scene, screen_fill: bool) -> Scene {
     s.app
@@ -466,8 +467,8 @@ fn settled_frames(
     settled
 }
 
-/// The frames of `plugin/frame` with the cost counters on, on HDR cameras without MSAA (which
-/// can take the screen-space hole fill): `App::update` timed, and the counts printed with the
+/// The frames of `plugin/frame` with the cost counters on, on HDR cameras without MSAA (one
+/// sample per pixel, so a count is per pixel): `App::update` timed, and the counts printed with the
 /// screen fill and with the fragment fill, and their ratio (see the module doc).
 fn costs(c: &mut Criterion) {
     let dir = room_pack();

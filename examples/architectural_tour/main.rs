@@ -14,7 +14,7 @@
 //!    file is checked against the generator by `tests/tour_scene.rs`).
 //! 2. Bakes the radiance pack from `assets/tour.toml` if it is missing, with progress bars
 //!    (`target/architectural_tour/tour.pack`; the recipe's `output`). Measured on two
-//!    cores: 6.0 min in a release build (`plenoptic bake`); the pack is 72.9 MiB (25 base
+//!    cores: 4.5 min in a release build (`plenoptic bake`); the pack is 40.6 MiB (25 base
 //!    views, 225 range images of 6 × 64², 25 volumes; the sun study and the sky).
 //! 3. Flies the camera path `assets/tour_path.json` (room B, atrium, room A, for the 14 s
 //!    of the animation) and renders every frame with the CPU reconstruction of
