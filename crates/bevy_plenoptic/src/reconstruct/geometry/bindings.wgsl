@@ -79,16 +79,27 @@ struct ViewParams {
     motion: array<mat4x4<f32>>,
 }
 
+// Bits of ObjectParams.flags (mod.rs, ObjectFlags).
+// Shaded as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
+const OBJECT_MATERIALS: u32 = 1u;
+// See-through transmissive glass: its reflection over what lies behind.
+const OBJECT_SEE_THROUGH: u32 = 2u;
+// Drawn in the opaque pass (its holes may be left to the screen-space fill).
+const OBJECT_OPAQUE_PASS: u32 = 4u;
+
 // A material's uniform (mod.rs, ObjectParams): its object and material.
 struct ObjectParams {
-    // x: object id, y: motion slot (−1: static, in world space), z: coverage of glazing,
-    // w: 1 to shade as albedo · lighting + non-diffuse (pack 2.0, Shading::Materials).
-    object: vec4<f32>,
-    // x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
-    // mean transmittance per surface, z: 1 when the object is drawn in the opaque pass (its
-    // holes may be left to the screen-space fill).
-    glass: vec4<f32>,
-    // The object's base-colour factor (xyz) and metallic factor (w) when object.w is 1.
+    // The object's id.
+    id: u32,
+    // Its motion slot (ViewParams.motion; −1: static, in world space).
+    motion_slot: i32,
+    // Its coverage: its output alpha as glazing in geometry-assisted mode (1: opaque).
+    coverage: f32,
+    // OBJECT_* bits.
+    flags: u32,
+    // See-through glass's mean transmittance per surface.
+    transmittance: f32,
+    // The object's base-colour factor (xyz) and metallic factor (w) with OBJECT_MATERIALS.
     albedo: vec4<f32>,
     // x: transmission factor; y, z, w: largest side of the base-colour and metallic-roughness
     // textures and of the normal map (0: none).
@@ -187,7 +198,17 @@ fn image_mode() -> bool {
     return view_has(VIEW_IMAGE_MODE);
 }
 
+// Whether this object's flags have `bit` (OBJECT_*).
+fn object_has(bit: u32) -> bool {
+    return (params.flags & bit) != 0u;
+}
+
 // Whether this object is shaded from its material (albedo · lighting + non-diffuse).
 fn lit() -> bool {
-    return params.object.w == 1.0;
+    return object_has(OBJECT_MATERIALS);
+}
+
+// Whether this object is glazing: partly covering, blended over what lies behind it.
+fn glazing() -> bool {
+    return params.coverage > 0.0 && params.coverage < 1.0;
 }

@@ -18,7 +18,7 @@
 #import bevy_pbr::prepass_utils
 #import plenoptic::geometry::bindings::{
     cam, params, image_frame, image_mode, view_has, lit, pixel_albedo,
-    non_diffuse_weight, VIEW_SCREEN_FILL,
+    non_diffuse_weight, VIEW_SCREEN_FILL, object_has, OBJECT_OPAQUE_PASS, glazing,
 }
 #ifdef PLENOPTIC_SCREEN_FILL
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
@@ -57,10 +57,10 @@ fn note_fragment(position: vec4<f32>, coverage: u32) {
 // Whether this fragment's hole is left to the screen-space fill kernel: the camera has it
 // (PLENOPTIC_SCREEN_FILL, compiled with the depth test forced before the fragment shader, so
 // that only the fragment the depth prepass kept runs and writes), and the object is drawn in
-// the opaque pass (params.glass.z), before the kernel runs.
+// the opaque pass (OBJECT_OPAQUE_PASS), before the kernel runs.
 fn screen_fill() -> bool {
 #ifdef PLENOPTIC_SCREEN_FILL
-    return view_has(VIEW_SCREEN_FILL) && params.glass.z == 1.0;
+    return view_has(VIEW_SCREEN_FILL) && object_has(OBJECT_OPAQUE_PASS);
 #else
     return false;
 #endif
@@ -96,7 +96,7 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
         return;
     }
     let i = px.y * size.x + px.x;
-    let object = u32(params.object.x) + 1u;
+    let object = params.id + 1u;
     let e = view.exposure;
     if entry_kind == ENTRY_ANSWERED {
         fill_entries[i] = vec4<u32>(pack_pair(entry_terms[0] * e, entry_terms[1] * e), object);
@@ -115,7 +115,7 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
     let r = &hole_list.records[hole_index];
     (*r).pair = pack_pair(added * e, albedo);
     (*r).pixel = i;
-    (*r).local = vec4<f32>(object_point(hole_point).xyz, params.object.y);
+    (*r).local = vec4<f32>(object_point(hole_point).xyz, f32(params.motion_slot));
     (*r).world = vec4<f32>(hole_point, fragment_near_depth);
     (*r).tag = tag;
     (*r).coverage = fragment_coverage;
@@ -173,7 +173,7 @@ fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
 // The reconstructed radiance of the fragment (linear, before exposure).
 // `ng_raw`: the triangle's plane from the position's derivatives (taken by the caller).
 fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
-    let object = u32(params.object.x);
+    let object = params.id;
     let p = in.world_position.xyz;
     let eye = view.world_position;
     // The surface plane.
@@ -232,7 +232,7 @@ fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>
                 // Glazing is not in the depth prepass (Bevy's transparent pass): its ring
                 // pixels are found on its plane, panes being flat.
                 var q: vec4<f32>;
-                if params.object.z > 0.0 && params.object.z < 1.0 {
+                if glazing() {
                     q = pixel_on_plane(c, p, nrm);
                 } else {
                     q = neighbour_point(c, p, nrm);

@@ -14,7 +14,7 @@ use bevy::render::storage::ShaderBuffer;
 use plenoptic_recon::temporal::bracketing;
 
 use super::view::{ViewFlags, ViewParams, motion_slot};
-use super::{MaterialFactors, ObjectParams, reflect, sun, view, volume};
+use super::{MaterialFactors, ObjectFlags, ObjectParams, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 use crate::reconstruct::environment::EnvironmentUniform;
@@ -162,12 +162,9 @@ impl ObjectShading<'_> {
     /// coverage and material. It changes only with the camera's settings.
     pub(crate) fn params(&self, cam: &PlenopticCamera, pack: &RadiancePack) -> ObjectParams {
         let mut params = ObjectParams {
-            object: Vec4::new(
-                self.id as f32,
-                motion_slot(pack, self.id).map_or(-1.0, |s| s as f32),
-                self.coverage,
-                0.0,
-            ),
+            id: self.id,
+            motion_slot: motion_slot(pack, self.id).map_or(-1, |s| s as i32),
+            coverage: self.coverage,
             ..default()
         };
         if let Some(factors) = self.factors
@@ -179,10 +176,13 @@ impl ObjectShading<'_> {
                 &factors.material,
             ) && self.coverage >= 1.0
             {
-                params.glass = Vec4::new(1.0, (t.x + t.y + t.z) / 3.0, 0.0, 0.0);
+                params.flags |= ObjectFlags::SEE_THROUGH;
+                params.transmittance = (t.x + t.y + t.z) / 3.0;
             }
         }
-        params.glass.z = if self.opaque_pass { 1.0 } else { 0.0 };
+        if self.opaque_pass {
+            params.flags |= ObjectFlags::OPAQUE_PASS;
+        }
         params
     }
 }

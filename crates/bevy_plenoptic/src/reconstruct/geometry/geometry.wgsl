@@ -28,6 +28,7 @@
 #import plenoptic::geometry::bindings::{
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
+    glazing,
 }
 #import plenoptic::geometry::fill::{radiance, write_fill_entry, note_fragment}
 #import plenoptic::geometry::sun::sun_light
@@ -132,10 +133,9 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
     write_fill_entry(in.position, added);
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in
     // geometry-assisted mode; the image-mode frame already holds what is behind.
-    let glazing = params.object.z > 0.0 && params.object.z < 1.0 && !image_mode();
-    var alpha = select(c.a, params.object.z, glazing);
+    var alpha = select(c.a, params.coverage, glazing() && !image_mode());
     if see_through() {
-        alpha = 1.0 - params.glass.y;
+        alpha = 1.0 - params.transmittance;
     }
     flush_counters(in.position.xy);
     var out = vec4<f32>(min(c.rgb * view.exposure, vec3<f32>(65504.0)), alpha);

@@ -20,7 +20,7 @@
 // for an animated object; `p` itself for a static one (in world space), which is not
 // carried. Computed once per point, before its lookups.
 fn object_point(p: vec3<f32>) -> vec4<f32> {
-    if params.object.y < 0.0 {
+    if params.motion_slot < 0 {
         return vec4<f32>(p, 1.0);
     }
     return local_from_world * vec4<f32>(p, 1.0);
@@ -341,7 +341,7 @@ fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
 // Whether this object stands still between the key times of lookups k and k + 1 (static, or
 // animated with the same transform at both): its point falls on the same texel of both keys.
 fn still_between(k: u32) -> bool {
-    let slot = params.object.y;
+    let slot = f32(params.motion_slot);
     if slot < 0.0 {
         return true;
     }
@@ -376,7 +376,7 @@ fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     // still between their times and the keys agree (blend.rs).
     let paired = lit();
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let l = lookup_of(local, k, n, params.object.y);
+        let l = lookup_of(local, k, n, f32(params.motion_slot));
         if !l.ok {
             continue;
         }
@@ -421,7 +421,7 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·terms, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
-    return nearby_texels(object_point(p), object, params.object.y, lit());
+    return nearby_texels(object_point(p), object, f32(params.motion_slot), lit());
 }
 
 // `neighbour_texels` of the point whose `object_point` is `local`, of `object` with motion

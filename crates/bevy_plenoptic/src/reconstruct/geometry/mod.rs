@@ -324,15 +324,20 @@ impl Material for PlenopticMaterial {
 /// in its view buffer, [`view::ViewParams`]). It changes only with the camera's settings.
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
 pub struct ObjectParams {
-    /// x: the object's id, y: its motion slot ([`view::ViewParams::motion`]; −1 for a static
-    /// object, in world space), z: its coverage (its output alpha as glazing in
-    /// geometry-assisted mode; 1 for opaque objects), w: 1 to shade as albedo · lighting +
-    /// non-diffuse (`Shading::Materials`; those lookups are always bilinear).
-    pub object: Vec4,
-    /// x: 1 for see-through transmissive glass (its reflection over what lies behind), y: its
-    /// mean transmittance per surface.
-    pub glass: Vec4,
-    /// The object's base-colour factor (xyz) and metallic factor (w) when `object.w` is 1.
+    /// The object's id.
+    pub id: u32,
+    /// Its motion slot ([`view::ViewParams::motion`]); −1 for a static object, in world
+    /// space.
+    pub motion_slot: i32,
+    /// Its coverage: its output alpha as glazing in geometry-assisted mode; 1 for opaque
+    /// objects.
+    pub coverage: f32,
+    /// [`ObjectFlags`] bits.
+    pub flags: u32,
+    /// See-through glass's mean transmittance per surface ([`ObjectFlags::SEE_THROUGH`]).
+    pub transmittance: f32,
+    /// The object's base-colour factor (xyz) and metallic factor (w) with
+    /// [`ObjectFlags::MATERIALS`].
     pub albedo: Vec4,
     /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
     /// z: the metallic-roughness texture's (0: none); w: the normal map's (0: none).
@@ -356,6 +361,19 @@ pub struct ObjectParams {
     /// emission to the runtime (pack 4: every lit fragment adds it); z: 1 when the material
     /// is double-sided (else it emits from its front only); w: the texture's UV rotation.
     pub emission: Vec4,
+}
+
+/// Bits of [`ObjectParams::flags`] (`bindings.wgsl`'s `OBJECT_*`).
+pub struct ObjectFlags;
+
+impl ObjectFlags {
+    /// Shaded as albedo · lighting + non-diffuse (`Shading::Materials`; those lookups are
+    /// always bilinear).
+    pub const MATERIALS: u32 = 1 << 0;
+    /// See-through transmissive glass: its reflection over what lies behind.
+    pub const SEE_THROUGH: u32 = 1 << 1;
+    /// Drawn in Bevy's opaque pass: its holes may be left to the screen-space fill.
+    pub const OPAQUE_PASS: u32 = 1 << 2;
 }
 
 /// The coverage of the pack's object `id`: its manifest coverage if it is see-through
@@ -399,7 +417,7 @@ impl MaterialFactors {
     /// The uniform's material fields.
     pub(crate) fn fill(&self, params: &mut ObjectParams) {
         let m = &self.material;
-        params.object.w = 1.0;
+        params.flags |= ObjectFlags::MATERIALS;
         params.albedo = m.base_colour.truncate().extend(m.metallic.clamp(0.0, 1.0));
         params.material = Vec4::new(
             m.transmission.clamp(0.0, 1.0),

@@ -14,7 +14,7 @@
 #import plenoptic::counters::{tally, C_LOADS_16}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, cam, params, cubes, env_image, pixel_base, pixel_metallic, pixel_roughness,
-    view_has, image_mode, VIEW_MARCHED,
+    view_has, image_mode, VIEW_MARCHED, object_has, OBJECT_SEE_THROUGH,
 }
 #import plenoptic::geometry::bsdf::{
     fresnel_dielectric, fresnel_schlick, glossy_weight, glossy_bsdf, viewer,
@@ -32,7 +32,7 @@ fn marched() -> bool {
 
 // Whether this fragment is see-through transmissive glass (flags.z).
 fn see_through() -> bool {
-    return params.glass.x == 1.0 && !image_mode();
+    return object_has(OBJECT_SEE_THROUGH) && !image_mode();
 }
 
 // The pack's environment in direction `dir` (an image's 4 bilinear texels counted).
