@@ -86,6 +86,10 @@ const OBJECT_MATERIALS: u32 = 1u;
 const OBJECT_SEE_THROUGH: u32 = 2u;
 // Drawn in the opaque pass (its holes may be left to the screen-space fill).
 const OBJECT_OPAQUE_PASS: u32 = 4u;
+// The pack leaves the emission to the runtime: every lit fragment adds it.
+const OBJECT_RUNTIME_EMISSION: u32 = 8u;
+// The material is double-sided (else it emits from its front only).
+const OBJECT_DOUBLE_SIDED: u32 = 16u;
 
 // A material's uniform (mod.rs, ObjectParams): its object and material.
 struct ObjectParams {
@@ -99,26 +103,29 @@ struct ObjectParams {
     flags: u32,
     // See-through glass's mean transmittance per surface.
     transmittance: f32,
+    // The material's transmission, roughness, IOR (the runtime sun's BSDF) and normal scale.
+    transmission: f32,
+    roughness: f32,
+    ior: f32,
+    normal_scale: f32,
+    // The largest side of each texture (0: none).
+    base_colour_size: f32,
+    metallic_roughness_size: f32,
+    normal_map_size: f32,
+    emissive_size: f32,
     // The object's base-colour factor (xyz) and metallic factor (w) with OBJECT_MATERIALS.
     albedo: vec4<f32>,
-    // x: transmission factor; y, z, w: largest side of the base-colour and metallic-roughness
-    // textures and of the normal map (0: none).
-    material: vec4<f32>,
-    // KHR_texture_transform of the three textures: offset (xy), scale (zw); rotations in
-    // uv_rotation.xyz.
+    // KHR_texture_transform of the base-colour, metallic-roughness and normal textures:
+    // offset (xy), scale (zw).
     base_uv: vec4<f32>,
     mr_uv: vec4<f32>,
     normal_uv: vec4<f32>,
+    // The rotations of the base-colour, metallic-roughness, normal and emissive transforms.
     uv_rotation: vec4<f32>,
-    // x: roughness factor, y: IOR (the runtime sun's BSDF), z: the normal map's scale.
-    surface: vec4<f32>,
     // The material's emissive factor (xyz).
     emissive: vec4<f32>,
     // The emissive texture's transform: offset (xy), scale (zw).
     emissive_uv: vec4<f32>,
-    // x: the emissive texture's largest side (0: none), y: 1 when the pack leaves the
-    // emission to the runtime, z: 1 when double-sided, w: the texture's UV rotation.
-    emission: vec4<f32>,
 }
 
 #ifdef PLENOPTIC_STANDARD

@@ -106,6 +106,6 @@ fn viewer(in: VertexOutput, ng_raw: vec3<f32>) -> Viewer {
         n = n - wo * (dot(n, wo) - 1e-4);
         n = select(ng, normalize(n), dot(n, n) > 0.0);
     }
-    let ior = select(1.5, params.surface.y, params.surface.y > 0.0);
+    let ior = select(1.5, params.ior, params.ior > 0.0);
     return Viewer(n, ng, wo, select(1.0 / ior, ior, front));
 }

@@ -28,7 +28,7 @@
 #import plenoptic::geometry::bindings::{
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
-    glazing,
+    glazing, object_has, OBJECT_RUNTIME_EMISSION,
 }
 #import plenoptic::geometry::fill::{radiance, write_fill_entry, note_fragment}
 #import plenoptic::geometry::sun::sun_light
@@ -60,7 +60,7 @@ fn fragment(
     pixel_base = pbr.material.base_color.rgb;
     pixel_metallic = clamp(pbr.material.metallic, 0.0, 1.0);
     pixel_roughness = clamp(pbr.material.perceptual_roughness, 0.0, 1.0);
-    pixel_albedo = pixel_base * ((1.0 - pixel_metallic) * (1.0 - params.material.x));
+    pixel_albedo = pixel_base * ((1.0 - pixel_metallic) * (1.0 - params.transmission));
     var in = vertex;
     // The shading normal, normal-mapped (viewer() turns it towards the eye where needed).
     in.world_normal = pbr.N;
@@ -109,7 +109,7 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         }
     }
     // Pack 4 leaves the emission to the runtime: where no marched reflection carries it.
-    if lit() && !image_mode() && params.emission.y == 1.0 && non_diffuse_weight != 0.0
+    if lit() && !image_mode() && object_has(OBJECT_RUNTIME_EMISSION) && non_diffuse_weight != 0.0
         && !see_through() {
         reflected += pixel_emission;
     }

@@ -7,7 +7,7 @@
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
-#import plenoptic::geometry::bindings::params
+#import plenoptic::geometry::bindings::{params, object_has, OBJECT_DOUBLE_SIDED}
 #import plenoptic::counters::{tally, C_SAMPLES}
 #ifndef PLENOPTIC_STANDARD
 #import plenoptic::geometry::bindings::{
@@ -38,16 +38,16 @@ fn level(footprint: f32, t: vec4<f32>, side: f32) -> f32 {
 fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     var base = params.albedo.xyz;
     var metallic = params.albedo.w;
-    var roughness = params.surface.x;
-    if params.material.y > 0.0 {
+    var roughness = params.roughness;
+    if params.base_colour_size > 0.0 {
         let st = uv_transform(uv, params.base_uv, params.uv_rotation.x);
-        let lod = level(footprint, params.base_uv, params.material.y);
+        let lod = level(footprint, params.base_uv, params.base_colour_size);
         tally(C_SAMPLES, 1u);
         base *= textureSampleLevel(base_colour_texture, base_colour_sampler, st, lod).rgb;
     }
-    if params.material.z > 0.0 {
+    if params.metallic_roughness_size > 0.0 {
         let st = uv_transform(uv, params.mr_uv, params.uv_rotation.y);
-        let lod = level(footprint, params.mr_uv, params.material.z);
+        let lod = level(footprint, params.mr_uv, params.metallic_roughness_size);
         tally(C_SAMPLES, 1u);
         let mr = textureSampleLevel(metallic_roughness_texture, metallic_roughness_sampler, st, lod);
         metallic *= mr.b;
@@ -56,7 +56,7 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     pixel_base = base;
     pixel_metallic = clamp(metallic, 0.0, 1.0);
     pixel_roughness = clamp(roughness, 0.0, 1.0);
-    return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.material.x));
+    return base * ((1.0 - clamp(metallic, 0.0, 1.0)) * (1.0 - params.transmission));
 }
 
 // The emission at UV `uv` (footprint as above), as plenoptic_recon's Materials::emission:
@@ -64,12 +64,12 @@ fn material_albedo(uv: vec2<f32>, footprint: f32) -> vec3<f32> {
 fn material_emission(in: VertexOutput, uv: vec2<f32>, footprint: f32) -> vec3<f32> {
     var e = params.emissive.xyz;
     let front = dot(view.world_position - in.world_position.xyz, in.world_normal) > 0.0;
-    if params.emission.z != 1.0 && !front {
+    if !object_has(OBJECT_DOUBLE_SIDED) && !front {
         return vec3<f32>(0.0);
     }
-    if params.emission.x > 0.0 && any(e != vec3<f32>(0.0)) {
-        let st = uv_transform(uv, params.emissive_uv, params.emission.w);
-        let lod = level(footprint, params.emissive_uv, params.emission.x);
+    if params.emissive_size > 0.0 && any(e != vec3<f32>(0.0)) {
+        let st = uv_transform(uv, params.emissive_uv, params.uv_rotation.w);
+        let lod = level(footprint, params.emissive_uv, params.emissive_size);
         tally(C_SAMPLES, 1u);
         e *= textureSampleLevel(emissive_texture, emissive_sampler, st, lod).rgb;
     }
@@ -80,14 +80,14 @@ fn material_emission(in: VertexOutput, uv: vec2<f32>, footprint: f32) -> vec3<f3
 // frame of `tangent` (xyz, the bitangent's sign in w), as plenoptic_recon's
 // material::bend_normal bends it; `ns` without a normal map or where the frame degenerates.
 fn bent_normal(ns: vec3<f32>, tangent: vec4<f32>, uv: vec2<f32>, footprint: f32) -> vec3<f32> {
-    if params.material.w <= 0.0 {
+    if params.normal_map_size <= 0.0 {
         return ns;
     }
     let st = uv_transform(uv, params.normal_uv, params.uv_rotation.z);
-    let lod = level(footprint, params.normal_uv, params.material.w);
+    let lod = level(footprint, params.normal_uv, params.normal_map_size);
     tally(C_SAMPLES, 1u);
     let c = textureSampleLevel(normal_texture, normal_sampler, st, lod).rgb * 2.0 - 1.0;
-    let local = vec3<f32>(c.xy * params.surface.z, c.z);
+    let local = vec3<f32>(c.xy * params.normal_scale, c.z);
     let t = tangent.xyz - ns * dot(ns, tangent.xyz);
     if dot(t, t) <= 1e-20 {
         return ns;

@@ -336,31 +336,38 @@ pub struct ObjectParams {
     pub flags: u32,
     /// See-through glass's mean transmittance per surface ([`ObjectFlags::SEE_THROUGH`]).
     pub transmittance: f32,
+    /// The material's transmission factor.
+    pub transmission: f32,
+    /// Its roughness factor.
+    pub roughness: f32,
+    /// Its IOR (the runtime sun's BSDF, [`sun`]).
+    pub ior: f32,
+    /// Its normal map's scale.
+    pub normal_scale: f32,
+    /// The base-colour texture's largest side (0: none).
+    pub base_colour_size: f32,
+    /// The metallic-roughness texture's largest side (0: none).
+    pub metallic_roughness_size: f32,
+    /// The normal map's largest side (0: none).
+    pub normal_map_size: f32,
+    /// The emissive texture's largest side (0: none).
+    pub emissive_size: f32,
     /// The object's base-colour factor (xyz) and metallic factor (w) with
     /// [`ObjectFlags::MATERIALS`].
     pub albedo: Vec4,
-    /// x: the transmission factor; y: the base-colour texture's largest side (0: none);
-    /// z: the metallic-roughness texture's (0: none); w: the normal map's (0: none).
-    pub material: Vec4,
     /// The base-colour texture's `KHR_texture_transform`: offset (xy), scale (zw).
     pub base_uv: Vec4,
     /// The metallic-roughness texture's: offset (xy), scale (zw).
     pub mr_uv: Vec4,
     /// The normal map's: offset (xy), scale (zw).
     pub normal_uv: Vec4,
-    /// The rotations of the three transforms (x, y, z), radians.
+    /// The rotations of the base-colour, metallic-roughness, normal and emissive transforms
+    /// (x, y, z, w), radians.
     pub uv_rotation: Vec4,
-    /// x: the roughness factor, y: the IOR (the runtime sun's BSDF, [`sun`]), z: the normal
-    /// map's scale.
-    pub surface: Vec4,
     /// The material's emissive factor (xyz).
     pub emissive: Vec4,
     /// The emissive texture's `KHR_texture_transform`: offset (xy), scale (zw).
     pub emissive_uv: Vec4,
-    /// x: the emissive texture's largest side (0: none); y: 1 when the pack leaves the
-    /// emission to the runtime (pack 4: every lit fragment adds it); z: 1 when the material
-    /// is double-sided (else it emits from its front only); w: the texture's UV rotation.
-    pub emission: Vec4,
 }
 
 /// Bits of [`ObjectParams::flags`] (`bindings.wgsl`'s `OBJECT_*`).
@@ -374,6 +381,10 @@ impl ObjectFlags {
     pub const SEE_THROUGH: u32 = 1 << 1;
     /// Drawn in Bevy's opaque pass: its holes may be left to the screen-space fill.
     pub const OPAQUE_PASS: u32 = 1 << 2;
+    /// The pack leaves the emission to the runtime (pack 4: every lit fragment adds it).
+    pub const RUNTIME_EMISSION: u32 = 1 << 3;
+    /// The material is double-sided (else it emits from its front only).
+    pub const DOUBLE_SIDED: u32 = 1 << 4;
 }
 
 /// The coverage of the pack's object `id`: its manifest coverage if it is see-through
@@ -419,18 +430,13 @@ impl MaterialFactors {
         let m = &self.material;
         params.flags |= ObjectFlags::MATERIALS;
         params.albedo = m.base_colour.truncate().extend(m.metallic.clamp(0.0, 1.0));
-        params.material = Vec4::new(
-            m.transmission.clamp(0.0, 1.0),
-            self.sizes.0 as f32,
-            self.sizes.1 as f32,
-            self.sizes.2 as f32,
-        );
-        params.surface = Vec4::new(
-            m.roughness.clamp(0.0, 1.0),
-            if m.ior > 0.0 { m.ior } else { 1.5 },
-            m.normal_scale,
-            0.0,
-        );
+        params.transmission = m.transmission.clamp(0.0, 1.0);
+        params.base_colour_size = self.sizes.0 as f32;
+        params.metallic_roughness_size = self.sizes.1 as f32;
+        params.normal_map_size = self.sizes.2 as f32;
+        params.roughness = m.roughness.clamp(0.0, 1.0);
+        params.ior = if m.ior > 0.0 { m.ior } else { 1.5 };
+        params.normal_scale = m.normal_scale;
         let uv = |b: Option<plenoptic_pack::TextureBinding>| {
             b.and_then(|b| b.transform)
                 .map_or((Vec4::new(0.0, 0.0, 1.0, 1.0), 0.0), |t| {
@@ -447,15 +453,16 @@ impl MaterialFactors {
         params.base_uv = base;
         params.mr_uv = mr;
         params.normal_uv = normal;
-        params.uv_rotation = Vec4::new(rb, rm, rn, 0.0);
+        params.uv_rotation = Vec4::new(rb, rm, rn, re);
         params.emissive = m.emissive.extend(0.0);
         params.emissive_uv = emissive;
-        params.emission = Vec4::new(
-            self.emissive_size as f32,
-            if self.runtime_emission { 1.0 } else { 0.0 },
-            if m.double_sided { 1.0 } else { 0.0 },
-            re,
-        );
+        params.emissive_size = self.emissive_size as f32;
+        if self.runtime_emission {
+            params.flags |= ObjectFlags::RUNTIME_EMISSION;
+        }
+        if m.double_sided {
+            params.flags |= ObjectFlags::DOUBLE_SIDED;
+        }
     }
 }
 

@@ -26,7 +26,7 @@ const RAY_OFFSET: f32 = 0.001;
 // Whether this fragment's surface is marched: no transmission, an ideal mirror, or glossy
 // up to the roughest surface marched.
 fn marched() -> bool {
-    return view_has(VIEW_MARCHED) && (params.material.x <= 0.0 || see_through())
+    return view_has(VIEW_MARCHED) && (params.transmission <= 0.0 || see_through())
         && (pixel_roughness < 0.02 || pixel_roughness <= cam.glossy_roughness);
 }
 

@@ -21,7 +21,7 @@ fn sun_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32)
     }
     let cos_o = dot(wo, n);
     let m = pixel_metallic;
-    let tr = params.material.x;
+    let tr = params.transmission;
     let alpha = max(pixel_roughness * pixel_roughness, 1e-4);
     let delta = pixel_roughness < 0.02;
     if reflect {
@@ -66,7 +66,7 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
     // Surfaces whose every lobe is ideal take no light sample (as the tracer).
     let fd = fresnel_dielectric(clamp(dot(wo, n), 1e-4, 1.0), eta);
     let lum = dot(pixel_base, vec3<f32>(0.2126, 0.7152, 0.0722));
-    let diffuse = (1.0 - pixel_metallic) * (1.0 - params.material.x) * (1.0 - fd) * max(lum, 0.0) > 0.0;
+    let diffuse = (1.0 - pixel_metallic) * (1.0 - params.transmission) * (1.0 - fd) * max(lum, 0.0) > 0.0;
     if !diffuse && pixel_roughness < 0.02 {
         return vec3<f32>(0.0);
     }
