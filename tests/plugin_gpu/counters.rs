@@ -4,9 +4,9 @@
 //! counts must be exact where they can be checked (every reconstruction of a point tries each
 //! of the camera's lookups once, and loads its texel), and counting must not change the frame.
 
-use crate::harness::{compare, compare_on, cpu_as_gpu};
+use crate::harness::{compare, compare_on};
 use crate::many_cameras::{
-    Eye, assert_each_matches, cpu_frame, plugin_cameras_with, settled_frames,
+    Eye, assert_each_matches, cpu_frame, cpu_frame_with, plugin_cameras_with, settled_frames,
 };
 use crate::pack::{Materials, PackSpec, room, write_pack};
 use bevy::camera::Hdr;
@@ -155,19 +155,8 @@ fn every_pixel_a_hole_fills_as_on_the_cpu() {
         "{report:?}"
     );
 
-    let mut rec = cpu_as_gpu(&path);
-    rec.settings.depth_tolerance = -1.0;
-    let e = eye();
-    let cam = plenoptic_recon::Camera::new(
-        e.at,
-        e.transform().rotation,
-        std::f32::consts::FRAC_PI_4,
-        crate::common::WIDTH,
-        crate::common::HEIGHT,
-    )
-    .unwrap();
-    let (cpu, _) = rec.render(&cam, e.t, e.mode.into()).unwrap();
-    assert_each_matches(&frames, &[cpu.radiance], 0.003, 0.995);
+    let cpu = cpu_frame_with(&path, eye(), |s| s.depth_tolerance = -1.0);
+    assert_each_matches(&frames, &[cpu], 0.003, 0.995);
 }
 
 /// A pack with materials: each view's two time keys are blended once per frame where they
@@ -266,20 +255,9 @@ fn msaa_brings_the_frame_nearer_the_supersampled_cpu_frame() {
     let (dir, path) = room_pack(Materials::None);
     let (single, _, _) = counted(dir.path(), true, |_| {});
     let (msaa, _) = msaa_frame(dir.path(), true, None);
-    let mut rec = cpu_as_gpu(&path);
-    rec.settings.supersampling = 4;
-    let e = eye();
-    let cam = plenoptic_recon::Camera::new(
-        e.at,
-        e.transform().rotation,
-        std::f32::consts::FRAC_PI_4,
-        crate::common::WIDTH,
-        crate::common::HEIGHT,
-    )
-    .unwrap();
-    let (cpu, _) = rec.render(&cam, e.t, e.mode.into()).unwrap();
-    let (off, off5, _) = compare_on(&single[0], &cpu.radiance);
-    let (on, on5, _) = compare_on(&msaa, &cpu.radiance);
+    let cpu = cpu_frame_with(&path, eye(), |s| s.supersampling = 4);
+    let (off, off5, _) = compare_on(&single[0], &cpu);
+    let (on, on5, _) = compare_on(&msaa, &cpu);
     eprintln!(
         "against the CPU's 4 × 4 supersampled frame: one sample mean {off:.4} ({off5:.4} within 5 %), 4× MSAA mean {on:.4} ({on5:.4} within 5 %)"
     );

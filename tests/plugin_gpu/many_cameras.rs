@@ -32,7 +32,17 @@ impl Eye {
 
 /// `plenoptic_recon`'s frame of the pack at `path` for `eye`.
 pub(crate) fn cpu_frame(path: &std::path::Path, eye: Eye) -> Vec<Vec3> {
-    let rec = cpu_as_gpu(path);
+    cpu_frame_with(path, eye, |_| {})
+}
+
+/// [`cpu_frame`] with the reconstructor's settings changed by `tweak` first.
+pub(crate) fn cpu_frame_with(
+    path: &std::path::Path,
+    eye: Eye,
+    tweak: impl FnOnce(&mut plenoptic_recon::ReconSettings),
+) -> Vec<Vec3> {
+    let mut rec = cpu_as_gpu(path);
+    tweak(&mut rec.settings);
     let cam = plenoptic_recon::Camera::new(
         eye.at,
         eye.transform().rotation,
