@@ -118,13 +118,19 @@ impl ScreenFill {
 
     /// The hole list's room: how many records it holds.
     pub(super) fn room(&self) -> u32 {
-        (self.pixels() / HOLE_SHARE).max(1) as u32
+        list_room(self.size) as u32
     }
+}
 
-    /// The viewport's pixels.
-    fn pixels(&self) -> u64 {
-        u64::from(self.size.x) * u64::from(self.size.y)
-    }
+/// The pixels of a viewport of `size`.
+fn pixels_of(size: UVec2) -> u64 {
+    u64::from(size.x) * u64::from(size.y)
+}
+
+/// The records a viewport of `size` has room for in its hole list: a [`HOLE_SHARE`] of its
+/// pixels, at least one.
+fn list_room(size: UVec2) -> u64 {
+    (pixels_of(size) / HOLE_SHARE).max(1)
 }
 
 /// The fill passes' uniform (`fill_entry.wgsl`'s `FillParams`).
@@ -216,8 +222,8 @@ pub(super) fn prepare_screen_fill(
             _ => UVec2::ZERO,
         };
         let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
-            let pixels = u64::from(size.x) * u64::from(size.y);
-            let list = LIST_HEADER_BYTES + (pixels / HOLE_SHARE).max(1) * RECORD_BYTES;
+            let pixels = pixels_of(size);
+            let list = LIST_HEADER_BYTES + list_room(size) * RECORD_BYTES;
             let buffer = |bytes: u64| {
                 ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
             };
@@ -368,8 +374,7 @@ fn bind_groups(
 ) -> Option<[BindGroup; 2]> {
     let entries = buffers.get(&fill.entries)?;
     let (cubes, shading) = fill.keys.as_ref()?;
-    let pixels = u64::from(fill.size.x) * u64::from(fill.size.y);
-    if !fill.on() || entries.buffer.size() < pixels * ENTRY_BYTES {
+    if !fill.on() || entries.buffer.size() < pixels_of(fill.size) * ENTRY_BYTES {
         return None;
     }
     let mut uniform = UniformBuffer::from(params);
