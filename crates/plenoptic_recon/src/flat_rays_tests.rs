@@ -216,3 +216,30 @@ fn the_nearest_hit_names_its_object_and_triangle() {
         None
     );
 }
+
+/// See-through objects let `1 − c` through at each surface a shadow ray crosses, as the
+/// tracer's rays pass BLEND coverage; an opaque surface anywhere along the ray stops it.
+#[test]
+fn see_through_objects_pass_one_minus_coverage_per_surface() {
+    let geometry = scene();
+    let shadows = ShadowScene::new(&geometry).with_see_through([(2, 0.5), (3, 0.3)]);
+    // Off the cube's face diagonals, where two triangles meet.
+    let o = Vec3::new(0.0, 1.6, 0.1);
+    let placed = shadows.at(&geometry, 0.0);
+    // Out of the window through the moving cube's two faces.
+    let through_cube = placed.transmittance(o, Vec3::X, 100.0);
+    assert!((through_cube - 0.49).abs() < 1e-6, "{through_cube}");
+    // Through the fixed pillar's two faces, then the wall behind it stops the ray.
+    let to_pillar = (Vec3::new(-0.8, 1.7, -0.7) - o).normalize();
+    let before_wall = placed.transmittance(o, to_pillar, 1.5);
+    assert!((before_wall - 0.25).abs() < 1e-6, "{before_wall}");
+    assert_eq!(placed.transmittance(o, to_pillar, 100.0), 0.0);
+    // The cube slid away by t = 1: nothing in the window.
+    let later = shadows.at(&geometry, 1.0);
+    assert_eq!(later.transmittance(o, Vec3::X, 100.0), 1.0);
+    // Without see-through objects the answer is the occlusion test's.
+    let opaque = ShadowScene::new(&geometry);
+    let placed = opaque.at(&geometry, 0.0);
+    assert_eq!(placed.transmittance(o, Vec3::X, 100.0), 0.0);
+    assert_eq!(placed.transmittance(o, to_pillar, 0.8), 1.0);
+}

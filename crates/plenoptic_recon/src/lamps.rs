@@ -98,7 +98,8 @@ impl RuntimeLamp {
 }
 
 /// The lamps' highlights towards the viewer at `p` (geometric normal `ng`, either side)
-/// through `bsdf`, each shadowed by a ray against `shadows` (all lit without proxies).
+/// through `bsdf`, each shadowed by a ray against `shadows` (all lit without proxies; glazing
+/// lets 1 − c through at each surface, [`PlacedShadows::transmittance`]).
 pub fn highlights(
     lamps: &[RuntimeLamp],
     p: Vec3,
@@ -117,10 +118,13 @@ pub fn highlights(
             continue;
         }
         let lift = shadow_lift(p, ng, wi);
-        if shadows.is_some_and(|s| s.occluded(p + lift, wi, dist - 2.0 * lift.length())) {
+        let pass = shadows.map_or(1.0, |s| {
+            s.transmittance(p + lift, wi, dist - 2.0 * lift.length())
+        });
+        if pass == 0.0 {
             continue;
         }
-        sum += f * irradiance * wi.dot(n).abs();
+        sum += f * irradiance * wi.dot(n).abs() * pass;
     }
     sum
 }

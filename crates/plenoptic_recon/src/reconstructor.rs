@@ -150,11 +150,16 @@ impl Reconstructor {
             .as_ref()
     }
 
-    /// The proxies' ray-cast geometry (BVHs built on first use), when the pack has proxies.
+    /// The proxies' ray-cast geometry (BVHs built on first use), when the pack has proxies;
+    /// the pack's glazing (objects with a coverage) is see-through to its shadow rays.
     pub(crate) fn proxy_rays(&self) -> Option<&crate::shadow::ShadowScene> {
         let proxy = self.proxy.as_ref()?;
         self.rays
-            .get_or_init(|| Some(crate::shadow::ShadowScene::new(proxy)))
+            .get_or_init(|| {
+                let glazing = self.pack.manifest().objects.iter();
+                let coverage = glazing.filter_map(|o| Some((o.id, o.coverage?)));
+                Some(crate::shadow::ShadowScene::new(proxy).with_see_through(coverage))
+            })
             .as_ref()
     }
 

@@ -10,7 +10,9 @@
 //!
 //! with `f` the surface's full BSDF ([`crate::brdf`]: the Lambertian lobe, and the GGX
 //! highlight the base views would have frozen in place), `E_sun` the track's illuminance at t
-//! and `V` a shadow ray against the proxies ([`crate::shadow`]). A sun with a disc (angular
+//! and `V` a shadow ray against the proxies ([`crate::shadow`]; glazing, the pack's objects
+//! with a coverage c, lets 1 − c through at each surface, as the tracer's shadow rays pass
+//! it). A sun with a disc (angular
 //! radius > 0) is sampled with `K` = [`crate::ReconSettings::sun_shadow_rays`] directions
 //! spread uniformly over the disc's cone, as the tracer draws them (stratified in cos θ and φ,
 //! the strata turned per pixel). The rays also leave from `K` points spread over the pixel's
@@ -163,9 +165,9 @@ impl PlacedSun<'_> {
             return Some(Vec3::ZERO);
         }
         let lift = shadow_lift(p, ng, wi);
-        let open = |uv: Vec2| {
+        let pass = |uv: Vec2| {
             let q = p + footprint.0 * uv.x + footprint.1 * uv.y;
-            !self.shadows.occluded(q + lift, wi, 1e9)
+            self.shadows.transmittance(q + lift, wi, 1e9)
         };
         let probes = [
             (0.0, 0.0),
@@ -174,13 +176,17 @@ impl PlacedSun<'_> {
             (0.5, 0.5),
             (-0.5, 0.5),
         ]
-        .map(|(u, v)| open(Vec2::new(u, v)));
-        let lit = if probes.iter().all(|&c| c == probes[0]) {
-            f32::from(u8::from(probes[0]))
+        .map(|(u, v)| pass(Vec2::new(u, v)));
+        // The edge is where opaque proxies block; glazing the open rays cross dims them all
+        // alike (its own border lies on its frame).
+        let open = probes.map(|t| t > 0.0);
+        let through = probes.iter().copied().fold(0.0, f32::max);
+        let lit = if open.iter().all(|&c| c == open[0]) {
+            f32::from(u8::from(open[0]))
         } else {
-            crate::sun_edge::straight_edge_coverage(open)?
+            crate::sun_edge::straight_edge_coverage(|uv| pass(uv) > 0.0)?
         };
-        Some(f * wi.dot(bsdf.normal()).abs() * lit)
+        Some(f * wi.dot(bsdf.normal()).abs() * lit * through)
     }
 
     /// The sum over `rays` of the BSDF-weighted cosines of the unblocked ones, with how many
@@ -214,12 +220,15 @@ impl PlacedSun<'_> {
                 let v = (shift + k as f32 * 0.569_840_3).fract() - 0.5;
                 p + footprint.0 * u + footprint.1 * v
             };
-            if self.shadows.occluded(q + shadow_lift(p, ng, wi), wi, 1e9) {
+            let pass = self
+                .shadows
+                .transmittance(q + shadow_lift(p, ng, wi), wi, 1e9);
+            if pass == 0.0 {
                 out.blocked += 1;
                 continue;
             }
             out.open += 1;
-            out.sum += f * wi.dot(n).abs();
+            out.sum += f * wi.dot(n).abs() * pass;
         }
         out
     }
