@@ -534,3 +534,72 @@ fn gpu_bilinear_lookups_match_cpu() {
     assert!(unchanged < 0.97, "bilinear changes the frame: {unchanged}");
     assert_gpu_matches(&gpu, &cpu.radiance, &room, "bilinear, the room's pixels");
 }
+
+/// The runtime sun through a glazed window: the pane (`alphaMode: BLEND`, coverage c = 0.25)
+/// lets 1 − c of the sun through, as the path tracer's shadow rays pass it, onto the floor
+/// behind it, on both backends.
+#[test]
+fn gpu_sun_through_glazing_matches_cpu() {
+    use plenoptic_pack::plenoptic_sky::{SunTrack, SunTrackSample};
+    // The sun high beyond the window (+z): its light falls through the pane onto the floor.
+    let towards = Vec3::new(0.1, 0.8, 1.0).normalize();
+    let track = SunTrack::new(vec![SunTrackSample {
+        time: 0.0,
+        direction: towards,
+        illuminance: Vec3::splat(2.0),
+    }])
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.pack");
+    let spec = PackSpec {
+        direct_sun: true,
+        materials: Materials::Factors,
+        ..PackSpec::segment(2, vec![0.0, 2.0], 16)
+    };
+    let scene = windowed_room(Some(0.25));
+    write_pack_with(&scene, &spec, &path, Some((Environment::None, Some(track))));
+    let eye = Vec3::new(0.2, 1.4, -1.5);
+    let transform = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.2, 1.0), Vec3::Y);
+    let t = 0.7;
+    let rec = cpu_as_gpu(&path);
+    let cam = cpu_camera(eye, &transform);
+    let (cpu, _) = rec.render(&cam, t, Mode::GeometryAssisted).unwrap();
+    // The floor pixels the sun reaches through the window (pane aside), by their point.
+    let (lo, hi) = crate::pack::WINDOW;
+    let basis = cam.basis();
+    let sunlit: Vec<usize> = (0..cpu.radiance.len())
+        .filter(|&j| {
+            let (x, y) = (
+                (j as u32 % WIDTH) as f32 + 0.5,
+                (j as u32 / WIDTH) as f32 + 0.5,
+            );
+            let p = basis.position + basis.direction(x, y) * cpu.depth[j];
+            let q = p + towards * ((2.5 - p.z) / towards.z);
+            p.y < 0.01 && (lo.x..hi.x).contains(&q.x) && (lo.y..hi.y).contains(&q.y)
+        })
+        .collect();
+    assert!(sunlit.len() > 200, "sunlit floor pixels: {}", sunlit.len());
+    let (mut app, camera, image) = sky_app(dir.path(), Backend::Gpu, transform, t);
+    let gpu = settle(&mut app, camera, &image);
+    // The patch's mean: the GPU's light through the pane is the CPU's.
+    let mean = |v: &[Vec3]| sunlit.iter().map(|&j| v[j].x).sum::<f32>() / sunlit.len() as f32;
+    let ratio = mean(&gpu) / mean(&cpu.radiance);
+    eprintln!("sun through the pane: GPU mean {ratio:.4} of the CPU's over the sunlit floor");
+    assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+    // Per pixel, 2 pixels inside the patch: its edges are the window frame's shadow, which
+    // the GPU takes from Bevy's shadow map and the CPU from exact rays.
+    let lit: std::collections::HashSet<usize> = sunlit.iter().copied().collect();
+    let w = WIDTH as usize;
+    let inside: Vec<usize> = (sunlit.iter().copied())
+        .filter(|&j| {
+            (-2..=2).all(|dy: i64| {
+                (-2..=2).all(|dx: i64| {
+                    let k = j as i64 + dy * w as i64 + dx;
+                    k >= 0 && lit.contains(&(k as usize))
+                })
+            })
+        })
+        .collect();
+    assert!(inside.len() > 100, "inside the patch: {}", inside.len());
+    assert_gpu_matches(&gpu, &cpu.radiance, &inside, "sunlit floor behind the pane");
+}

@@ -45,11 +45,41 @@ fn scene() -> SceneBuilder {
     let floor = MaterialDesc::diffuse(Vec3::new(0.55, 0.45, 0.35));
     let outer = 2.0 * HALF + 2.0 * WALL;
     let d = HALF + 0.5 * WALL;
-    slab(&mut b, "floor", Vec3::new(0.0, -d, 0.0), Vec3::new(outer, WALL, outer), floor);
-    slab(&mut b, "ceiling", Vec3::new(0.0, d, 0.0), Vec3::new(outer, WALL, outer), plaster.clone());
-    slab(&mut b, "wall_w", Vec3::new(-d, 0.0, 0.0), Vec3::new(WALL, outer, outer), plaster.clone());
-    slab(&mut b, "wall_s", Vec3::new(0.0, 0.0, -d), Vec3::new(outer, outer, WALL), plaster.clone());
-    slab(&mut b, "wall_n", Vec3::new(0.0, 0.0, d), Vec3::new(outer, outer, WALL), plaster.clone());
+    slab(
+        &mut b,
+        "floor",
+        Vec3::new(0.0, -d, 0.0),
+        Vec3::new(outer, WALL, outer),
+        floor,
+    );
+    slab(
+        &mut b,
+        "ceiling",
+        Vec3::new(0.0, d, 0.0),
+        Vec3::new(outer, WALL, outer),
+        plaster.clone(),
+    );
+    slab(
+        &mut b,
+        "wall_w",
+        Vec3::new(-d, 0.0, 0.0),
+        Vec3::new(WALL, outer, outer),
+        plaster.clone(),
+    );
+    slab(
+        &mut b,
+        "wall_s",
+        Vec3::new(0.0, 0.0, -d),
+        Vec3::new(outer, outer, WALL),
+        plaster.clone(),
+    );
+    slab(
+        &mut b,
+        "wall_n",
+        Vec3::new(0.0, 0.0, d),
+        Vec3::new(outer, outer, WALL),
+        plaster.clone(),
+    );
     // The +x wall as four pieces around the window.
     let (y0, y1) = WINDOW_Y;
     let (z0, z1) = WINDOW_Z;
@@ -61,7 +91,13 @@ fn scene() -> SceneBuilder {
     ];
     for (name, (ya, yb), (za, zb)) in pieces {
         let c = Vec3::new(d, 0.5 * (ya + yb), 0.5 * (za + zb));
-        slab(&mut b, name, c, Vec3::new(WALL, yb - ya, zb - za), plaster.clone());
+        slab(
+            &mut b,
+            name,
+            c,
+            Vec3::new(WALL, yb - ya, zb - za),
+            plaster.clone(),
+        );
     }
     let glazing = MaterialDesc::diffuse(Vec3::splat(0.9))
         .base_color_alpha(Vec4::new(0.9, 0.95, 0.95, 0.12))
@@ -69,9 +105,21 @@ fn scene() -> SceneBuilder {
         .double_sided(true)
         .named("glazing");
     let pane = Vec3::new(d, 0.5 * (y0 + y1), 0.5 * (z0 + z1));
-    slab(&mut b, "pane", pane, Vec3::new(0.01, y1 - y0, z1 - z0), glazing);
+    slab(
+        &mut b,
+        "pane",
+        pane,
+        Vec3::new(0.01, y1 - y0, z1 - z0),
+        glazing,
+    );
     let wood = MaterialDesc::diffuse(Vec3::new(0.5, 0.3, 0.15));
-    slab(&mut b, "table", Vec3::new(-0.9, -1.3, 1.0), Vec3::new(0.8, 0.08, 0.8), wood);
+    slab(
+        &mut b,
+        "table",
+        Vec3::new(-0.9, -1.3, 1.0),
+        Vec3::new(0.8, 0.08, 0.8),
+        wood,
+    );
     b.add_node(
         NodeDesc::new("sun")
             .light(LightDesc::directional(Vec3::ONE, 4.0))
@@ -113,7 +161,10 @@ fn sun_through_a_glazed_window_lights_the_floor_as_the_path_tracer_does() {
     let t = 0.5;
     let (a, b) = common::reference_halves(&scene, &camera, t, 256, 7);
     let rec = Reconstructor::open(dir.path().join("out/scene.pack")).unwrap();
-    assert!(rec.runtime_sun().is_some(), "the bake leaves the sun to the runtime");
+    assert!(
+        rec.runtime_sun().is_some(),
+        "the bake leaves the sun to the runtime"
+    );
     let (frame, _) = rec.render(&camera, t, Mode::GeometryAssisted).unwrap();
     common::save_frames("sunlit_interior", "", &a, &frame);
 
@@ -128,7 +179,11 @@ fn sun_through_a_glazed_window_lights_the_floor_as_the_path_tracer_does() {
         .collect();
     let all: Vec<usize> = (0..frame.radiance.len()).collect();
     let mean = |img: &dyn Fn(usize) -> Vec3, which: &[usize]| {
-        which.iter().map(|&j| f64::from(luminance(img(j)))).sum::<f64>() / which.len() as f64
+        which
+            .iter()
+            .map(|&j| f64::from(luminance(img(j))))
+            .sum::<f64>()
+            / which.len() as f64
     };
     let reference = |j: usize| 0.5 * (a.pixels[j] + b.pixels[j]);
     let ours = |j: usize| frame.radiance[j];
@@ -140,7 +195,17 @@ fn sun_through_a_glazed_window_lights_the_floor_as_the_path_tracer_does() {
         lit.len(),
         all.len()
     );
-    assert!(lit.len() > 400, "the sun patch is in view: {} pixels", lit.len());
-    assert!((lit_ratio - 1.0).abs() < 0.05, "sunlit pixels: {lit_ratio:.4}");
-    assert!((frame_ratio - 1.0).abs() < 0.03, "whole frame: {frame_ratio:.4}");
+    assert!(
+        lit.len() > 400,
+        "the sun patch is in view: {} pixels",
+        lit.len()
+    );
+    assert!(
+        (lit_ratio - 1.0).abs() < 0.05,
+        "sunlit pixels: {lit_ratio:.4}"
+    );
+    assert!(
+        (frame_ratio - 1.0).abs() < 0.03,
+        "whole frame: {frame_ratio:.4}"
+    );
 }

@@ -13,7 +13,11 @@
 //! Words (`u32` fields stored as the `f32` with those bits):
 //! - word 0: (first, end) node words of the fixed BVH (equal: none), the count of moving BVHs,
 //!   and 1 (the pack has proxy geometry);
-//! - one word per moving BVH: (first, end) node words, its pack object id, 0;
+//! - one word per moving BVH: (first, end) node words, its pack object id, and the fraction
+//!   of light each of its surfaces lets through: 0 for an opaque object, 1 − c for
+//!   see-through glazing of coverage c ([`FlatRays::with_see_through`]; glazing gets a BVH of
+//!   its own in object space, moving or not, so that the runtime sun can walk the glazing
+//!   alone, [`FlatRays::see_through_pass`]);
 //! - two words per node: (box min, miss link), (box max, first triangle word or
 //!   [`NO_TRIANGLES`] for an inner node);
 //! - three words per triangle: (v0, 1 for the last triangle of its leaf else 0), (v1, 0),
@@ -109,19 +113,44 @@ impl FlatRays {
     /// The ray-cast geometry of every proxy of `proxy`, the same triangles as
     /// [`crate::shadow::ShadowScene::new`].
     pub fn new(proxy: &ProxyGeometry) -> Self {
-        let (fixed, moving) = crate::shadow::split_triangles(proxy, |_| true);
+        Self::with_see_through(proxy, [])
+    }
+
+    /// [`FlatRays::new`] with the objects of `coverage` (pack id, coverage c) see-through
+    /// glazing: each in a BVH of its own whose surfaces pass 1 − c of the light
+    /// ([`FlatRays::see_through_pass`]). [`FlatRays::occluded`] still stops at them.
+    pub fn with_see_through(
+        proxy: &ProxyGeometry,
+        coverage: impl IntoIterator<Item = (u32, f32)>,
+    ) -> Self {
+        let glazing: Vec<(u32, f32)> = coverage
+            .into_iter()
+            .map(|(id, c)| (id, 1.0 - c.clamp(0.0, 1.0)))
+            .collect();
+        let pass_of = |id: u32| glazing.iter().find(|g| g.0 == id).map(|g| g.1);
+        let (fixed, moving) = crate::shadow::split_triangles(proxy, |id| pass_of(id).is_none());
         let fixed: Vec<Triangle> = fixed.into_iter().map(|(t, _)| t).collect();
         let fixed = flatten(&fixed);
-        let moving: Vec<(u32, Flat)> = moving
+        let see_through = proxy
+            .object_ids()
+            .iter()
+            .zip(proxy.meshes())
+            .filter_map(|(&id, m)| {
+                let pass = pass_of(id)?;
+                Some((id, crate::shadow::object_triangles(m), pass))
+            });
+        let moving: Vec<(u32, Flat, f32)> = moving
             .into_iter()
-            .filter_map(|(id, tris)| Some((id, flatten(&tris)?)))
+            .map(|(id, tris)| (id, tris, 0.0))
+            .chain(see_through)
+            .filter_map(|(id, tris, pass)| Some((id, flatten(&tris)?, pass)))
             .collect();
         let node_words = |f: &Flat| 2 * f.nodes.len() as u32;
         // Node words start after the header and the moving table; triangles after all nodes.
         let mut node_at = 1 + moving.len() as u32;
         let mut tri_at = node_at
             + fixed.as_ref().map_or(0, node_words)
-            + moving.iter().map(|(_, f)| node_words(f)).sum::<u32>();
+            + moving.iter().map(|(_, f, _)| node_words(f)).sum::<u32>();
         let mut words = vec![Vec4::ZERO; 1 + moving.len()];
         let mut nodes = Vec::new();
         let mut triangles = Vec::new();
@@ -147,15 +176,15 @@ impl FlatRays {
         };
         let (f0, f1) = fixed.as_ref().map_or((0, 0), &mut place);
         words[0] = Vec4::new(bits(f0), bits(f1), bits(moving.len() as u32), bits(1));
-        for (k, (id, f)) in moving.iter().enumerate() {
+        for (k, (id, f, pass)) in moving.iter().enumerate() {
             let (first, end) = place(f);
-            words[1 + k] = Vec4::new(bits(first), bits(end), bits(*id), 0.0);
+            words[1 + k] = Vec4::new(bits(first), bits(end), bits(*id), *pass);
         }
         words.extend(nodes);
         words.extend(triangles);
         FlatRays {
             words,
-            moving: moving.iter().map(|(id, _)| *id).collect(),
+            moving: moving.iter().map(|(id, _, _)| *id).collect(),
         }
     }
 
@@ -203,38 +232,46 @@ impl FlatRays {
         if word_u32(header.w) == 0 {
             return false;
         }
-        if self.traverse(word_u32(header.x), word_u32(header.y), origin, dir, tmax) {
+        let (first, end) = (word_u32(header.x), word_u32(header.y));
+        if self.hits(first, end, origin, dir, tmax, false) > 0 {
             return true;
         }
-        for k in 0..word_u32(header.z) as usize {
+        (0..word_u32(header.z) as usize).any(|k| {
+            let (first, end) = (word_u32(w[1 + k].x), word_u32(w[1 + k].y));
+            placements.get(3 * k..3 * k + 3).is_some_and(|rows| {
+                let (o, d) = placed_ray(rows, origin, dir);
+                self.hits(first, end, o, d, tmax, false) > 0
+            })
+        })
+    }
+
+    /// The fraction of light the see-through glazing lets through along the ray from
+    /// `origin` along `dir` within `tmax`: `Π (1 − c)` over the glazing surfaces it crosses,
+    /// the other proxies ignored (the runtime sun's shadow map has them); `rays.wgsl`'s
+    /// `see_through_pass`, step for step.
+    pub fn see_through_pass(&self, placements: &[Vec4], origin: Vec3, dir: Vec3, tmax: f32) -> f32 {
+        let w = &self.words;
+        let mut through = 1.0;
+        for k in 0..word_u32(w[0].z) as usize {
             let entry = w[1 + k];
             let Some(rows) = placements.get(3 * k..3 * k + 3) else {
                 continue;
             };
-            let apply = |p: Vec3, one: f32| {
-                Vec3::new(
-                    rows[0].dot(p.extend(one)),
-                    rows[1].dot(p.extend(one)),
-                    rows[2].dot(p.extend(one)),
-                )
-            };
-            if self.traverse(
-                word_u32(entry.x),
-                word_u32(entry.y),
-                apply(origin, 1.0),
-                apply(dir, 0.0),
-                tmax,
-            ) {
-                return true;
+            if entry.w > 0.0 {
+                let (o, d) = placed_ray(rows, origin, dir);
+                let n = self.hits(word_u32(entry.x), word_u32(entry.y), o, d, tmax, true);
+                through *= entry.w.powi(n as i32);
             }
         }
-        false
+        through
     }
 
-    /// The stackless walk of the node words `first..end`.
-    fn traverse(&self, first: u32, end: u32, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    /// The stackless walk of the node words `first..end`: how many triangles the ray meets,
+    /// stopping at the first unless `all`.
+    fn hits(&self, first: u32, end: u32, origin: Vec3, dir: Vec3, tmax: f32, all: bool) -> u32 {
         let w = &self.words;
         let inv = safe_recip(dir);
+        let mut count = 0;
         let mut i = first;
         while i < end {
             let (a, b) = (w[i as usize], w[i as usize + 1]);
@@ -250,15 +287,12 @@ impl FlatRays {
             let mut j = leaf as usize;
             loop {
                 let (v0, v1, v2) = (w[j], w[j + 1], w[j + 2]);
-                if hits_triangle(
-                    origin,
-                    dir,
-                    tmax,
-                    v0.truncate(),
-                    v1.truncate(),
-                    v2.truncate(),
-                ) {
-                    return true;
+                let [a0, a1, a2] = [v0, v1, v2].map(Vec4::truncate);
+                if hits_triangle(origin, dir, tmax, a0, a1, a2) {
+                    count += 1;
+                    if !all {
+                        return count;
+                    }
                 }
                 if v0.w != 0.0 {
                     break;
@@ -267,8 +301,20 @@ impl FlatRays {
             }
             i = word_u32(a.w);
         }
-        false
+        count
     }
+}
+
+/// The ray (`origin`, `dir`) moved by the three rows of a world → object placement.
+fn placed_ray(rows: &[Vec4], origin: Vec3, dir: Vec3) -> (Vec3, Vec3) {
+    let apply = |p: Vec3, one: f32| {
+        Vec3::new(
+            rows[0].dot(p.extend(one)),
+            rows[1].dot(p.extend(one)),
+            rows[2].dot(p.extend(one)),
+        )
+    };
+    (apply(origin, 1.0), apply(dir, 0.0))
 }
 
 /// `1/d` per component, a zero component replaced by ±1e-12 first (no NaN in the slab test).

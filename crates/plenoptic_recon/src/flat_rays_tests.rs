@@ -109,16 +109,25 @@ fn r3(k: u32) -> Vec3 {
 }
 
 /// The flat layout's traversal answers as the CPU's BVHs do, with the moving cube at two
-/// times, on rays from inside the room in every direction.
+/// times, on rays from inside the room in every direction; and so does the layout with the
+/// pillar as glazing in a BVH of its own.
 #[test]
 fn the_flat_traversal_agrees_with_the_cpus_bvhs() {
     let geometry = scene();
-    let flat = FlatRays::new(&geometry);
     let shadows = ShadowScene::new(&geometry);
+    let glazed = FlatRays::with_see_through(&geometry, [(2, 0.5)]);
+    assert_eq!(glazed.moving(), &[3, 2]);
+    agrees_with(&geometry, &shadows, &glazed);
+    let flat = FlatRays::new(&geometry);
     assert_eq!(flat.moving(), &[3]);
+    agrees_with(&geometry, &shadows, &flat);
+}
+
+/// [`the_flat_traversal_agrees_with_the_cpus_bvhs`] for one layout.
+fn agrees_with(geometry: &ProxyGeometry, shadows: &ShadowScene, flat: &FlatRays) {
     let (mut agree, mut total, mut blocked) = (0, 0, 0);
     for t in [0.0, 0.6] {
-        let placed = shadows.at(&geometry, t);
+        let placed = shadows.at(geometry, t);
         let placements = flat.placements(|id| geometry.transform(id, t));
         for k in 0..4000 {
             let o = r3(k) * Vec3::new(3.8, 2.8, 3.8) + Vec3::new(-1.9, 0.1, -1.9);
@@ -218,7 +227,8 @@ fn the_nearest_hit_names_its_object_and_triangle() {
 }
 
 /// See-through objects let `1 − c` through at each surface a shadow ray crosses, as the
-/// tracer's rays pass BLEND coverage; an opaque surface anywhere along the ray stops it.
+/// tracer's rays pass BLEND coverage; an opaque surface anywhere along the ray stops it. The
+/// GPU's flat layout gives the glazing's part alike.
 #[test]
 fn see_through_objects_pass_one_minus_coverage_per_surface() {
     let geometry = scene();
@@ -237,6 +247,21 @@ fn see_through_objects_pass_one_minus_coverage_per_surface() {
     // The cube slid away by t = 1: nothing in the window.
     let later = shadows.at(&geometry, 1.0);
     assert_eq!(later.transmittance(o, Vec3::X, 100.0), 1.0);
+    // The GPU's layout: the glazing alone dims the ray (the wall behind the pillar is the
+    // shadow map's), every surface still stops an occlusion test.
+    let flat = FlatRays::with_see_through(&geometry, [(2, 0.5), (3, 0.3)]);
+    let at = |t: f32| flat.placements(|id| geometry.transform(id, t));
+    let gpu_cube = flat.see_through_pass(&at(0.0), o, Vec3::X, 100.0);
+    assert!((gpu_cube - 0.49).abs() < 1e-6, "{gpu_cube}");
+    let gpu_pillar = flat.see_through_pass(&at(0.0), o, to_pillar, 100.0);
+    assert!((gpu_pillar - 0.25).abs() < 1e-6, "{gpu_pillar}");
+    assert_eq!(flat.see_through_pass(&at(1.0), o, Vec3::X, 100.0), 1.0);
+    assert!(flat.occluded(&at(0.0), o, Vec3::X, 100.0));
+    assert!(flat.occluded(&at(0.0), o, to_pillar, 1.5));
+    assert_eq!(
+        FlatRays::new(&geometry).see_through_pass(&at(0.0), o, Vec3::X, 100.0),
+        1.0
+    );
     // Without see-through objects the answer is the occlusion test's.
     let opaque = ShadowScene::new(&geometry);
     let placed = opaque.at(&geometry, 0.0);

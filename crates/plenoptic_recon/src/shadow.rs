@@ -370,14 +370,12 @@ pub(crate) fn split_triangles(
     proxy: &ProxyGeometry,
     keep: impl Fn(u32) -> bool,
 ) -> (Vec<(Triangle, TriangleTag)>, MovingTriangles) {
-    let triangles = |m: &crate::proxy::TriangleMesh, xf: Affine3A| -> Vec<Triangle> {
-        m.triangles
-            .iter()
-            .map(|t| {
-                let [v0, v1, v2] = t.map(|i| xf.transform_point3a(m.positions[i as usize].into()));
-                Triangle { v0, v1, v2 }
-            })
-            .collect()
+    let placed = |m: &crate::proxy::TriangleMesh, xf: Affine3A| {
+        object_triangles(m).into_iter().map(move |t| Triangle {
+            v0: xf.transform_point3a(t.v0),
+            v1: xf.transform_point3a(t.v1),
+            v2: xf.transform_point3a(t.v2),
+        })
     };
     let mut fixed = Vec::new();
     let mut moving = Vec::new();
@@ -387,17 +385,22 @@ pub(crate) fn split_triangles(
         }
         let mesh = &proxy.meshes()[i];
         match &proxy.motions()[i] {
-            Some(m) if m.is_animated() => {
-                moving.push((id, triangles(mesh, Affine3A::IDENTITY)));
-            }
-            _ => fixed.extend(
-                triangles(mesh, proxy.transform(id, 0.0))
-                    .into_iter()
-                    .zip((0..).map(|k| (id, k))),
-            ),
+            Some(m) if m.is_animated() => moving.push((id, object_triangles(mesh))),
+            _ => fixed.extend(placed(mesh, proxy.transform(id, 0.0)).zip((0..).map(|k| (id, k)))),
         }
     }
     (fixed, moving)
+}
+
+/// The triangles of `mesh` in its object's space, in mesh order.
+pub(crate) fn object_triangles(mesh: &crate::proxy::TriangleMesh) -> Vec<Triangle> {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let [v0, v1, v2] = t.map(|i| mesh.positions[i as usize].into());
+            Triangle { v0, v1, v2 }
+        })
+        .collect()
 }
 
 /// The world bounds of object-space bounds `b` moved by `xf` (its eight corners').

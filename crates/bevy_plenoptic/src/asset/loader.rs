@@ -81,9 +81,15 @@ impl AssetLoader for RadiancePackLoader {
         })?;
 
         let (read, mut failed) = plenoptic_recon::proxy::read_proxies(&pack);
-        // What reflected rays are cast against (the CPU's escape test, on the GPU).
+        // What reflected rays are cast against (the CPU's escape test, on the GPU), with the
+        // glazing in BVHs of its own for the runtime sun.
+        let glazing: Vec<(u32, f32)> = (pack.manifest().objects.iter())
+            .filter_map(|o| Some((o.id, o.coverage?)))
+            .collect();
         let rays = plenoptic_recon::ProxyGeometry::from_proxies(&read)
-            .map_or_else(FlatRays::none, |g| FlatRays::new(&g));
+            .map_or_else(FlatRays::none, |g| {
+                FlatRays::with_see_through(&g, glazing.iter().copied())
+            });
         // The environment (its image chunk, if any, is read now: every frame needs it).
         let (environment, env_error) =
             plenoptic_recon::background::PackEnvironment::from_pack(&pack);

@@ -112,4 +112,11 @@ impl RadiancePack {
     pub fn proxy(&self, id: u32) -> Option<&ProxyObject> {
         self.proxies.iter().find(|p| p.id == id)
     }
+
+    /// The coverage of object `id` when it is see-through glazing (the pack's
+    /// [`plenoptic_pack::ObjectEntry::coverage`], clamped to [0.001, 1]); `None` when opaque.
+    pub fn coverage(&self, id: u32) -> Option<f32> {
+        let object = self.reader.manifest().objects.iter().find(|o| o.id == id)?;
+        object.coverage.map(|c| c.clamp(1e-3, 1.0))
+    }
 }

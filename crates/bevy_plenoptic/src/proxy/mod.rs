@@ -11,6 +11,7 @@
 
 use std::collections::HashMap;
 
+use bevy::light::NotShadowCaster;
 use bevy::prelude::*;
 
 use crate::asset::RadiancePack;
@@ -128,7 +129,7 @@ fn spawn_proxy_scenes(
             ))
             .with_children(|parent| {
                 for p in &pack.proxies {
-                    parent.spawn((
+                    let mut proxy = parent.spawn((
                         Name::new(p.name.clone()),
                         ProxyOf { id: p.id },
                         Mesh3d(p.mesh.clone()),
@@ -136,6 +137,11 @@ fn spawn_proxy_scenes(
                         p.transform_at(cam.time),
                         layer.layers(),
                     ));
+                    // Glazing dims the runtime sun by its coverage instead of blocking it
+                    // (the shaders' `see_through_pass`), so it stays out of the shadow map.
+                    if pack.coverage(p.id).is_some() {
+                        proxy.insert(NotShadowCaster);
+                    }
                 }
             })
             .id();

@@ -390,13 +390,7 @@ impl ObjectFlags {
 /// The coverage of the pack's object `id`: its manifest coverage if it is see-through
 /// glazing, else 1 (opaque).
 pub(crate) fn object_coverage(pack: &RadiancePack, id: u32) -> f32 {
-    pack.reader
-        .manifest()
-        .objects
-        .iter()
-        .find(|o| o.id == id)
-        .and_then(|o| o.coverage)
-        .map_or(1.0, |c| c.clamp(1e-3, 1.0))
+    pack.coverage(id).unwrap_or(1.0)
 }
 
 /// What the shader needs of an object's material to compute its diffuse albedo per pixel as

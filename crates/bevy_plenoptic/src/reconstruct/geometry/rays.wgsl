@@ -60,9 +60,11 @@ fn hits_triangle(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, v0: vec3<f32>, v1
     return t >= 0.0 && t <= tmax;
 }
 
-// The walk of the node words first..end.
-fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+// The walk of the node words first..end: how many triangles the ray meets, stopping at the
+// first unless `all` (FlatRays::hits).
+fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32, all: bool) -> u32 {
     let inv = safe_recip(dir);
+    var count = 0u;
     var i = first;
     while i < end {
         tally(C_STEPS, 1u);
@@ -84,7 +86,10 @@ fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) 
             tally(C_LOADS_16, 3u);
             let v0 = rays[j];
             if hits_triangle(origin, dir, tmax, v0.xyz, rays[j + 1u].xyz, rays[j + 2u].xyz) {
-                return true;
+                count += 1u;
+                if !all {
+                    return count;
+                }
             }
             if v0.w != 0.0 {
                 break;
@@ -93,7 +98,22 @@ fn traverse(first: u32, end: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) 
         }
         i = bitcast<u32>(a.w);
     }
-    return false;
+    return count;
+}
+
+// The ray moved into the space of moving BVH k (its three placement rows).
+struct PlacedRay {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+fn placed_ray(k: u32, origin: vec3<f32>, dir: vec3<f32>) -> PlacedRay {
+    let r0 = ray_placements[3u * k];
+    let r1 = ray_placements[3u * k + 1u];
+    let r2 = ray_placements[3u * k + 2u];
+    let o = vec4<f32>(origin, 1.0);
+    let d = vec4<f32>(dir, 0.0);
+    return PlacedRay(vec3<f32>(dot(r0, o), dot(r1, o), dot(r2, o)), vec3<f32>(dot(r0, d), dot(r1, d), dot(r2, d)));
 }
 
 // Whether any proxy lies along the ray from `origin` along `dir` closer than `tmax`.
@@ -102,26 +122,33 @@ fn occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     if bitcast<u32>(header.w) == 0u {
         return false;
     }
-    if traverse(bitcast<u32>(header.x), bitcast<u32>(header.y), origin, dir, tmax) {
+    if traverse(bitcast<u32>(header.x), bitcast<u32>(header.y), origin, dir, tmax, false) > 0u {
         return true;
     }
-    let moving = bitcast<u32>(header.z);
-    let placed = arrayLength(&ray_placements) / 3u;
+    let moving = min(bitcast<u32>(header.z), arrayLength(&ray_placements) / 3u);
     for (var k = 0u; k < moving; k++) {
-        if k >= placed {
-            break;
-        }
         let entry = rays[1u + k];
-        let r0 = ray_placements[3u * k];
-        let r1 = ray_placements[3u * k + 1u];
-        let r2 = ray_placements[3u * k + 2u];
-        let o = vec4<f32>(origin, 1.0);
-        let d = vec4<f32>(dir, 0.0);
-        let o_obj = vec3<f32>(dot(r0, o), dot(r1, o), dot(r2, o));
-        let d_obj = vec3<f32>(dot(r0, d), dot(r1, d), dot(r2, d));
-        if traverse(bitcast<u32>(entry.x), bitcast<u32>(entry.y), o_obj, d_obj, tmax) {
+        let r = placed_ray(k, origin, dir);
+        if traverse(bitcast<u32>(entry.x), bitcast<u32>(entry.y), r.origin, r.dir, tmax, false) > 0u {
             return true;
         }
     }
     return false;
+}
+
+// The fraction of light the see-through glazing lets through along the ray: the product of
+// 1 − c over the glazing surfaces it crosses, the other proxies ignored
+// (FlatRays::see_through_pass). Glazing BVHs are the moving entries whose w is above 0.
+fn see_through_pass(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> f32 {
+    let moving = min(bitcast<u32>(rays[0].z), arrayLength(&ray_placements) / 3u);
+    var through = 1.0;
+    for (var k = 0u; k < moving; k++) {
+        let entry = rays[1u + k];
+        if entry.w > 0.0 {
+            let r = placed_ray(k, origin, dir);
+            let n = traverse(bitcast<u32>(entry.x), bitcast<u32>(entry.y), r.origin, r.dir, tmax, true);
+            through *= pow(entry.w, f32(n));
+        }
+    }
+    return through;
 }

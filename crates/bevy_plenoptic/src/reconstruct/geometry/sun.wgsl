@@ -1,7 +1,8 @@
 // The runtime sun of geometry-assisted reconstruction (pack 3; thesis §8.2.3;
 // plenoptic_recon's sun and brdf modules, the same formulas): the sun's direct light added per
 // lit fragment through its full BSDF, shadowed by Bevy's shadow map of the directional light
-// the plugin keeps aimed along the pack's sun (sun.rs).
+// the plugin keeps aimed along the pack's sun (sun.rs) and dimmed by the glazing it crosses
+// (rays.wgsl's see_through_pass over the glazing's own BVHs; glazing casts no shadow).
 #define_import_path plenoptic::geometry::sun
 
 #import bevy_pbr::forward_io::VertexOutput
@@ -9,6 +10,7 @@
 #import bevy_pbr::shadows::fetch_directional_shadow
 #import plenoptic::geometry::bindings::{cam, params, pixel_base, pixel_metallic, pixel_roughness}
 #import plenoptic::counters::{tally, C_SAMPLES}
+#import plenoptic::rays::{has_rays, see_through_pass}
 #import plenoptic::geometry::bsdf::{PI, fresnel_dielectric, ggx_d, smith_g1, glossy_bsdf, viewer}
 
 // The BSDF for light from `wi` seen along `wo`, with shading normal `n` and geometric normal
@@ -90,6 +92,12 @@ fn sun_light(in: VertexOutput, ng_raw: vec3<f32>) -> vec3<f32> {
             // One filtered sample per shadow lookup (Bevy's filter taps are not counted).
             tally(C_SAMPLES, 1u);
             shadow = fetch_directional_shadow(i, in.world_position, towards, view_z, in.position.xy);
+            // Glazing is not in the shadow map: it lets 1 − c through at each surface, as
+            // plenoptic_recon's shadow rays pass it.
+            if shadow > 0.0 && has_rays() {
+                let eps = 1e-4 * (1.0 + max(max(abs(in.world_position.x), abs(in.world_position.y)), abs(in.world_position.z)));
+                shadow *= see_through_pass(in.world_position.xyz + towards * eps, wi, 1e9);
+            }
             break;
         }
     }
