@@ -444,7 +444,7 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
     let (start, end) = path.time_range();
     let samples: Vec<PathSample> = match options.frames {
         None => path.frames().collect(),
-        Some(n) => spread_samples(&path, n),
+        Some(n) => path.spread(n),
     };
     let frame_seconds = (end - start) / samples.len().saturating_sub(1).max(1) as f32;
 
@@ -535,20 +535,6 @@ fn render_headless(options: &Options, pack: &Path) -> Result<(), BoxError> {
         gif.display()
     );
     Ok(())
-}
-
-/// `n` samples spread evenly over the whole camera path, numbered 0..n.
-fn spread_samples(path: &CameraPath, n: usize) -> Vec<PathSample> {
-    let (start, end) = path.time_range();
-    if n <= 1 {
-        return vec![path.sample(start)];
-    }
-    (0..n)
-        .map(|i| PathSample {
-            index: i,
-            ..path.sample(start + (end - start) * i as f32 / (n - 1) as f32)
-        })
-        .collect()
 }
 
 /// The plugin's streaming working set along every frame of the tour, with its default

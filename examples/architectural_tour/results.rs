@@ -206,7 +206,7 @@ pub fn run(
 ) -> Result<(), BoxError> {
     let frames_dir = dir.join("frames");
     std::fs::create_dir_all(&frames_dir)?;
-    let full = crate::spread_samples(path, o.frames);
+    let full = path.spread(o.frames);
     let mut small = full.clone();
     for s in &mut small {
         s.camera.width = o.width;

@@ -138,6 +138,10 @@ enum Command {
         /// reference's pixels are box-filtered, so compare with 2–4).
         #[arg(long, default_value_t = 1)]
         supersampling: u32,
+        /// Render N frames spread evenly over the whole path (first and last keyframe
+        /// included, as the tour's `--results` frames are) instead of every frame.
+        #[arg(long)]
+        frames: Option<usize>,
         /// Output directory.
         #[arg(long, default_value = "frames")]
         out: PathBuf,
@@ -262,6 +266,7 @@ fn run(command: Command) -> Result<()> {
             shading,
             reflections,
             supersampling,
+            frames,
             out,
         } => {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
@@ -272,7 +277,7 @@ fn run(command: Command) -> Result<()> {
                 shaded_reflections: parse_reflections(&reflections)?,
                 supersampling,
             };
-            cmd_render(&pack, &path, mode, look, &out)
+            cmd_render(&pack, &path, (mode, frames), look, &out)
         }
         Command::Compare {
             reference,
@@ -358,7 +363,7 @@ fn parse_reflections(reflections: &str) -> Result<bool> {
 fn cmd_render(
     pack: &Path,
     path: &Path,
-    mode: plenoptic_recon::Mode,
+    (mode, frames): (plenoptic_recon::Mode, Option<usize>),
     look: Look,
     out: &Path,
 ) -> Result<()> {
@@ -375,6 +380,7 @@ fn cmd_render(
             &plenoptic_eval::tools::RenderOptions {
                 mode,
                 progress: true,
+                frames,
                 ..Default::default()
             },
         )

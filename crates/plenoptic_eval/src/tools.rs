@@ -40,6 +40,9 @@ pub struct RenderOptions {
     pub exr: bool,
     /// Print one line per frame to stderr.
     pub progress: bool,
+    /// `Some(n)`: `n` frames spread evenly over the whole path ([`CameraPath::spread`], the
+    /// tour's results' frames) instead of every frame at the path's frame rate.
+    pub frames: Option<usize>,
 }
 
 impl Default for RenderOptions {
@@ -50,6 +53,7 @@ impl Default for RenderOptions {
             png: true,
             exr: true,
             progress: false,
+            frames: None,
         }
     }
 }
@@ -142,8 +146,12 @@ pub fn render_path_with(
     };
     let mut total_ms = 0.0;
     let mut exposure = options.exposure;
-    let count = path.frame_count();
-    for s in path.frames() {
+    let samples: Vec<_> = match options.frames {
+        Some(n) => path.spread(n),
+        None => path.frames().collect(),
+    };
+    let count = samples.len();
+    for s in samples {
         let start = Instant::now();
         let (frame, report) = rec.render(&s.camera, s.scene_time, options.mode)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;

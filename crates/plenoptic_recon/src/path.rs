@@ -243,6 +243,21 @@ impl CameraPath {
         }
     }
 
+    /// `n` samples spread evenly over the whole path, first and last keyframe included,
+    /// numbered 0..n (one sample, the first keyframe's, for `n` ≤ 1).
+    pub fn spread(&self, n: usize) -> Vec<PathSample> {
+        let (start, end) = self.time_range();
+        if n <= 1 {
+            return vec![self.sample(start)];
+        }
+        (0..n)
+            .map(|i| PathSample {
+                index: i,
+                ..self.sample(start + (end - start) * i as f32 / (n - 1) as f32)
+            })
+            .collect()
+    }
+
     /// Every frame of the path, at `frame_rate`.
     pub fn frames(&self) -> impl Iterator<Item = PathSample> + '_ {
         let start = self.time_range().0;
