@@ -15,7 +15,11 @@
 //! time. That light also lights the app's own `StandardMaterial` meshes in that camera like
 //! the pack's sun, but they cast no shadow from it (they are not on the camera's layer). The
 //! CPU casts shadow rays against the proxies instead, so the two agree away from shadow edges
-//! and differ at them by the shadow map's resolution and filter.
+//! and differ at them by the shadow map's resolution and filter. Glazing (objects with a pack
+//! coverage c) casts no shadow map: `sun.wgsl` dims the light by `Π (1 − c)` over the glazing
+//! surfaces between the fragment and the sun, walking the glazing's own BVHs in the flat ray
+//! layout (`rays.wgsl`'s `see_through_pass`), as the CPU's shadow rays pass glazing. The app's
+//! own meshes lit by that light get the sun through glazing undimmed.
 
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
