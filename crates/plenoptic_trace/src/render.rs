@@ -101,29 +101,14 @@ where
 pub enum PixelFilter {
     /// Every sample: the mean over the pixel's area (images to look at, references).
     Box,
-    /// Only the samples that hit the surface the pixel-centre ray hit (or missed, as it did):
-    /// the same object, with a shading normal within [`SAME_SURFACE_COS`] of the centre's. A
-    /// pixel's colour then belongs to the surface its distance, id and normal describe, as a
-    /// range image's lookups take it. Where rays pass a see-through surface (BLEND coverage
-    /// c), the pixel is the surface's own radiance where the centre ray stopped at it, and what
-    /// lies behind where it passed, instead of the mix c · surface + (1 − c) · behind in both
-    /// (with the mix, the tour's glazed window would show the sky through its own pane
-    /// texels). At silhouettes, the centre's object alone; at an object's own creases, the
-    /// centre's face alone (a wall's texels beside a window would otherwise take in the
-    /// sky-lit reveal of the opening, one object with the wall, and show a bright halo).
-    SameSurface,
-}
-
-/// The cosine above which two shading normals of one object count as one surface for
-/// [`PixelFilter::SameSurface`]: 25°, well above the turn of a smooth normal across one texel
-/// and well below a crease (a wall and its window reveal meet at 90°).
-pub const SAME_SURFACE_COS: f32 = 0.9;
-
-/// Whether sample `r` hit the surface `centre` did: the same object (or both missed), with
-/// shading normals within [`SAME_SURFACE_COS`].
-fn same_surface(r: &RadianceSample, centre: &RadianceSample) -> bool {
-    r.object == centre.object
-        && (centre.object == NO_OBJECT || r.normal.dot(centre.normal) > SAME_SURFACE_COS)
+    /// Only the samples that hit the object the pixel-centre ray hit (or missed, as it did): a
+    /// pixel's colour then belongs to the surface its distance and id describe, as a range
+    /// image's lookups take it. Where rays pass a see-through surface (BLEND coverage c), the
+    /// pixel is the surface's own radiance where the centre ray stopped at it, and what lies
+    /// behind where it passed, instead of the mix c · surface + (1 − c) · behind in both (with
+    /// the mix, the tour's glazed window would show the sky through its own pane texels). At
+    /// silhouettes, the centre's object alone.
+    SameObject,
 }
 
 /// [`render_camera`] with the samples `filter` keeps (at least the centre ray's).
@@ -164,7 +149,7 @@ where
                 aux = r;
             }
             // The centre ray (k = 0) is always kept, so `aux` is set before any comparison.
-            if filter == PixelFilter::SameSurface && any && !same_surface(&r, &aux) {
+            if filter == PixelFilter::SameObject && any && r.object != aux.object {
                 continue;
             }
             any = true;

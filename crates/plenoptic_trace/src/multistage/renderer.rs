@@ -228,8 +228,8 @@ impl<'f> MultiStageRenderer<'f> {
     }
 
     /// Renders the six faces of a cube camera in KTX2 layer order (+X, −X, +Y, −Y, +Z, −Z);
-    /// each texel's means take only the samples that hit the centre ray's surface
-    /// ([`PixelFilter::SameSurface`]), as the range image's lookups read a texel.
+    /// each texel's means take only the samples that hit the centre ray's object
+    /// ([`PixelFilter::SameObject`]), as the range image's lookups read a texel.
     pub fn render_cube(
         &self,
         placed: &PlacedScene<'_>,
@@ -242,7 +242,7 @@ impl<'f> MultiStageRenderer<'f> {
                 &face,
                 self.settings.samples_per_pixel,
                 seed,
-                PixelFilter::SameSurface,
+                PixelFilter::SameObject,
                 |ray, s, _| self.sample(placed, ray, s),
             )
         })
