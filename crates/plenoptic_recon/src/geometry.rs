@@ -223,7 +223,7 @@ pub(crate) fn render_pair(
         anchors: anchors.as_ref(),
     };
     let mut class = vec![HOLE; frame.radiance.len()];
-    let interpolated = lookups.run(&mut frame, &mut plane2, &mut class);
+    let interpolated = lookups.run(&mut frame, &mut plane2, &mut class, &mut prims);
     report.stage_ms.push(("mask_and_lookups".into(), ms(start)));
     let start = Instant::now();
     // The hit point of a pixel (for the fallbacks), as the pixel loop computed it.
@@ -524,6 +524,8 @@ struct Band<'b> {
     dep: &'b mut [f32],
     obj: &'b mut [u32],
     cls: &'b mut [u8],
+    /// Each pixel's proxy triangle (an index into the projection's normals).
+    prim: &'b mut [u32],
     /// The second colour, where there is one.
     rad2: Option<&'b mut [Vec3]>,
 }
@@ -534,11 +536,22 @@ type Workspace = (Scratch, Scratch, Vec<usize>);
 
 impl Lookups<'_> {
     /// Looks up every pixel of `frame` (and `plane2`, where not empty), classing each in
-    /// `class`; returns how many took their anchors' mean.
-    fn run(&self, frame: &mut Frame, plane2: &mut [Vec3], class: &mut [u8]) -> usize {
+    /// `class`; returns how many took their anchors' mean. `prims` holds each pixel's proxy
+    /// triangle where the anchors' pass rasterized, else the bands rasterize it there.
+    fn run(
+        &self,
+        frame: &mut Frame,
+        plane2: &mut [Vec3],
+        class: &mut [u8],
+        prims: &mut Vec<u32>,
+    ) -> usize {
         let w = self.rows.width;
         let band = ROWS * w.max(1);
         let n = frame.radiance.len();
+        if prims.len() != n {
+            prims.clear();
+            prims.resize(n, u32::MAX);
+        }
         let interpolated = AtomicUsize::new(0);
         // The second colour's band, where there is one.
         let bands2 = if !plane2.is_empty() {
@@ -552,17 +565,19 @@ impl Lookups<'_> {
             .zip(frame.depth.par_chunks_mut(band))
             .zip(frame.object.par_chunks_mut(band))
             .zip(class.par_chunks_mut(band))
+            .zip(prims.par_chunks_mut(band))
             .zip(bands2)
             .enumerate()
             .for_each_init(
                 || (Scratch::default(), Scratch::default(), Vec::new()),
-                |work, (index, ((((rad, dep), obj), cls), rad2))| {
+                |work, (index, (((((rad, dep), obj), cls), prim), rad2))| {
                     let band = Band {
                         index,
                         rad,
                         dep,
                         obj,
                         cls,
+                        prim,
                         rad2,
                     };
                     let between = self.band(work, band);
@@ -578,8 +593,8 @@ impl Lookups<'_> {
         let w = self.rows.width;
         let y0 = b.index * ROWS;
         if let (MaskSource::Raster(tris), None) = (self.rows.source, &self.anchors) {
-            // Camera-space depth into `dep`, object into `obj`.
-            crate::raster::raster_band(tris, w, y0, b.dep, b.obj, None);
+            // Camera-space depth into `dep`, object into `obj`, triangle into `prim`.
+            crate::raster::raster_band(tris, w, y0, b.dep, b.obj, Some(&mut *b.prim));
         }
         let mut between_count = 0;
         let mut rad2 = b.rad2;
@@ -588,10 +603,11 @@ impl Lookups<'_> {
             .chunks_mut(w)
             .zip(b.dep.chunks_mut(w))
             .zip(b.obj.chunks_mut(w))
-            .zip(b.cls.chunks_mut(w));
-        for (r, (((rad, dep), obj), cls)) in lines.enumerate() {
+            .zip(b.cls.chunks_mut(w))
+            .zip(b.prim.chunks(w));
+        for (r, ((((rad, dep), obj), cls), prim)) in lines.enumerate() {
             let row2 = rad2.as_deref_mut().map(|b| &mut b[r * w..(r + 1) * w]);
-            between_count += self.row(work, y0 + r, rad, dep, obj, cls, row2);
+            between_count += self.row(work, (y0 + r, prim), rad, dep, obj, cls, row2);
         }
         between_count
     }
@@ -605,7 +621,7 @@ impl Lookups<'_> {
     fn row(
         &self,
         (s, packed, xs): &mut Workspace,
-        y: usize,
+        (y, prim): (usize, &[u32]),
         rad: &mut [Vec3],
         dep: &mut [f32],
         obj: &mut [u32],
@@ -618,6 +634,7 @@ impl Lookups<'_> {
             self.rows.slots(&mut s.slot, y, obj, Some((rad, cls)));
         } else {
             self.rows.prepare(s, y, dep, obj, Some((rad, cls)));
+            self.rows.normals(s, prim.iter().copied());
         }
         let mut between_count = 0;
         xs.clear();
@@ -639,6 +656,7 @@ impl Lookups<'_> {
         let gathered = anchors.is_some();
         let lanes = if gathered && !xs.is_empty() {
             packed.gather_rays(self.rows.basis, y, xs, dep, &s.slot);
+            self.rows.normals(packed, xs.iter().map(|&x| prim[x]));
             packed
         } else {
             s

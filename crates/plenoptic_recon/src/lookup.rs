@@ -127,6 +127,9 @@ pub(crate) struct Scratch {
     pub p: [Vec<f32>; 3],
     /// Unit direction from the hit point to the eye.
     e: [Vec<f32>; 3],
+    /// The pixel's surface normal (its proxy triangle's, unit, facing the eye; zero where
+    /// unknown, which turns the face test of [`same_face`] off).
+    n: [Vec<f32>; 3],
     /// The current lookup: direction from the base view, its length, the texel ([`NO_TEXEL`]:
     /// none), the angular weight.
     d: [Vec<f32>; 3],
@@ -153,7 +156,13 @@ impl Scratch {
         // Whole groups of four lanes; the padding is never fresh.
         let n = n.next_multiple_of(4);
         self.slot.resize(n, NO_SLOT);
-        for a in [&mut self.dir, &mut self.p, &mut self.e, &mut self.d] {
+        for a in [
+            &mut self.dir,
+            &mut self.p,
+            &mut self.e,
+            &mut self.d,
+            &mut self.n,
+        ] {
             for c in a {
                 c.resize(n, 0.0);
             }
@@ -196,6 +205,9 @@ impl Scratch {
                 self.e[c][i] = ec;
             }
             self.slot[i] = slots[x];
+        }
+        for c in &mut self.n {
+            c[..n].fill(0.0);
         }
         // The padding of the last group of four looks nothing up.
         self.slot[n..].fill(NO_SLOT);
@@ -270,6 +282,33 @@ impl Scratch {
             ex[x] = if ok { vx * r } else { 0.0 };
             ey[x] = if ok { vy * r } else { 0.0 };
             ez[x] = if ok { vz * r } else { 0.0 };
+        }
+    }
+
+    /// The surface normals of the first pixels, one per item of `prims` (the pixels' proxy
+    /// triangles: indices into `normals`, camera-space normals either side, as
+    /// [`crate::raster::Projected::normals`] holds them): in world space, turned to face the
+    /// eye against the pixels' ray directions (which must be set). A pixel past `normals`
+    /// (no triangle) gets zero, and no face test.
+    pub fn set_normals(
+        &mut self,
+        b: &CameraBasis,
+        normals: &[Vec3],
+        prims: impl Iterator<Item = u32>,
+    ) {
+        for (i, prim) in prims.enumerate() {
+            let c = normals.get(prim as usize).copied().unwrap_or_default();
+            let n = b.right * c.x + b.up * c.y + b.forward * c.z;
+            let d = Vec3::new(self.dir[0][i], self.dir[1][i], self.dir[2][i]);
+            let n = if n.dot(d) > 0.0 { -n } else { n };
+            (self.n[0][i], self.n[1][i], self.n[2][i]) = (n.x, n.y, n.z);
+        }
+    }
+
+    /// Clears the surface normals of the first `n` pixels (no face test).
+    pub fn clear_normals(&mut self, n: usize) {
+        for c in &mut self.n {
+            c[..n].fill(0.0);
         }
     }
 
@@ -443,6 +482,15 @@ impl Shade<'_> {
             if tx.id != obj[x] {
                 continue;
             }
+            // The pixel's normal in the key's frame (an object's motion turns it).
+            let np = Vec3::new(s.n[0][x], s.n[1][x], s.n[2][x]);
+            let np = match k.motion.get(s.slot[x] as usize) {
+                Some(m) if np != Vec3::ZERO => m.transform_vector3(np),
+                _ => np,
+            };
+            if !same_face(k, t, np) {
+                continue;
+            }
             let (dc, l) = (tx.distance, dist[x]);
             // Fast path: the texel's centre distance agrees. Otherwise compare with the
             // distance to the texel's surface plane along the lookup direction (grazing
@@ -475,7 +523,8 @@ impl Shade<'_> {
                 };
                 let o = obj[x];
                 let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
-                let keep = |tj: &Texel, j: usize| j == t || same_surface(k, tj, j, o, d, l, tol);
+                let keep =
+                    |tj: &Texel, j: usize| j == t || same_surface(k, tj, j, (o, np), d, l, tol);
                 // Each tap tested once (the plane test is not free).
                 let kept = [
                     keep(&a[0], i),
@@ -507,7 +556,7 @@ impl Shade<'_> {
                 }
             } else {
                 let d = Vec3::new(s.d[0][x], s.d[1][x], s.d[2][x]);
-                filtered(k, d, t, obj[x], l, tol)
+                filtered(k, d, t, (obj[x], np), l, tol)
             };
             s.accepted[x] |= (1 | (whole as u32) << 1) << bit;
             let weight = k.weight * wa[x];
@@ -519,16 +568,46 @@ impl Shade<'_> {
     }
 }
 
+/// The cosine below which a texel's normal and the pixel's surface normal are two faces: the
+/// texel is not the pixel's surface however near it lies ([`same_face`]). 60°: well beyond a
+/// smooth normal's turn across a proxy triangle or a normal map's bumps, well short of a
+/// crease (a wall and the reveal of its window, 90°) or the far side of a thin surface (180°).
+pub const SAME_FACE_COS: f32 = 0.5;
+
+/// Whether texel `j` of key `k` faces as the pixel's surface does: its stored normal (which
+/// faces the base view) within [`SAME_FACE_COS`] of the pixel's normal `np` (facing the
+/// camera, in the key's frame). Without either normal (a key without normals, a pixel without
+/// a proxy triangle: `np` zero) every texel passes. A window's reveal is the wall's object at
+/// the wall's distance; without this test the wall beside the window takes the reveal's
+/// sky-lit texels and shows a bright halo, and the outside of a lampshade takes the texels of
+/// its lamp-lit inside (the same triangles, seen from the other side).
+#[inline]
+fn same_face(k: &FastKey<'_>, j: usize, np: Vec3) -> bool {
+    match k.normal.and_then(|c| c.get(j)) {
+        Some(n) if np != Vec3::ZERO => n.dot(np) >= SAME_FACE_COS,
+        _ => true,
+    }
+}
+
 /// Whether texel `j` of key `k` (its texel `tj`) shows the surface of the lookup `d` (from
-/// the base view, length `l`) of object `o`: the same object, and its distance agrees within
+/// the base view, length `l`) of object `o` whose surface normal is `np`: the same object,
+/// facing alike ([`same_face`]), and its distance agrees within
 /// the relative tolerance `tol`, or (where the key has normals) the texel's centre point lies
 /// on the plane through the lookup's point with the texel's normal, within `tol · l`. A
 /// surface seen at a grazing angle changes distance by more than the tolerance from one
 /// texel to the next; without the plane the bilinear footprint would lose those taps, and the
 /// lighting would show the cube's texels as blocks (docs/architecture.md, "Reconstruction").
 #[inline]
-fn same_surface(k: &FastKey<'_>, tj: &Texel, j: usize, o: u32, d: Vec3, l: f32, tol: f32) -> bool {
-    if tj.id != o {
+fn same_surface(
+    k: &FastKey<'_>,
+    tj: &Texel,
+    j: usize,
+    (o, np): (u32, Vec3),
+    d: Vec3,
+    l: f32,
+    tol: f32,
+) -> bool {
+    if tj.id != o || !same_face(k, j, np) {
         return false;
     }
     if (tj.distance - l).abs() <= tol * l {
@@ -544,11 +623,18 @@ fn same_surface(k: &FastKey<'_>, tj: &Texel, j: usize, o: u32, d: Vec3, l: f32, 
 /// The radiance of key `k` in direction `d` (length `l`) filtered over the bilinear taps that
 /// show the lookup's surface of object `o` ([`same_surface`]) or are the nearest texel `t`,
 /// as radiance and 1; and its second colour filtered alike.
-fn filtered(k: &FastKey<'_>, d: Vec3, t: usize, o: u32, l: f32, tol: f32) -> (Vec4, Option<Vec3>) {
+fn filtered(
+    k: &FastKey<'_>,
+    d: Vec3,
+    t: usize,
+    (o, np): (u32, Vec3),
+    l: f32,
+    tol: f32,
+) -> (Vec4, Option<Vec3>) {
     let (mut acc, mut acc2) = (Vec4::ZERO, Vec3::ZERO);
     for (i, w) in sample::bilinear_taps(k.face, d) {
         let Some(tx) = k.texels.get(i) else { continue };
-        if w > 0.0 && (i == t || same_surface(k, tx, i, o, d, l, tol)) {
+        if w > 0.0 && (i == t || same_surface(k, tx, i, (o, np), d, l, tol)) {
             acc += tx.radiance * w;
             if let Some(c) = k.second.and_then(|c| c.get(i)) {
                 acc2 += *c * w;
@@ -580,10 +666,10 @@ pub(crate) fn at_point(k: &FastKey<'_>, p: Vec3, o: u32, tol: f32) -> Option<(Ve
     }
     let t = cube::direction_to_texel(k.face, d);
     let tx = k.texels.get(t)?;
-    if !same_surface(k, tx, t, o, d, l, tol) {
+    if !same_surface(k, tx, t, (o, Vec3::ZERO), d, l, tol) {
         return None;
     }
-    let (c, second) = filtered(k, d, t, o, l, tol);
+    let (c, second) = filtered(k, d, t, (o, Vec3::ZERO), l, tol);
     Some((c.truncate(), second))
 }
 

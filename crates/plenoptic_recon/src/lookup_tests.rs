@@ -110,15 +110,58 @@ fn a_grazing_surface_keeps_its_neighbouring_texels() {
     let l = d.length();
     let (near, far) = (texels[next].distance, texels[t].distance);
     assert!((near - far).abs() > 0.03 * l, "{near} {far}: not grazing");
-    assert!(same_surface(&with, &texels[next], next, 1, d, l, 0.03));
-    assert!(!same_surface(&without, &texels[next], next, 1, d, l, 0.03));
+    assert!(same_surface(
+        &with,
+        &texels[next],
+        next,
+        (1, Vec3::ZERO),
+        d,
+        l,
+        0.03
+    ));
+    assert!(!same_surface(
+        &without,
+        &texels[next],
+        next,
+        (1, Vec3::ZERO),
+        d,
+        l,
+        0.03
+    ));
     // Another object, and the same object half a metre below the floor's plane.
-    assert!(!same_surface(&with, &texels[next], next, 2, d, l, 0.03));
+    assert!(!same_surface(
+        &with,
+        &texels[next],
+        next,
+        (2, Vec3::ZERO),
+        d,
+        l,
+        0.03
+    ));
     let behind = Texel {
         distance: near + 0.5 / (cube::texel_direction(face, next).y.abs()),
         ..texels[next]
     };
-    assert!(!same_surface(&with, &behind, next, 1, d, l, 0.03));
+    assert!(!same_surface(
+        &with,
+        &behind,
+        next,
+        (1, Vec3::ZERO),
+        d,
+        l,
+        0.03
+    ));
+    // The face test: the floor's texel serves a pixel whose surface faces up (the floor),
+    // not one facing sideways (a wall's reveal at the floor's distance) or down (the floor's
+    // underside, the same triangles seen from below); without the key's normals, or without
+    // the pixel's, every face passes.
+    let face = |np: Vec3, key: &FastKey<'_>| same_surface(key, &texels[t], t, (1, np), d, l, 0.03);
+    assert!(face(Vec3::Y, &with));
+    assert!(face(Vec3::new(0.0, 0.8, 0.6), &with));
+    assert!(!face(Vec3::X, &with));
+    assert!(!face(-Vec3::Y, &with));
+    assert!(same_face(&without, t, -Vec3::Y));
+    assert!(face(Vec3::ZERO, &with));
     // A single point's lookup (a reflected ray's hit) answers on the floor and not for
     // another object or a point half a metre above it.
     let (c, second) = at_point(&with, d, 1, 0.03).unwrap();

@@ -87,6 +87,16 @@ impl Rows<'_> {
         self.slots(&mut s.slot, y, obj, out);
     }
 
+    /// The surface normals of the pixels whose proxy triangles are `prims`, in the order
+    /// `s`'s rays were set ([`Scratch::set_normals`]); none (no face test) without a
+    /// rasterized mask.
+    pub fn normals(&self, s: &mut Scratch, prims: impl ExactSizeIterator<Item = u32>) {
+        match self.source {
+            MaskSource::Raster(tris) => s.set_normals(self.basis, &tris.normals, prims),
+            MaskSource::Mask(_) => s.clear_normals(prims.len()),
+        }
+    }
+
     /// Row `y`'s camera-space depths `dep` as distances along the rays (∞ where nothing is),
     /// as [`Rows::prepare`] leaves them.
     pub fn distances(&self, y: usize, dep: &mut [f32], obj: &[u32]) {

@@ -194,6 +194,10 @@ var<private> pixel_emission: vec3<f32>;
 // The drawn mesh's local_from_world (Bevy's mesh uniform): M_o(t)⁻¹ for a proxy placed at
 // the camera's time, the app mesh's own inverse transform for a lit mesh.
 var<private> local_from_world: mat4x4<f32>;
+// The fragment's surface normal facing the eye, in the frame its points are looked up from
+// (the object's own for an animated one, as object_point): the lookups' face test
+// (lookup.wgsl's same_face). Zero: no face test.
+var<private> face_normal: vec3<f32>;
 
 // Whether the camera's flags have `bit` (VIEW_*).
 fn view_has(bit: u32) -> bool {

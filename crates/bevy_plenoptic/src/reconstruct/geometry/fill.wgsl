@@ -17,7 +17,7 @@
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
 #import plenoptic::geometry::bindings::{
-    cam, params, image_frame, image_mode, view_has, lit, pixel_albedo,
+    cam, params, image_frame, image_mode, view_has, lit, pixel_albedo, face_normal, local_from_world,
     non_diffuse_weight, VIEW_SCREEN_FILL, object_has, OBJECT_OPAQUE_PASS, glazing,
 }
 #ifdef PLENOPTIC_SCREEN_FILL
@@ -185,7 +185,15 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     if image_mode() {
         return image_frame_texel(in.position.xy);
     }
+    // The face test of the fragment's own lookups (lookup.wgsl's same_face): its surface
+    // normal facing the eye, in its lookups' frame; the ring's points are other pixels'.
+    let facing = select(-nrm, nrm, dot(nrm, eye - p) >= 0.0);
+    face_normal = facing;
+    if params.motion_slot >= 0 {
+        face_normal = normalize((local_from_world * vec4<f32>(facing, 0.0)).xyz);
+    }
     let own = reconstruct(p, eye, object);
+    face_normal = vec3<f32>(0.0);
     let deferred = screen_fill();
     if own.w > 0.0 {
         if deferred {

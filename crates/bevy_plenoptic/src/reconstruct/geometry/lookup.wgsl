@@ -12,7 +12,7 @@
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
-    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, lit, view_has, VIEW_BILINEAR,
+    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, face_normal, lit, view_has, VIEW_BILINEAR,
     blended_geometry, blended_terms, PAIR_CHANGING,
 }
 
@@ -77,12 +77,27 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
     return normalize(v);
 }
 
+// plenoptic_recon's SAME_FACE_COS.
+const SAME_FACE_COS: f32 = 0.5;
+
+// Whether a key texel whose packed normal is `normal` faces as the lookup's surface does,
+// whose normal is `np` in the key's frame (plenoptic_recon's lookup::same_face): within
+// SAME_FACE_COS, or no test where the key has no normals or `np` is zero.
+fn same_face(normal: u32, np: vec3<f32>, normals: bool) -> bool {
+    if !normals || all(np == vec3<f32>(0.0)) {
+        return true;
+    }
+    let nrm = oct_decode(max(unpack2x16snorm(normal), vec2<f32>(-1.0)));
+    return dot(nrm, np) >= SAME_FACE_COS;
+}
+
 // Whether key texel `c` (its key-texture texel `texel`) shows the surface of the lookup `d`
-// (length `l`) of `object`: the same object at the distance within `tol · l`, or, where the
-// key has normals (`normals`), its centre point on the plane through the lookup's point with
-// the texel's normal within `tol · l` (plenoptic_recon's lookup::same_surface).
-fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32>, l: f32, tol: f32, normals: bool) -> bool {
-    if texel.z != object {
+// (length `l`, surface normal `np`) of `object`: the same object facing alike (same_face) at
+// the distance within `tol · l`, or, where the key has normals (`normals`), its centre point
+// on the plane through the lookup's point with the texel's normal within `tol · l`
+// (plenoptic_recon's lookup::same_surface).
+fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32>, np: vec3<f32>, l: f32, tol: f32, normals: bool) -> bool {
+    if texel.z != object || !same_face(texel.w, np, normals) {
         return false;
     }
     let dc = bitcast<f32>(texel.y);
@@ -101,7 +116,7 @@ fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32
 // nearest texel `t`, whose key texel `nearest` the caller has loaded (plenoptic_recon's
 // lookup::filtered). Each tap is loaded on its own: the path of a footprint across a face
 // seam (gathered_filter takes the others).
-fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> mat2x3<f32> {
+fn filtered(layer0: u32, n: u32, d: vec3<f32>, np: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> mat2x3<f32> {
     var acc = mat2x3<f32>();
     var aw = 0.0;
     for (var k = 0u; k < 4u; k++) {
@@ -117,7 +132,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>,
         }
         tally(C_LOADS_16, 1u);
         let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
-        if same_surface(c, n, texel, object, d, l, tol, normals) {
+        if same_surface(c, n, texel, object, d, np, l, tol, normals) {
             acc += colour(c, layer0, texel) * tap.w;
             aw += tap.w;
         }
@@ -154,6 +169,9 @@ struct Lookup {
     dist: f32,
     // The key texel in direction d: (column, row, face).
     t: vec3<u32>,
+    // The point's surface normal in the key's frame (face_normal carried; zero: no face
+    // test).
+    np: vec3<f32>,
 }
 
 // Lookup k of the point whose `object_point` is `local` (of an object with motion slot
@@ -166,6 +184,10 @@ fn lookup_of(local: vec4<f32>, k: u32, n: u32, slot: f32) -> Lookup {
     if l.ok {
         l.t = cube_texel(l.d, n);
     }
+    l.np = face_normal;
+    if slot >= 0.0 && any(face_normal != vec3<f32>(0.0)) {
+        l.np = normalize((cam.motion[u32(slot) * MAX_LOOKUPS + k] * vec4<f32>(face_normal, 0.0)).xyz);
+    }
     return l;
 }
 
@@ -174,6 +196,9 @@ fn lookup_of(local: vec4<f32>, k: u32, n: u32, slot: f32) -> Lookup {
 // agrees within `tol`, or, on a key with normals (grazing surfaces), the distance to the
 // texel's surface plane along the lookup direction does (plenoptic_recon's lookup test).
 fn nearest_accepts(l: Lookup, n: u32, dc: f32, normal: u32, tol: f32, normals: bool) -> bool {
+    if !same_face(normal, l.np, normals) {
+        return false;
+    }
     if abs(dc - l.dist) <= tol * l.dist {
         return true;
     }
@@ -206,7 +231,7 @@ fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bo
     if fp.inside {
         return Weighted(gathered_filter(l, fp, layer0, n, object, tol, normals), 1.0);
     }
-    return Weighted(filtered(layer0, n, l.d, l.t, texel, object, l.dist, tol, normals), 1.0);
+    return Weighted(filtered(layer0, n, l.d, l.np, l.t, texel, object, l.dist, tol, normals), 1.0);
 }
 
 // Tap k's lane of a gather (taps in bilinear_tap's order (0,0), (1,0), (0,1), (1,1); a
@@ -221,8 +246,8 @@ fn lane(v: vec4<u32>, k: u32) -> u32 {
 }
 
 // A footprint's geometry from gathers: its object ids and distances (two gathers), and its
-// normals only where a tap of `object` misses the distance test of lookup `l` on a key with
-// normals (else zero). `tex`: the key texture, or a camera's blended keys (blend.rs).
+// normals where the lookup has a face test or a tap of `object` misses the distance test of
+// lookup `l`, on a key with normals (else zero). `tex`: the key texture, or a camera's blended keys (blend.rs).
 struct Gathered {
     ids: vec4<u32>,
     dists: vec4<u32>,
@@ -235,7 +260,8 @@ fn gather_geometry(tex: texture_2d_array<u32>, uv: vec2<f32>, layer: u32, l: Loo
     g.ids = textureGather(2, tex, cube_sampler, uv, layer);
     g.dists = textureGather(1, tex, cube_sampler, uv, layer);
     let fd = bitcast<vec4<f32>>(g.dists);
-    if normals && any((g.ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist))) {
+    let face_test = any(l.np != vec3<f32>(0.0));
+    if normals && (face_test || any((g.ids == vec4<u32>(object)) & (abs(fd - l.dist) > vec4<f32>(tol * l.dist)))) {
         tally(C_GATHERS, 1u);
         g.nrms = textureGather(3, tex, cube_sampler, uv, layer);
     }
@@ -256,7 +282,7 @@ fn filter_taps(l: Lookup, fp: Footprint, n: u32, object: u32, tol: f32, normals:
         let w = tap_weight(fp.f, k);
         let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
         let texel = vec4<u32>(0u, lane(g.dists, k), lane(g.ids, k), lane(g.nrms, k));
-        if k == kn || same_surface(c, n, texel, object, l.d, l.dist, tol, normals) {
+        if k == kn || same_surface(c, n, texel, object, l.d, l.np, l.dist, tol, normals) {
             acc += terms[k] * w;
             aw += w;
         }
