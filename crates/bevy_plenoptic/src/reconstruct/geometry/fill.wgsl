@@ -161,6 +161,46 @@ fn neighbour_point(c: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>) -> vec4<f32> {
 #endif
 }
 
+// The surface normal at the point `q` pixel `c` shows, from its nearer neighbours' points
+// in the depth prepass (one-sided differences towards the neighbour nearer `q`, so that a
+// depth step beside the pixel does not bend it); zero without a prepass or a neighbour.
+fn neighbour_normal(c: vec2<f32>, q: vec3<f32>) -> vec3<f32> {
+#ifdef DEPTH_PREPASS
+    var axes: array<vec3<f32>, 2>;
+    for (var a = 0; a < 2; a++) {
+        let step = select(vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), a == 0);
+        let plus = neighbour_point(c + step, q, vec3<f32>(0.0));
+        let minus = neighbour_point(c - step, q, vec3<f32>(0.0));
+        let dp = select(vec3<f32>(1e30), plus.xyz - q, plus.w > 0.0);
+        let dm = select(vec3<f32>(1e30), q - minus.xyz, minus.w > 0.0);
+        axes[a] = select(dm, dp, dot(dp, dp) <= dot(dm, dm));
+        if dot(axes[a], axes[a]) > 1e29 {
+            return vec3<f32>(0.0);
+        }
+    }
+    let n = cross(axes[0], axes[1]);
+    if dot(n, n) < 1e-20 {
+        return vec3<f32>(0.0);
+    }
+    return normalize(n);
+#else
+    return vec3<f32>(0.0);
+#endif
+}
+
+// `n` turned to face the eye from point `p` (zero stays zero).
+fn facing_eye(n: vec3<f32>, p: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
+    return select(-n, n, dot(n, eye - p) >= 0.0);
+}
+
+// World normal `n` in the frame this object's points are looked up from (object_point's).
+fn lookup_frame(n: vec3<f32>) -> vec3<f32> {
+    if params.motion_slot < 0 || all(n == vec3<f32>(0.0)) {
+        return n;
+    }
+    return normalize((local_from_world * vec4<f32>(n, 0.0)).xyz);
+}
+
 // The image-mode frame's texel of the fragment's pixel.
 fn image_frame_texel(position: vec2<f32>) -> vec4<f32> {
     let size = textureDimensions(image_frame);
@@ -185,15 +225,11 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     if image_mode() {
         return image_frame_texel(in.position.xy);
     }
-    // The face test of the fragment's own lookups (lookup.wgsl's same_face): its surface
-    // normal facing the eye, in its lookups' frame; the ring's points are other pixels'.
-    let facing = select(-nrm, nrm, dot(nrm, eye - p) >= 0.0);
-    face_normal = facing;
-    if params.motion_slot >= 0 {
-        face_normal = normalize((local_from_world * vec4<f32>(facing, 0.0)).xyz);
-    }
+    // The face test of the lookups (lookup.wgsl's same_face): the fragment's surface normal
+    // facing the eye, in its lookups' frame (fragment_fill keeps it for ring points on the
+    // fragment's plane).
+    face_normal = lookup_frame(facing_eye(nrm, p, eye));
     let own = reconstruct(p, eye, object);
-    face_normal = vec3<f32>(0.0);
     let deferred = screen_fill();
     if own.w > 0.0 {
         if deferred {
@@ -228,6 +264,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
 // this object; their mean, shaded with this fragment's albedo (w = 0: none).
 fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let radius = i32(cam.fill_radius);
+    let own_face = face_normal;
     for (var r = 1; r <= radius; r++) {
         var sum = mat2x3<f32>();
         var count = 0.0;
@@ -247,6 +284,14 @@ fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>
                 }
                 if q.w == 0.0 {
                     continue;
+                }
+                // A ring pixel's lookups were face-tested with its own normal: the
+                // fragment's where the pixel lies on the fragment's plane, else its surface's
+                // from the depth prepass.
+                let on_plane = abs(dot(q.xyz - p, nrm)) <= 0.01 * distance(q.xyz, eye);
+                face_normal = own_face;
+                if !on_plane {
+                    face_normal = lookup_frame(facing_eye(neighbour_normal(c, q.xyz), q.xyz, eye));
                 }
                 tally(C_FILL_LOOKUPS, 1u);
                 let got = reconstruct(q.xyz, eye, object);
