@@ -154,14 +154,16 @@ impl<'s> RayCastMask<'s> {
             .par_chunks_mut(w)
             .zip(mask.position.par_chunks_mut(w))
             .zip(mask.depth.par_chunks_mut(w))
+            .zip(mask.normal.par_chunks_mut(w))
             .enumerate()
-            .for_each(|(y, ((o, p), d))| {
+            .for_each(|(y, (((o, p), d), n))| {
                 for x in 0..w {
                     let dir = b.direction(x as f32 + 0.5, y as f32 + 0.5);
                     if let Some(hit) = placed.intersect(&Ray::new(b.position, dir)) {
                         o[x] = self.pack_ids.get(hit.object as usize).copied().unwrap_or(0);
                         p[x] = hit.position;
                         d[x] = hit.distance;
+                        n[x] = hit.geometric_normal;
                     }
                 }
             });

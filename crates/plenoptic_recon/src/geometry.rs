@@ -634,7 +634,7 @@ impl Lookups<'_> {
             self.rows.slots(&mut s.slot, y, obj, Some((rad, cls)));
         } else {
             self.rows.prepare(s, y, dep, obj, Some((rad, cls)));
-            self.rows.normals(s, prim.iter().copied());
+            self.rows.normals(s, y, None, prim);
         }
         let mut between_count = 0;
         xs.clear();
@@ -656,7 +656,7 @@ impl Lookups<'_> {
         let gathered = anchors.is_some();
         let lanes = if gathered && !xs.is_empty() {
             packed.gather_rays(self.rows.basis, y, xs, dep, &s.slot);
-            self.rows.normals(packed, xs.iter().map(|&x| prim[x]));
+            self.rows.normals(packed, y, Some(xs), prim);
             packed
         } else {
             s

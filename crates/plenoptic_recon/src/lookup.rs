@@ -296,19 +296,20 @@ impl Scratch {
         normals: &[Vec3],
         prims: impl Iterator<Item = u32>,
     ) {
-        for (i, prim) in prims.enumerate() {
+        self.set_world_normals(prims.map(|prim| {
             let c = normals.get(prim as usize).copied().unwrap_or_default();
-            let n = b.right * c.x + b.up * c.y + b.forward * c.z;
+            b.right * c.x + b.up * c.y + b.forward * c.z
+        }));
+    }
+
+    /// The surface normals of the first pixels from world normals either side (zero:
+    /// unknown), turned to face the eye against the pixels' ray directions (which must be
+    /// set).
+    pub fn set_world_normals(&mut self, normals: impl Iterator<Item = Vec3>) {
+        for (i, n) in normals.enumerate() {
             let d = Vec3::new(self.dir[0][i], self.dir[1][i], self.dir[2][i]);
             let n = if n.dot(d) > 0.0 { -n } else { n };
             (self.n[0][i], self.n[1][i], self.n[2][i]) = (n.x, n.y, n.z);
-        }
-    }
-
-    /// Clears the surface normals of the first `n` pixels (no face test).
-    pub fn clear_normals(&mut self, n: usize) {
-        for c in &mut self.n {
-            c[..n].fill(0.0);
         }
     }
 

@@ -248,6 +248,9 @@ pub struct GeometryMask {
     pub position: Vec<Vec3>,
     /// Distance from the eye along the ray (∞ where none).
     pub depth: Vec<f32>,
+    /// The surface's geometric normal per pixel (world, unit, either side; zero where none or
+    /// unknown, which leaves the lookups' face test out there).
+    pub normal: Vec<Vec3>,
 }
 
 impl GeometryMask {
@@ -260,6 +263,7 @@ impl GeometryMask {
             object: vec![0; n],
             position: vec![Vec3::ZERO; n],
             depth: vec![f32::INFINITY; n],
+            normal: vec![Vec3::ZERO; n],
         }
     }
 }

@@ -254,10 +254,12 @@ pub(crate) fn rasterize(
         .par_chunks_mut(w * BAND)
         .zip(mask.depth.par_chunks_mut(w * BAND))
         .zip(mask.position.par_chunks_mut(w * BAND))
+        .zip(mask.normal.par_chunks_mut(w * BAND))
         .enumerate()
-        .for_each(|(band, ((obj, dep), pos))| {
+        .for_each(|(band, (((obj, dep), pos), nrm))| {
             let y0 = band * BAND;
-            raster_band(&tris, w, y0, dep, obj, None);
+            let mut prim = vec![u32::MAX; dep.len()];
+            raster_band(&tris, w, y0, dep, obj, Some(&mut prim));
             for (j, (z, p)) in dep.iter_mut().zip(pos.iter_mut()).enumerate() {
                 if z.is_finite() {
                     let (px, py) = ((j % w) as f32 + 0.5, (y0 + j / w) as f32 + 0.5);
@@ -265,6 +267,12 @@ pub(crate) fn rasterize(
                     let dist = *z / dir.dot(b.forward);
                     *z = dist;
                     *p = b.position + dir * dist;
+                    let c = tris
+                        .normals
+                        .get(prim[j] as usize)
+                        .copied()
+                        .unwrap_or_default();
+                    nrm[j] = b.right * c.x + b.up * c.y + b.forward * c.z;
                 }
             }
         });

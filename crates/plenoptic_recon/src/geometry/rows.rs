@@ -87,13 +87,23 @@ impl Rows<'_> {
         self.slots(&mut s.slot, y, obj, out);
     }
 
-    /// The surface normals of the pixels whose proxy triangles are `prims`, in the order
-    /// `s`'s rays were set ([`Scratch::set_normals`]); none (no face test) without a
-    /// rasterized mask.
-    pub fn normals(&self, s: &mut Scratch, prims: impl ExactSizeIterator<Item = u32>) {
+    /// The surface normals of row `y`'s pixels whose proxy triangles are `prims` (the whole
+    /// row, or `xs` gathered), in the order `s`'s rays were set ([`Scratch::set_normals`]);
+    /// from the mask's own normals where the mask was given.
+    pub fn normals(&self, s: &mut Scratch, y: usize, xs: Option<&[usize]>, prims: &[u32]) {
         match self.source {
-            MaskSource::Raster(tris) => s.set_normals(self.basis, &tris.normals, prims),
-            MaskSource::Mask(_) => s.clear_normals(prims.len()),
+            MaskSource::Raster(tris) => match xs {
+                Some(xs) => s.set_normals(self.basis, &tris.normals, xs.iter().map(|&x| prims[x])),
+                None => s.set_normals(self.basis, &tris.normals, prims.iter().copied()),
+            },
+            MaskSource::Mask(m) => {
+                let row = &m.normal[y * self.width..(y + 1) * self.width];
+                let pick = |x: usize| row.get(x).copied().unwrap_or_default();
+                match xs {
+                    Some(xs) => s.set_world_normals(xs.iter().map(|&x| pick(x))),
+                    None => s.set_world_normals((0..self.width).map(pick)),
+                }
+            }
         }
     }
 

@@ -182,7 +182,7 @@ impl AnchorPass<'_> {
                         xs.clear();
                         xs.extend((0..w).step_by(2).filter(|&x| s.slot[x] != NO_SLOT));
                         packed.gather_rays(rows.basis, y0 + r, xs, dep, &s.slot);
-                        rows.normals(packed, xs.iter().map(|&x| prim[r * w + x]));
+                        rows.normals(packed, y0 + r, Some(xs), &prim[r * w..(r + 1) * w]);
                         lookup_some(self.shade, packed, true, xs, obj, |accepted, x, c, c2| {
                             if c.w > 0.0 {
                                 let cell = &mut line[x / 2];
