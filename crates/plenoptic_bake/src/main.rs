@@ -8,7 +8,8 @@
 //! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
 //!                    [--exposure E]
 //! plenoptic render PACK --path PATH.json [--mode image|volume|geometry]
-//!     [--shading materials|radiance] [--reflections shaded|marched] --out DIR
+//!     [--shading materials|radiance] [--reflections shaded|marched] [--supersampling N]
+//!     [--frames N] [--exposure E] --out DIR
 //! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
 //!                   [--plot OUT.svg]
 //! ```
@@ -142,6 +143,10 @@ enum Command {
         /// included, as the tour's `--results` frames are) instead of every frame.
         #[arg(long)]
         frames: Option<usize>,
+        /// Exposure of the PNGs (default: automatic from the first frame; printed, so that a
+        /// reference can be shown at the same one).
+        #[arg(long)]
+        exposure: Option<f32>,
         /// Output directory.
         #[arg(long, default_value = "frames")]
         out: PathBuf,
@@ -267,6 +272,7 @@ fn run(command: Command) -> Result<()> {
             reflections,
             supersampling,
             frames,
+            exposure,
             out,
         } => {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
@@ -276,6 +282,7 @@ fn run(command: Command) -> Result<()> {
                 shading: parse_shading(&shading)?,
                 shaded_reflections: parse_reflections(&reflections)?,
                 supersampling,
+                exposure,
             };
             cmd_render(&pack, &path, (mode, frames), look, &out)
         }
@@ -328,13 +335,14 @@ fn cmd_bake(recipe_path: &Path, options: &BakeOptions) -> Result<()> {
     Ok(())
 }
 
-/// How `plenoptic render` shows the frames (its `--shading`, `--reflections` and
-/// `--supersampling`).
+/// How `plenoptic render` shows the frames (its `--shading`, `--reflections`,
+/// `--supersampling` and `--exposure`).
 #[derive(Clone, Copy)]
 struct Look {
     shading: plenoptic_recon::Shading,
     shaded_reflections: bool,
     supersampling: u32,
+    exposure: Option<f32>,
 }
 
 /// `--shading`: materials or radiance.
@@ -381,16 +389,18 @@ fn cmd_render(
                 mode,
                 progress: true,
                 frames,
+                exposure: look.exposure,
                 ..Default::default()
             },
         )
     };
     let summary = render().map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
     out!(
-        "{} frames in {} ({:.1} ms per frame), report {}",
+        "{} frames in {} ({:.1} ms per frame, exposure {}), report {}",
         summary.frames,
         out.display(),
         summary.mean_ms,
+        summary.exposure,
         summary.report_csv.display()
     );
     Ok(())

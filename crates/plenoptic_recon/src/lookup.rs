@@ -285,27 +285,10 @@ impl Scratch {
         }
     }
 
-    /// The surface normals of the first pixels, one per item of `prims` (the pixels' proxy
-    /// triangles: indices into `normals`, camera-space normals either side, as
-    /// [`crate::raster::Projected::normals`] holds them): in world space, turned to face the
-    /// eye against the pixels' ray directions (which must be set). A pixel past `normals`
-    /// (no triangle) gets zero, and no face test.
-    pub fn set_normals(
-        &mut self,
-        b: &CameraBasis,
-        normals: &[Vec3],
-        prims: impl Iterator<Item = u32>,
-    ) {
-        self.set_world_normals(prims.map(|prim| {
-            let c = normals.get(prim as usize).copied().unwrap_or_default();
-            b.right * c.x + b.up * c.y + b.forward * c.z
-        }));
-    }
-
     /// The surface normals of the first pixels from world normals either side (zero:
-    /// unknown), turned to face the eye against the pixels' ray directions (which must be
-    /// set).
-    pub fn set_world_normals(&mut self, normals: impl Iterator<Item = Vec3>) {
+    /// unknown, no face test), turned to face the eye against the pixels' ray directions
+    /// (which must be set).
+    pub fn set_normals(&mut self, normals: impl Iterator<Item = Vec3>) {
         for (i, n) in normals.enumerate() {
             let d = Vec3::new(self.dir[0][i], self.dir[1][i], self.dir[2][i]);
             let n = if n.dot(d) > 0.0 { -n } else { n };

@@ -10,7 +10,7 @@
 use glam::{Affine3A, Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraBasis};
 use crate::proxy::{GeometryMask, TriangleMesh};
 
 const NEAR: f32 = 1e-3;
@@ -39,6 +39,16 @@ pub(crate) struct Projected {
     /// Per source: the triangle's unit normal in camera space (either side; zero when
     /// degenerate).
     pub normals: Vec<Vec3>,
+}
+
+impl Projected {
+    /// The world-space normal (either side; zero for no triangle or a degenerate one) of
+    /// the triangle `prim` that [`raster_band`] wrote for a pixel, for the camera basis `b` the
+    /// triangles were projected with.
+    pub(crate) fn world_normal(&self, b: &CameraBasis, prim: u32) -> Vec3 {
+        let c = self.normals.get(prim as usize).copied().unwrap_or_default();
+        b.right * c.x + b.up * c.y + b.forward * c.z
+    }
 }
 
 /// Places, clips and projects `objects` for `camera`.
@@ -267,12 +277,7 @@ pub(crate) fn rasterize(
                     let dist = *z / dir.dot(b.forward);
                     *z = dist;
                     *p = b.position + dir * dist;
-                    let c = tris
-                        .normals
-                        .get(prim[j] as usize)
-                        .copied()
-                        .unwrap_or_default();
-                    nrm[j] = b.right * c.x + b.up * c.y + b.forward * c.z;
+                    nrm[j] = tris.world_normal(&b, prim[j]);
                 }
             }
         });

@@ -91,19 +91,17 @@ impl Rows<'_> {
     /// row, or `xs` gathered), in the order `s`'s rays were set ([`Scratch::set_normals`]);
     /// from the mask's own normals where the mask was given.
     pub fn normals(&self, s: &mut Scratch, y: usize, xs: Option<&[usize]>, prims: &[u32]) {
-        match self.source {
-            MaskSource::Raster(tris) => match xs {
-                Some(xs) => s.set_normals(self.basis, &tris.normals, xs.iter().map(|&x| prims[x])),
-                None => s.set_normals(self.basis, &tris.normals, prims.iter().copied()),
-            },
-            MaskSource::Mask(m) => {
-                let row = &m.normal[y * self.width..(y + 1) * self.width];
-                let pick = |x: usize| row.get(x).copied().unwrap_or_default();
-                match xs {
-                    Some(xs) => s.set_world_normals(xs.iter().map(|&x| pick(x))),
-                    None => s.set_world_normals((0..self.width).map(pick)),
-                }
-            }
+        let normal = |x: usize| match self.source {
+            MaskSource::Raster(tris) => tris.world_normal(self.basis, prims[x]),
+            MaskSource::Mask(m) => m
+                .normal
+                .get(y * self.width + x)
+                .copied()
+                .unwrap_or_default(),
+        };
+        match xs {
+            Some(xs) => s.set_normals(xs.iter().map(|&x| normal(x))),
+            None => s.set_normals((0..self.width).map(normal)),
         }
     }
 
