@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use plenoptic_scene::recipe::{BakeRecipe, Recipe};
-use plenoptic_scene::{Node, Scene, Trs};
+use plenoptic_scene::{LightGroups, Node, Scene, Trs};
 
 use crate::error::Result;
 
@@ -18,8 +18,9 @@ pub fn load_recipe(path: &Path) -> Result<(BakeRecipe, Scene)> {
     Ok((recipe, scene))
 }
 
-/// Loads every scene file of `recipe`, joins them into one scene, and applies the recipe's
-/// sun and sky ([`crate::daylight`]).
+/// Loads every scene file of `recipe`, joins them into one scene, applies the recipe's sun
+/// and sky ([`crate::daylight`]) and assigns its emitters to the recipe's light groups
+/// ([`plenoptic_scene::groups`]).
 pub fn load_scenes(recipe: &BakeRecipe) -> Result<Scene> {
     let mut out = Scene::default();
     for source in &recipe.scenes {
@@ -27,6 +28,7 @@ pub fn load_scenes(recipe: &BakeRecipe) -> Result<Scene> {
         append(&mut out, scene, source.transform, &source.path);
     }
     crate::daylight::apply(&mut out, recipe)?;
+    out.light_groups = LightGroups::resolve(&out, &recipe.light_groups, &recipe.name)?;
     Ok(out)
 }
 

@@ -45,6 +45,7 @@
 pub mod anim;
 pub mod builder;
 pub mod error;
+pub mod groups;
 pub mod import;
 pub mod model;
 pub mod recipe;
@@ -53,5 +54,6 @@ mod util;
 
 pub use anim::{Interpolation, Key, Track, TrsTrack};
 pub use error::{RecipeError, Result, SceneError};
+pub use groups::{EmitterWeights, LightGroups};
 pub use import::{load, load_slice};
 pub use model::*;

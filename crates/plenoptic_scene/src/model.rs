@@ -271,6 +271,10 @@ pub struct Scene {
     pub cameras: Vec<CameraDef>,
     /// Warnings from import (unsupported features, named by node).
     pub warnings: Vec<String>,
+    /// Which light group each emitter belongs to ([`crate::groups`]); empty: one group.
+    pub light_groups: crate::groups::LightGroups,
+    /// Multipliers of the sun and the environment ([`Scene::relit`]); one by default.
+    pub weights: crate::groups::EmitterWeights,
 }
 
 impl Scene {
@@ -350,8 +354,18 @@ impl Scene {
         self.node_is_animated(self.objects[id as usize].node)
     }
 
-    /// Light `light` placed at time `t`: the sun follows its track when it has one.
+    /// Light `light` placed at time `t`: the sun follows its track when it has one, times
+    /// [`EmitterWeights::sun`](crate::groups::EmitterWeights::sun).
     pub fn placed_light(&self, light: usize, t: f32) -> PlacedLight {
+        let mut placed = self.placed_light_unweighted(light, t);
+        if self.sun.as_ref().is_some_and(|s| s.light == light) {
+            placed.emitted *= self.weights.sun;
+        }
+        placed
+    }
+
+    /// [`Scene::placed_light`] before the sun's weight.
+    fn placed_light_unweighted(&self, light: usize, t: f32) -> PlacedLight {
         let l = &self.lights[light];
         let m = self.node_transform(l.node, t);
         let mut placed = PlacedLight {
@@ -381,9 +395,15 @@ impl Scene {
         Some((-p.direction, p.emitted))
     }
 
-    /// The environment at time `t` (a sky, and its ground, lit by the sun then).
+    /// The environment at time `t` (a sky, and its ground, lit by the sun then), times
+    /// [`EmitterWeights::sky`](crate::groups::EmitterWeights::sky). The ground is lit by the
+    /// sun at its own intensity: it is part of the sky's light group.
     pub fn environment_at(&self, t: f32) -> PlacedEnvironment {
-        self.environment.at_lit(self.sun_at(t))
+        let sun = self.sun.as_ref().map(|s| {
+            let p = self.placed_light_unweighted(s.light, t);
+            (-p.direction, p.emitted)
+        });
+        self.environment.at_lit(sun).scaled(self.weights.sky)
     }
 
     /// Whether the environment changes over time: a sky whose sun moves or changes.
@@ -401,21 +421,22 @@ impl Scene {
 
     /// The sun over `[start, end]` as the runtime needs it: the sun study's track, or the
     /// sun light sampled at `samples` times (one sample when it does not move). `None`
-    /// without a sun.
+    /// without a sun. The sun at its own intensity, whatever [`Scene::weights`] says.
     pub fn sun_track(&self, start: f32, end: f32, samples: usize) -> Option<SunTrack> {
         let sun = self.sun.as_ref()?;
         if let Some(track) = &sun.track {
             return Some(track.clone());
         }
         if !self.sun_is_animated() || end <= start {
-            let (d, e) = self.sun_at(start)?;
+            let p = self.placed_light_unweighted(sun.light, start);
+            let (d, e) = (-p.direction, p.emitted);
             return Some(SunTrack::fixed(d, e));
         }
         let n = samples.clamp(2, SunTrack::MAX_SAMPLES);
         let list = (0..n)
             .map(|i| {
                 let t = start + (end - start) * i as f32 / (n - 1) as f32;
-                let p = self.placed_light(sun.light, t);
+                let p = self.placed_light_unweighted(sun.light, t);
                 SunTrackSample {
                     time: t,
                     direction: -p.direction,

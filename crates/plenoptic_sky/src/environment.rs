@@ -177,7 +177,7 @@ impl Environment {
                 rotation_deg,
             } => PlacedEnvironment::Image {
                 image: Arc::clone(image),
-                intensity: *intensity,
+                intensity: Vec3::splat(*intensity),
                 to_image: Quat::from_rotation_y(rotation_deg.to_radians()),
             },
             Environment::Sky(p) => {
@@ -201,8 +201,8 @@ pub enum PlacedEnvironment {
     Image {
         /// The image.
         image: Arc<EquirectImage>,
-        /// Multiplies every texel.
-        intensity: f32,
+        /// Multiplies every texel, per channel.
+        intensity: Vec3,
         /// Turns a world direction into the image's frame.
         to_image: Quat,
     },
@@ -233,6 +233,28 @@ impl PlacedEnvironment {
             }
         }
         e.as_vec3()
+    }
+
+    /// The environment with its radiance multiplied by `weight` per channel: the sky's light
+    /// group at a colour × intensity (the `sky` emitter of a recipe's `[[light_group]]`).
+    pub fn scaled(self, weight: Vec3) -> Self {
+        if weight == Vec3::ONE {
+            return self;
+        }
+        match self {
+            PlacedEnvironment::None => PlacedEnvironment::None,
+            PlacedEnvironment::Uniform(c) => PlacedEnvironment::Uniform(c * weight),
+            PlacedEnvironment::Image {
+                image,
+                intensity,
+                to_image,
+            } => PlacedEnvironment::Image {
+                image,
+                intensity: intensity * weight,
+                to_image,
+            },
+            PlacedEnvironment::Sky(sky) => PlacedEnvironment::Sky(sky.scaled(weight)),
+        }
     }
 
     /// Linear RGB radiance arriving from unit direction `dir`.

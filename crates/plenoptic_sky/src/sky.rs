@@ -138,6 +138,16 @@ impl Sky {
         Ok(sky)
     }
 
+    /// The same sky with every radiance, its ground's included, multiplied by `weight` per
+    /// channel: a light group's colour × intensity (light transport is linear in it).
+    pub fn scaled(&self, weight: Vec3) -> Self {
+        let mut sky = *self;
+        let c = &mut sky.coefficients;
+        c.radiances = (Vec3::from_array(c.radiances) * weight).to_array();
+        c.ground = (Vec3::from_array(c.ground) * weight).to_array();
+        sky
+    }
+
     /// The sky's irradiance on a horizontal plane (ground excluded): π × the mean radiance of
     /// 512 cosine-distributed directions, one per cell of a 32 × 16 grid (Malley's method).
     fn horizontal_irradiance(&self) -> Vec3 {

@@ -56,7 +56,8 @@ impl EnvironmentUniform {
                 // `to_image` turns about +Y only: its angle, sign from the axis.
                 let (axis, angle) = to_image.to_axis_angle();
                 let angle = angle * axis.y.signum();
-                u.kind = Vec4::new(3.0, *intensity, angle.cos(), angle.sin());
+                u.kind = Vec4::new(3.0, 0.0, angle.cos(), angle.sin());
+                u.sky_radiance = intensity.extend(0.0);
             }
         }
         u

@@ -7,14 +7,14 @@ const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
 struct Environment {
-    // x: kind (0 none, 1 uniform, 2 sky, 3 image), y: image intensity, z, w: cos and sin of
-    // the image's turn about +Y.
+    // x: kind (0 none, 1 uniform, 2 sky, 3 image), y: unused, z, w: cos and sin of the
+    // image's turn about +Y.
     kind: vec4<f32>,
     // Uniform colour (xyz).
     colour: vec4<f32>,
     // The sky's 27 coefficients, A–I of R, then G, then B, four per vector.
     sky: array<vec4<f32>, 7>,
-    // Radiance scale per channel (xyz).
+    // Radiance scale per channel (xyz): the sky's, or the image's intensity.
     sky_radiance: vec4<f32>,
     // Unit direction towards the sun (xyz).
     sun: vec4<f32>,
@@ -78,7 +78,7 @@ fn equirect(e: Environment, image: texture_2d<f32>, d: vec3<f32>) -> vec3<f32> {
     let yi = i32(y0);
     let top = mix(image_texel(image, xi, yi), image_texel(image, xi + 1, yi), f.x);
     let bottom = mix(image_texel(image, xi, yi + 1), image_texel(image, xi + 1, yi + 1), f.x);
-    return mix(top, bottom, f.y) * e.kind.y;
+    return mix(top, bottom, f.y) * e.sky_radiance.xyz;
 }
 
 // The environment `e` (its image `image`, 1 × 1 when it has none) in world direction `dir`;

@@ -32,6 +32,7 @@
 //! ```
 
 pub mod daylight;
+mod groups;
 mod quality;
 
 use std::path::{Path, PathBuf};
@@ -39,6 +40,7 @@ use std::path::{Path, PathBuf};
 use glam::{EulerRot, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+pub use self::groups::{EmitterRef, LightGroupSpec, LightGroupToml, MAX_GROUPS};
 pub use self::quality::{Preset, Quality};
 use crate::error::RecipeError;
 use crate::model::Trs;
@@ -65,6 +67,9 @@ pub struct Recipe {
     /// The environment (see [`daylight`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sky: Option<daylight::SkyToml>,
+    /// Light groups (see [`LightGroupToml`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub light_group: Vec<LightGroupToml>,
 }
 
 /// One `[[scene]]` entry: a glTF file and its placement.
@@ -179,6 +184,8 @@ pub struct BakeRecipe {
     pub output: PathBuf,
     /// Sun study and sky.
     pub daylight: daylight::Daylight,
+    /// Light groups, in recipe order (empty: one group holds every emitter).
+    pub light_groups: Vec<LightGroupSpec>,
 }
 
 /// A scene file and its placement.
@@ -285,7 +292,7 @@ impl Recipe {
         name: &str,
         base_dir: &Path,
     ) -> Result<BakeRecipe, RecipeError> {
-        Self::parse(text, name)?.validate(name, base_dir)
+        Self::parse(text, name)?.validate_text(name, base_dir, Some(text))
     }
 
     /// Parses recipe text without validating it.
@@ -303,6 +310,17 @@ impl Recipe {
 
     /// Checks every value and resolves paths against `base_dir`.
     pub fn validate(&self, name: &str, base_dir: &Path) -> Result<BakeRecipe, RecipeError> {
+        self.validate_text(name, base_dir, None)
+    }
+
+    /// [`Recipe::validate`], with the recipe's `text` (when it was parsed from one) for the
+    /// lines that errors about light groups name.
+    fn validate_text(
+        &self,
+        name: &str,
+        base_dir: &Path,
+        text: Option<&str>,
+    ) -> Result<BakeRecipe, RecipeError> {
         let err = |key: &str, problem: &str| RecipeError::Invalid {
             file: name.to_owned(),
             key: key.to_owned(),
@@ -381,6 +399,7 @@ impl Recipe {
 
         let quality = self.quality.validate(&err)?;
         let daylight = daylight::validate(self.sun.as_ref(), self.sky.as_ref(), base_dir, &err)?;
+        let light_groups = groups::validate(&self.light_group, text, &err)?;
         Ok(BakeRecipe {
             name: name.to_owned(),
             scenes,
@@ -393,6 +412,7 @@ impl Recipe {
             quality,
             output: base_dir.join(&self.output),
             daylight,
+            light_groups,
         })
     }
 }
