@@ -11,6 +11,7 @@ use plenoptic_scene::recipe::BakeRecipe;
 use plenoptic_trace::SceneAccel;
 
 use crate::error::{BakeError, Result};
+use crate::groups::Layer;
 use crate::plan::{self, Plan};
 use crate::progress::Progress;
 use crate::render::BakeRenderer;
@@ -81,8 +82,8 @@ pub fn render_item(r: &BakeRenderer<'_>, item: &WorkItem) -> Result<Vec<ItemChun
             range_image_chunks(base_view, key, &image)
         }
         WorkItem::Volume { base_view } => {
-            let samples = r.volume(base_view as usize);
-            volume_chunks(r.plan, base_view, &samples)
+            let volume = r.volume(base_view as usize);
+            volume_chunks(r.plan, base_view, &volume)
         }
     }
 }
@@ -113,6 +114,17 @@ pub fn bake(recipe: &BakeRecipe, scene: &Scene, options: &BakeOptions) -> Result
     let bar = progress.phase("ambient field", 0);
     let fields = plan::ambient_phase(&mut plan, scene, &accel)?;
     plan.volume_complex = options.volume_complex;
+    // Light groups: one scene per layer, sharing the plan (crate::groups).
+    let layer_scenes = crate::groups::layer_scenes(scene);
+    let layer_accels = layer_scenes
+        .iter()
+        .map(|(_, s)| SceneAccel::new(s))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let layer_fields = layer_scenes
+        .iter()
+        .zip(&layer_accels)
+        .map(|((_, s), a)| plan::layer_fields(&plan, s, a))
+        .collect::<Result<Vec<_>>>()?;
     bar.finish_and_clear();
     timings.insert("ambient_field".to_owned(), clock.elapsed().as_secs_f64());
 
@@ -129,7 +141,17 @@ pub fn bake(recipe: &BakeRecipe, scene: &Scene, options: &BakeOptions) -> Result
         .enumerate()
         .filter(|(i, _)| options.shard.is_none_or(|s| s.owns(*i)))
         .collect();
-    let renderer = BakeRenderer::new(&plan, &accel, &fields);
+    let layers = layer_scenes
+        .iter()
+        .zip(&layer_accels)
+        .zip(&layer_fields)
+        .map(|(((group, _), accel), fields)| Layer {
+            group: *group,
+            accel,
+            fields,
+        })
+        .collect();
+    let renderer = BakeRenderer::new(&plan, &accel, &fields).with_layers(layers);
     let (mut rendered, mut skipped) = (0usize, 0usize);
     for (phase, is_volume) in [("range_images", false), ("volumes", true)] {
         let clock = Instant::now();

@@ -86,6 +86,7 @@ pub mod bake;
 pub mod daylight;
 pub mod denoise;
 pub mod error;
+pub mod groups;
 pub mod input;
 pub mod lights;
 pub mod materials;

@@ -17,7 +17,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
-use plenoptic_pack::{CubeImage, RangeImage, VolumeSample, face_uv_to_direction};
+use plenoptic_pack::{CubeImage, RangeImage, face_uv_to_direction};
 use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
 use plenoptic_trace::image::luminance;
 use plenoptic_trace::sampling::Sampler;
@@ -29,7 +29,9 @@ use rayon::prelude::*;
 
 use crate::denoise::{DenoiseSettings, LightingCube, ambient_passes};
 use crate::error::Result;
+use crate::groups::{Layer, LayeredImage};
 use crate::plan::{Plan, ambient::field_at};
+use crate::volume::LayeredVolume;
 
 /// The pack's object id of scene object `id` (0 for [`NO_OBJECT`]).
 pub fn pack_object_id(id: ObjectId) -> u32 {
@@ -71,8 +73,20 @@ pub struct BakeRenderer<'a> {
     pub accel: &'a SceneAccel<'a>,
     /// Ambient fields at `plan.ambient_keys`.
     pub fields: &'a [AmbientField],
-    single: Arc<AmbientField>,
-    cache: Mutex<HashMap<u32, Arc<AmbientField>>>,
+    /// The light layers rendered instead of the scene when it has light groups
+    /// ([`crate::groups`]); empty without.
+    layers: Vec<Layer<'a>>,
+    /// Per layer (one entry without layers): the field at each distinct volume-sample time.
+    cache: Mutex<HashMap<(usize, u32), Arc<AmbientField>>>,
+}
+
+/// A volume sample rendered per layer: the total and each declared group's (lighting,
+/// non-diffuse radiance).
+pub struct LayeredSample {
+    /// The sum of the layers (or the scene's own sample without groups).
+    pub total: RadianceSample,
+    /// `(declared group, [lighting, non-diffuse])`, in group order.
+    pub groups: Vec<(u32, [Vec3; 2])>,
 }
 
 impl<'a> BakeRenderer<'a> {
@@ -83,9 +97,27 @@ impl<'a> BakeRenderer<'a> {
             plan,
             accel,
             fields,
-            single: Arc::new(fields[0].clone()),
+            layers: Vec::new(),
             cache: Mutex::new(HashMap::new()),
         }
+    }
+
+    /// Renders `layers` (one per light group, [`crate::groups::layer_scenes`]) instead of
+    /// the scene; no layers keeps the scene.
+    pub fn with_layers(mut self, layers: Vec<Layer<'a>>) -> Self {
+        self.layers = layers;
+        self
+    }
+
+    /// What is rendered: `(group, scene, its fields)` per layer, or the scene itself.
+    fn sources(&self) -> Vec<(Option<u32>, &'a SceneAccel<'a>, &'a [AmbientField])> {
+        if self.layers.is_empty() {
+            return vec![(None, self.accel, self.fields)];
+        }
+        self.layers
+            .iter()
+            .map(|l| (l.group, l.accel, l.fields))
+            .collect()
     }
 
     /// The scene.
@@ -105,45 +137,50 @@ impl<'a> BakeRenderer<'a> {
         }
     }
 
-    /// The range image of base view `bv` at its time key `key`.
-    pub fn range_image(&self, bv: usize, key: usize) -> Result<RangeImage> {
+    /// The range image of base view `bv` at its time key `key`, per light layer.
+    pub fn range_image(&self, bv: usize, key: usize) -> Result<LayeredImage> {
         let view = &self.plan.base_views[bv];
         let t = view.time_keys[key];
-        let placed = self.accel.at_time(t);
-        let field = field_at(&self.plan.ambient_keys, self.fields, t);
         let seed = seed_of(&[self.plan.seed, 1, bv as u64, key as u64]);
-        let renderer = MultiStageRenderer::new(
-            self.settings(
-                seed,
-                self.plan.quality.samples_per_pixel,
-                final_gather_rays(self.plan.quality.range_image_size),
-            ),
-            &field,
+        let settings = self.settings(
+            seed,
+            self.plan.quality.samples_per_pixel,
+            final_gather_rays(self.plan.quality.range_image_size),
         );
         let n = self.plan.quality.range_image_size.max(1);
         let denoise = self.plan.quality.denoise.then(DenoiseSettings::default);
         let runtime_sun = self.plan.quality.runtime_sun;
-        render_range_image(
-            &renderer,
-            &placed,
-            view.position,
-            n,
-            denoise.as_ref(),
-            runtime_sun,
-        )
+        let mut images = Vec::new();
+        for (group, accel, fields) in self.sources() {
+            let field = field_at(&self.plan.ambient_keys, fields, t);
+            let renderer = MultiStageRenderer::new(settings, &field);
+            let image = render_range_image(
+                &renderer,
+                &accel.at_time(t),
+                view.position,
+                n,
+                denoise.as_ref(),
+                runtime_sun,
+            )?;
+            images.push((group, image));
+        }
+        let total = crate::groups::sum_images(&images.iter().map(|(_, i)| i).collect::<Vec<_>>())
+            .expect("at least one source");
+        let groups = images
+            .into_iter()
+            .filter_map(|(g, image)| g.filter(|_| !self.layers.is_empty()).map(|g| (g, image)))
+            .collect();
+        Ok(LayeredImage { total, groups })
     }
 
     /// The ambient field at time `t`, interpolated once per distinct `t` and cached (volume
     /// samples ask at frame times only).
-    fn frame_field(&self, t: f32) -> Arc<AmbientField> {
-        if self.fields.len() == 1 {
-            return self.single.clone();
-        }
-        let key = t.to_bits();
+    fn frame_field(&self, layer: usize, fields: &[AmbientField], t: f32) -> Arc<AmbientField> {
+        let key = (layer, if fields.len() == 1 { 0 } else { t.to_bits() });
         if let Some(f) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
             return f;
         }
-        let f = Arc::new(field_at(&self.plan.ambient_keys, self.fields, t).into_owned());
+        let f = Arc::new(field_at(&self.plan.ambient_keys, fields, t).into_owned());
         if let Ok(mut c) = self.cache.lock() {
             c.entry(key).or_insert_with(|| f.clone());
         }
@@ -151,20 +188,19 @@ impl<'a> BakeRenderer<'a> {
     }
 
     /// The temporal-volume samples of base view `bv` (empty for a zero budget).
-    pub fn volume(&self, bv: usize) -> Vec<VolumeSample> {
+    pub fn volume(&self, bv: usize) -> LayeredVolume {
         let view = &self.plan.base_views[bv];
         let budget = view.volume_samples as usize;
         if budget == 0 {
-            return Vec::new();
+            return LayeredVolume::default();
         }
         crate::volume::sample_volume(self, bv, budget)
     }
 
-    /// One volume sample along `dir` at time `t` from base view `bv`; `stream` picks the
-    /// random stream.
-    pub fn sample(&self, bv: usize, dir: Vec3, t: f32, stream: u64) -> RadianceSample {
+    /// One volume sample along `dir` at time `t` from base view `bv`, per light layer;
+    /// `stream` picks the random stream (the same for every layer).
+    pub fn sample(&self, bv: usize, dir: Vec3, t: f32, stream: u64) -> LayeredSample {
         let view = &self.plan.base_views[bv];
-        let placed = self.accel.at_time(t);
         // The ambient field changes slowly: evaluate it at the frame nearest to t.
         let frame = if self.plan.frame_rate > 0.0 {
             ((t - self.plan.start) * self.plan.frame_rate).round() / self.plan.frame_rate
@@ -172,17 +208,33 @@ impl<'a> BakeRenderer<'a> {
         } else {
             t
         };
-        let field = self.frame_field(frame);
         let seed = seed_of(&[self.plan.seed, 2, bv as u64]);
-        // No final gather: a volume sample is one sample, which nothing smooths afterwards, so
-        // it reads the field at its hit as version 1 did.
-        let renderer = MultiStageRenderer::new(self.settings(seed, 1, 0), &field);
-        let mut sampler = Sampler::new(seed, stream, 0);
-        let mut s = renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler);
-        if !self.plan.quality.runtime_sun {
-            bake_the_sun(&mut s);
+        let mut total: Option<RadianceSample> = None;
+        let mut groups = Vec::new();
+        for (i, (group, accel, fields)) in self.sources().into_iter().enumerate() {
+            let field = self.frame_field(i, fields, frame);
+            // No final gather: a volume sample is one sample, which nothing smooths
+            // afterwards, so it reads the field at its hit as version 1 did.
+            let renderer = MultiStageRenderer::new(self.settings(seed, 1, 0), &field);
+            let mut sampler = Sampler::new(seed, stream, 0);
+            let placed = accel.at_time(t);
+            let mut s = renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler);
+            if !self.plan.quality.runtime_sun {
+                bake_the_sun(&mut s);
+            }
+            if let Some(g) = group.filter(|_| !self.layers.is_empty()) {
+                let (lighting, non_diffuse) = crate::denoise::split_sample(&s);
+                groups.push((g, [lighting, non_diffuse]));
+            }
+            match &mut total {
+                Some(sum) => sum.add_light(&s),
+                None => total = Some(s),
+            }
         }
-        s
+        LayeredSample {
+            total: total.expect("at least one source"),
+            groups,
+        }
     }
 }
 

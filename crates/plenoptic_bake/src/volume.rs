@@ -78,6 +78,8 @@ impl Cell {
 struct Sampled {
     cell: Cell,
     sample: RadianceSample,
+    /// Each declared light group's (lighting, non-diffuse radiance).
+    groups: Vec<(u32, [Vec3; 2])>,
     dir: Vec3,
     t: f32,
 }
@@ -92,17 +94,28 @@ fn evaluate(r: &BakeRenderer<'_>, bv: usize, cells: &[(u64, Cell)]) -> Vec<Sampl
         let v = cell.v[0] + (cell.v[1] - cell.v[0]) * j.y;
         let t = cell.t[0] + (cell.t[1] - cell.t[0]) * jt;
         let dir = face_direction(cell.face, u, v);
+        let layered = r.sample(bv, dir, t, serial);
         Sampled {
             cell,
-            sample: r.sample(bv, dir, t, serial),
+            sample: layered.total,
+            groups: layered.groups,
             dir,
             t,
         }
     })
 }
 
+/// A base view's volume samples, and each declared light group's values of them.
+#[derive(Debug, Clone, Default)]
+pub struct LayeredVolume {
+    /// The samples (their lighting the sum of the groups').
+    pub samples: Vec<VolumeSample>,
+    /// Per declared group, in group order: `(group, [lighting, non-diffuse] per sample)`.
+    pub groups: Vec<(u32, Vec<[Vec3; 2]>)>,
+}
+
 /// Samples the temporal volume of base view `bv` with `budget` samples (see the module doc).
-pub fn sample_volume(r: &BakeRenderer<'_>, bv: usize, budget: usize) -> Vec<VolumeSample> {
+pub fn sample_volume(r: &BakeRenderer<'_>, bv: usize, budget: usize) -> LayeredVolume {
     let plan = r.plan;
     let (start, end) = (plan.start, plan.end);
     let split_time = end > start;
@@ -201,7 +214,21 @@ pub fn sample_volume(r: &BakeRenderer<'_>, bv: usize, budget: usize) -> Vec<Volu
         all.extend(done);
         parents = next;
     }
-    all.iter()
+    let groups = all
+        .first()
+        .map(|first| {
+            (0..first.groups.len())
+                .map(|i| {
+                    (
+                        first.groups[i].0,
+                        all.iter().map(|s| s.groups[i].1).collect(),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let samples = all
+        .iter()
         .map(|s| {
             let (lighting, non_diffuse) = crate::denoise::split_sample(&s.sample);
             VolumeSample {
@@ -216,5 +243,6 @@ pub fn sample_volume(r: &BakeRenderer<'_>, bv: usize, budget: usize) -> Vec<Volu
                 radius: s.cell.radius(),
             }
         })
-        .collect()
+        .collect();
+    LayeredVolume { samples, groups }
 }

@@ -25,15 +25,16 @@ use std::path::{Path, PathBuf};
 use plenoptic_pack::{
     Aabb, AnimationTracks, BakeSettings, BaseView, ChunkKind, CubeFormats, DirectSun,
     EnvironmentEntry, Interpolation, Manifest, Motion, ObjectEntry, ObjectTracks, PackWriter,
-    ProxyMesh, RangeImage, TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block,
-    encode_connectivity, encode_distance, encode_normal, encode_object_id, encode_radiance,
-    encode_volume_block,
+    ProxyMesh, TimeRange, Track, ViewSpace, VolumeSample, decode_volume_block, encode_connectivity,
+    encode_distance, encode_normal, encode_object_id, encode_radiance, encode_volume_block,
 };
 use plenoptic_scene::{Mesh, Scene};
 use plenoptic_trace::SceneAccel;
 
 use crate::error::{BakeError, Result};
+use crate::groups::LayeredImage;
 use crate::plan::{Plan, PlanViewSpace};
+use crate::volume::LayeredVolume;
 use crate::work::{ItemChunk, WorkDir, WorkItem, work_items};
 
 /// Storage formats of the range images (the pack's defaults: RGB9E5, R32F, R32 uint, RG16
@@ -46,9 +47,9 @@ pub const FORMATS: CubeFormats = CubeFormats {
 };
 
 /// The six cube chunks of a range image (lighting and non-diffuse radiance in the radiance
-/// format).
-pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<ItemChunk>> {
-    let image = &crate::quantise::coarsen(image);
+/// format), then each light group's lighting and non-diffuse cubes ([`crate::groups`]).
+pub fn range_image_chunks(bv: u32, key: u32, layered: &LayeredImage) -> Result<Vec<ItemChunk>> {
+    let image = &crate::quantise::coarsen(&layered.total);
     let c = |kind, bytes| ItemChunk {
         kind,
         base_view: bv,
@@ -56,7 +57,7 @@ pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<I
         uncompressed_length: 0,
         bytes,
     };
-    Ok(vec![
+    let mut out = vec![
         c(
             ChunkKind::RadianceCube,
             encode_radiance(&image.radiance, FORMATS.radiance)?,
@@ -81,7 +82,19 @@ pub fn range_image_chunks(bv: u32, key: u32, image: &RangeImage) -> Result<Vec<I
             ChunkKind::NormalCube,
             encode_normal(&image.normal, FORMATS.normal)?,
         ),
-    ])
+    ];
+    for (g, group) in &layered.groups {
+        let group = crate::quantise::coarsen(group);
+        out.push(c(
+            ChunkKind::GroupLighting(*g),
+            encode_radiance(&group.lighting, FORMATS.radiance)?,
+        ));
+        out.push(c(
+            ChunkKind::GroupNonDiffuse(*g),
+            encode_radiance(&group.non_diffuse, FORMATS.radiance)?,
+        ));
+    }
+    Ok(out)
 }
 
 /// A manifest for `plan` used only to bucket times (same rule as the pack's).
@@ -95,40 +108,49 @@ fn bucketing(plan: &Plan) -> Manifest {
     )
 }
 
-/// The volume blocks of one base view: samples bucketed by time, empty buckets left out.
-pub fn volume_chunks(plan: &Plan, bv: u32, samples: &[VolumeSample]) -> Result<Vec<ItemChunk>> {
+/// The volume blocks of one base view: samples bucketed by time, empty buckets left out; with
+/// light groups, each group's values of each block ([`ChunkKind::GroupVolume`]).
+pub fn volume_chunks(plan: &Plan, bv: u32, volume: &LayeredVolume) -> Result<Vec<ItemChunk>> {
     let m = bucketing(plan);
-    let mut buckets: BTreeMap<u32, Vec<VolumeSample>> = BTreeMap::new();
-    for s in samples {
-        buckets
-            .entry(m.bucket_of(s.t))
-            .or_default()
-            .push(crate::quantise::coarsen_sample(s));
+    let mut buckets: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    for (i, s) in volume.samples.iter().enumerate() {
+        buckets.entry(m.bucket_of(s.t)).or_default().push(i);
     }
     let mut out = Vec::new();
-    for (b, list) in buckets {
+    for (b, members) in buckets {
         let (t0, t1) = m.bucket_range(b);
+        let list: Vec<VolumeSample> = members
+            .iter()
+            .map(|&i| crate::quantise::coarsen_sample(&volume.samples[i]))
+            .collect();
         let enc = encode_volume_block(t0, t1, &list)?;
         let complex = if plan.volume_complex {
             complex_chunk(&enc.bytes)?
         } else {
             None
         };
-        out.push(ItemChunk {
-            kind: ChunkKind::VolumeBlock,
+        let chunk = |kind, uncompressed_length, bytes| ItemChunk {
+            kind,
             base_view: bv,
             key: b,
-            uncompressed_length: enc.uncompressed_length,
-            bytes: enc.bytes,
-        });
+            uncompressed_length,
+            bytes,
+        };
+        out.push(chunk(
+            ChunkKind::VolumeBlock,
+            enc.uncompressed_length,
+            enc.bytes,
+        ));
         if let Some((bytes, len)) = complex {
-            out.push(ItemChunk {
-                kind: ChunkKind::VolumeConnectivity,
-                base_view: bv,
-                key: b,
-                uncompressed_length: len,
-                bytes,
-            });
+            out.push(chunk(ChunkKind::VolumeConnectivity, len, bytes));
+        }
+        for (g, values) in &volume.groups {
+            let values: Vec<[glam::Vec3; 2]> = members
+                .iter()
+                .map(|&i| values[i].map(crate::quantise::coarsen_colour))
+                .collect();
+            let (bytes, len) = plenoptic_pack::groups::encode_group_volume(&values, &enc.order)?;
+            out.push(chunk(ChunkKind::GroupVolume(*g), len, bytes));
         }
     }
     Ok(out)
@@ -362,6 +384,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
         extra,
     };
     m.environment = environment_entry(plan.start, plan.end, scene, plan.quality.runtime_sun);
+    m.light_groups = crate::groups::manifest_entry(scene);
     m
 }
 
@@ -411,6 +434,9 @@ fn stat_name(kind: ChunkKind) -> &'static str {
         ChunkKind::EnvironmentImage => "environment",
         ChunkKind::MaterialTexture => "textures",
         ChunkKind::ProxyAttributes => "proxy_attributes",
+        ChunkKind::GroupLighting(_) => "group_lighting",
+        ChunkKind::GroupNonDiffuse(_) => "group_non_diffuse",
+        ChunkKind::GroupVolume(_) => "group_volume",
         ChunkKind::Unknown(_) => "other",
     }
 }

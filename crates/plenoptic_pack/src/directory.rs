@@ -10,6 +10,13 @@ pub const DIRECTORY_ROW_LEN: u64 = 48;
 /// `base_view` of a chunk that belongs to no base view (proxy meshes, animation tracks).
 pub const NO_BASE_VIEW: u32 = u32::MAX;
 
+/// First code of [`ChunkKind::GroupLighting`]; group `g` is `GROUP_LIGHTING + g`, `g < 256`.
+const GROUP_LIGHTING: u32 = 0x100;
+/// First code of [`ChunkKind::GroupNonDiffuse`].
+const GROUP_NON_DIFFUSE: u32 = 0x200;
+/// First code of [`ChunkKind::GroupVolume`].
+const GROUP_VOLUME: u32 = 0x300;
+
 /// What a chunk holds. The numeric codes are part of the format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum ChunkKind {
@@ -45,6 +52,15 @@ pub enum ChunkKind {
     /// KTX2 cube of the radiance that is not the Lambertian lobe's (code 13, since version
     /// 2.0): emission plus the specular part as seen from the base view. Key: time key index.
     NonDiffuseCube,
+    /// KTX2 cube of light group `g`'s diffuse lighting (code `0x100 + g`, since version 4.2;
+    /// [`crate::groups`]). Key: time key index.
+    GroupLighting(u32),
+    /// KTX2 cube of light group `g`'s non-diffuse radiance (code `0x200 + g`, since 4.2).
+    /// Key: time key index.
+    GroupNonDiffuse(u32),
+    /// Light group `g`'s lighting and non-diffuse values of the volume block with the same
+    /// base view and key (code `0x300 + g`, since 4.2). Key: time bucket index.
+    GroupVolume(u32),
     /// A kind written by a newer minor version. It is validated like every other chunk and its
     /// raw bytes can be read, but it cannot be decoded.
     Unknown(u32),
@@ -67,6 +83,9 @@ impl ChunkKind {
             ChunkKind::ProxyAttributes => 11,
             ChunkKind::LightingCube => 12,
             ChunkKind::NonDiffuseCube => 13,
+            ChunkKind::GroupLighting(g) => GROUP_LIGHTING + g,
+            ChunkKind::GroupNonDiffuse(g) => GROUP_NON_DIFFUSE + g,
+            ChunkKind::GroupVolume(g) => GROUP_VOLUME + g,
             ChunkKind::Unknown(c) => c,
         }
     }
@@ -87,6 +106,15 @@ impl ChunkKind {
             11 => ChunkKind::ProxyAttributes,
             12 => ChunkKind::LightingCube,
             13 => ChunkKind::NonDiffuseCube,
+            c if (GROUP_LIGHTING..GROUP_LIGHTING + 0x100).contains(&c) => {
+                ChunkKind::GroupLighting(c - GROUP_LIGHTING)
+            }
+            c if (GROUP_NON_DIFFUSE..GROUP_NON_DIFFUSE + 0x100).contains(&c) => {
+                ChunkKind::GroupNonDiffuse(c - GROUP_NON_DIFFUSE)
+            }
+            c if (GROUP_VOLUME..GROUP_VOLUME + 0x100).contains(&c) => {
+                ChunkKind::GroupVolume(c - GROUP_VOLUME)
+            }
             c => ChunkKind::Unknown(c),
         }
     }
@@ -101,7 +129,19 @@ impl ChunkKind {
                 | ChunkKind::NormalCube
                 | ChunkKind::LightingCube
                 | ChunkKind::NonDiffuseCube
+                | ChunkKind::GroupLighting(_)
+                | ChunkKind::GroupNonDiffuse(_)
         )
+    }
+
+    /// The light group of a group kind, `None` for other kinds.
+    pub fn light_group(self) -> Option<u32> {
+        match self {
+            ChunkKind::GroupLighting(g)
+            | ChunkKind::GroupNonDiffuse(g)
+            | ChunkKind::GroupVolume(g) => Some(g),
+            _ => None,
+        }
     }
 }
 

@@ -189,6 +189,16 @@ pub enum PackError {
         /// Number of base views in the manifest.
         count: usize,
     },
+    /// The light-group chunks disagree with the manifest's `light_groups`: a group chunk of a
+    /// group the manifest does not declare, or a range image or volume block without a
+    /// declared group's layer.
+    #[error("{chunk}: {problem}")]
+    LightGroupMismatch {
+        /// The chunk.
+        chunk: ChunkRef,
+        /// What is wrong.
+        problem: String,
+    },
     /// A directory row has a non-zero reserved field.
     #[error("{chunk}: reserved directory field is {value:#x}, expected 0")]
     ReservedNotZero {
@@ -327,6 +337,7 @@ impl PackError {
         match self {
             PackError::ChunkOutOfBounds { chunk, .. }
             | PackError::UnknownBaseView { chunk, .. }
+            | PackError::LightGroupMismatch { chunk, .. }
             | PackError::ReservedNotZero { chunk, .. }
             | PackError::ChecksumMismatch { chunk, .. }
             | PackError::UnknownChunkKind { chunk }

@@ -13,7 +13,7 @@ pub const VERSION_MAJOR: u16 = 4;
 /// [`PackError::NeedsRebake`].
 pub const OLDEST_MAJOR: u16 = 2;
 /// The minor format version this crate writes. Readers accept any minor of their major.
-pub const VERSION_MINOR: u16 = 1;
+pub const VERSION_MINOR: u16 = 2;
 /// The first major whose non-diffuse radiance leaves the emission to the runtime.
 pub const RUNTIME_EMISSION_MAJOR: u16 = 4;
 /// Size of the header in bytes.

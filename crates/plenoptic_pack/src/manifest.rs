@@ -48,6 +48,10 @@ pub struct Manifest {
     /// The materials objects refer to (version 1.2; empty in older packs).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub materials: Vec<MaterialEntry>,
+    /// The light groups stored apart and each emitter's group (version 4.2; absent: one
+    /// group, [`crate::groups`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_groups: Option<crate::LightGroupsEntry>,
 }
 
 impl Manifest {
@@ -71,6 +75,7 @@ impl Manifest {
             environment: None,
             textures: Vec::new(),
             materials: Vec::new(),
+            light_groups: None,
         }
     }
 
@@ -144,6 +149,10 @@ impl Manifest {
                     o.id, o.name
                 ));
             }
+        }
+        if let Some(g) = &self.light_groups {
+            g.validate(self.lights.len(), self.objects.len())
+                .or_else(|reason| bad(reason))?;
         }
         for (i, l) in self.lights.iter().enumerate() {
             if let Some(p) = &l.placed {

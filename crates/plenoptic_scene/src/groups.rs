@@ -306,8 +306,8 @@ mod tests {
     #[test]
     fn emitters_resolve_to_their_groups() {
         let scene = scene();
-        let g = LightGroups::resolve(&scene, &[spec("lamps", &["Desk", "Glow"])], "r.toml")
-            .unwrap();
+        let g =
+            LightGroups::resolve(&scene, &[spec("lamps", &["Desk", "Glow"])], "r.toml").unwrap();
         assert_eq!(g.lights, vec![Some(0)]);
         let bulbs: Vec<_> = (0..scene.objects.len()).map(|i| g.object(i)).collect();
         assert_eq!(bulbs, vec![None, Some(0), Some(0)]);

@@ -53,6 +53,20 @@ pub struct RadianceSample {
 }
 
 impl RadianceSample {
+    /// Adds the light of `other`, a sample along the same ray of the same scene lit by other
+    /// emitters (a light group's: light transport is linear in the emitters), into this one:
+    /// every radiance and its parts add, the variances of independent estimates add, and
+    /// the geometry and the albedo, which do not depend on the emitters, stay this sample's.
+    pub fn add_light(&mut self, other: &RadianceSample) {
+        self.radiance += other.radiance;
+        self.diffuse += other.diffuse;
+        self.lighting_variance += other.lighting_variance;
+        self.sun += other.sun;
+        self.sun_diffuse += other.sun_diffuse;
+        self.ambient += other.ambient;
+        self.emission += other.emission;
+    }
+
     /// A miss before the environment is added: no radiance, infinite distance (the renderers
     /// set the environment's radiance for the ray).
     pub const MISS: Self = Self {

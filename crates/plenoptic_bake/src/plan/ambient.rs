@@ -87,6 +87,21 @@ pub fn key_times(
     })
 }
 
+/// The fields of `scene` (one light group's: the same geometry as the scene whose
+/// [`key_times`] chose `times`, other emitters) gathered at `times`.
+pub fn fields_at(
+    scene: &Scene,
+    accel: &SceneAccel<'_>,
+    settings: &AmbientSettings,
+    times: &[f32],
+) -> Result<Vec<AmbientField>> {
+    let layout = Arc::new(FieldLayout::new(scene, settings.quality)?);
+    Ok(times
+        .iter()
+        .map(|&t| AmbientField::compute(&accel.at_time(t), layout.clone(), settings))
+        .collect())
+}
+
 /// The field at time `t`: the key field itself at a key time, else the linear interpolation
 /// of the two key fields around `t` (clamped at the ends).
 pub fn field_at<'f>(times: &[f32], fields: &'f [AmbientField], t: f32) -> Cow<'f, AmbientField> {

@@ -405,13 +405,28 @@ pub fn build(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> Resu
     })
 }
 
+/// The ambient settings of a plan's fields.
+fn ambient_settings(plan: &Plan) -> plenoptic_trace::AmbientSettings {
+    ambient::settings(&plan.quality, plan.seed ^ 0xa3b1)
+}
+
+/// The fields of one light layer's scene (the planned scene with other emitters,
+/// [`crate::groups`]) at the key times [`ambient_phase`] chose.
+pub fn layer_fields(
+    plan: &Plan,
+    scene: &Scene,
+    accel: &SceneAccel<'_>,
+) -> Result<Vec<AmbientField>> {
+    ambient::fields_at(scene, accel, &ambient_settings(plan), &plan.ambient_keys)
+}
+
 /// Fills `plan.ambient_keys` and returns the fields at them.
 pub fn ambient_phase(
     plan: &mut Plan,
     scene: &Scene,
     accel: &SceneAccel<'_>,
 ) -> Result<Vec<AmbientField>> {
-    let settings = ambient::settings(&plan.quality, plan.seed ^ 0xa3b1);
+    let settings = ambient_settings(plan);
     let keys = ambient::key_times(
         scene,
         accel,

@@ -1,0 +1,102 @@
+//! Light groups in the bake (docs/pack-format.md, "Light groups"; [`plenoptic_scene::groups`]).
+//!
+//! A scene with declared groups is rendered once per *layer*: each declared group, and the
+//! default group when it holds an emitter, with only its emitters on
+//! ([`Scene::group_only`]). The plan (base views, time keys, ambient key times) is the whole
+//! scene's and is shared; each layer gets its own scene, acceleration structure and ambient
+//! fields at the plan's ambient key times. Every range image and volume sample is rendered per
+//! layer with the same random streams; the total the pack stores in its lighting cubes is the
+//! layers' sum, and each declared group's lighting and non-diffuse radiance are stored beside
+//! it. So the total equals the sum of its groups exactly (up to quantisation) and a reader
+//! may scale each. The geometry (distance, id, normal) does not depend on the emitters and is
+//! taken from the first layer.
+//!
+//! Cost: every rendering of the bake is done once per layer, so the range images, volumes and
+//! ambient fields take about as many times as long as there are layers.
+
+use glam::Vec3;
+use plenoptic_pack::{CubeImage, LightGroupsEntry, RangeImage};
+use plenoptic_scene::Scene;
+use plenoptic_trace::{AmbientField, SceneAccel};
+
+/// The light layers of `scene`: `(group, scene with only that group on)`, declared groups
+/// first, then the default group (`None`) when it holds an emitter. Empty for a scene
+/// without groups (the bake then renders the scene itself).
+pub fn layer_scenes(scene: &Scene) -> Vec<(Option<u32>, Scene)> {
+    let groups = &scene.light_groups;
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let mut out: Vec<(Option<u32>, Scene)> = (0..groups.names.len() as u32)
+        .map(|g| (Some(g), scene.group_only(Some(g))))
+        .collect();
+    if groups.default_has_emitters(scene) {
+        out.push((None, scene.group_only(None)));
+    }
+    out
+}
+
+/// One light layer as the renderer uses it.
+pub struct Layer<'a> {
+    /// Its group (`None`: the default group).
+    pub group: Option<u32>,
+    /// The scene with only the group's emitters on.
+    pub accel: &'a SceneAccel<'a>,
+    /// Its ambient fields at the plan's ambient key times.
+    pub fields: &'a [AmbientField],
+}
+
+/// A range image rendered per layer: the total the pack stores in its ordinary chunks, and
+/// each declared group's image.
+pub struct LayeredImage {
+    /// The sum of the layers (or the scene's own image without groups).
+    pub total: RangeImage,
+    /// `(declared group, its image)`.
+    pub groups: Vec<(u32, RangeImage)>,
+}
+
+/// The sum of per-layer range images of one view and key: radiance, lighting and non-diffuse
+/// radiance add; the geometry is the first image's. `None` for no images.
+pub fn sum_images(images: &[&RangeImage]) -> Option<RangeImage> {
+    let (first, rest) = images.split_first()?;
+    let mut total = (*first).clone();
+    let add = |a: &mut CubeImage<Vec3>, b: &CubeImage<Vec3>| {
+        for (x, y) in a.texels.iter_mut().zip(&b.texels) {
+            *x += *y;
+        }
+    };
+    for image in rest {
+        add(&mut total.radiance, &image.radiance);
+        add(&mut total.lighting, &image.lighting);
+        add(&mut total.non_diffuse, &image.non_diffuse);
+    }
+    Some(total)
+}
+
+/// The manifest's `light_groups` for `scene` (`None` without groups). Manifest lights and
+/// objects are the scene's, in the same order.
+pub fn manifest_entry(scene: &Scene) -> Option<LightGroupsEntry> {
+    let groups = &scene.light_groups;
+    if groups.is_empty() {
+        return None;
+    }
+    Some(LightGroupsEntry {
+        names: groups.names.clone(),
+        lights: (0..scene.lights.len()).map(|i| groups.light(i)).collect(),
+        objects: (0..scene.objects.len()).map(|i| groups.object(i)).collect(),
+        sun: groups.sun(scene),
+        sky: groups.sky,
+        default_has_emitters: groups.default_has_emitters(scene),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn groups_are_as_many_as_the_pack_allows() {
+        assert_eq!(
+            plenoptic_scene::recipe::MAX_GROUPS,
+            plenoptic_pack::MAX_LIGHT_GROUPS
+        );
+    }
+}
