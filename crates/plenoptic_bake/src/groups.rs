@@ -15,7 +15,7 @@
 //! ambient fields take about as many times as long as there are layers.
 
 use glam::Vec3;
-use plenoptic_pack::{CubeImage, LightGroupsEntry, RangeImage};
+use plenoptic_pack::{CubeImage, GroupWeights, LightGroupsEntry, RangeImage};
 use plenoptic_scene::Scene;
 use plenoptic_trace::{AmbientField, SceneAccel};
 
@@ -88,6 +88,27 @@ pub fn manifest_entry(scene: &Scene) -> Option<LightGroupsEntry> {
         sky: groups.sky,
         default_has_emitters: groups.default_has_emitters(scene),
     })
+}
+
+/// Parses `settings` (`NAME=I` or `NAME=R,G,B`, [`plenoptic_pack::groups::parse_setting`])
+/// into weights over the groups `names`.
+pub fn weights(names: &[String], settings: &[String]) -> crate::Result<GroupWeights> {
+    let parsed = settings
+        .iter()
+        .map(|s| plenoptic_pack::groups::parse_setting(s))
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map_err(crate::BakeError::Invalid)?;
+    GroupWeights::from_names(names, &parsed).map_err(crate::BakeError::Invalid)
+}
+
+/// `scene` relit with its light groups at `settings` (what `plenoptic reference --light`
+/// path-traces).
+pub fn relit_scene(scene: &Scene, settings: &[String]) -> crate::Result<Scene> {
+    if settings.is_empty() {
+        return Ok(scene.clone());
+    }
+    let w = weights(&scene.light_groups.names, settings)?;
+    Ok(scene.relit(|g| w.weight(g)))
 }
 
 #[cfg(test)]

@@ -6,10 +6,10 @@
 //! plenoptic merge RECIPE [--keep-work]              join shards into the pack
 //! plenoptic inspect PACK [--chunks] [--extract N OUT]
 //! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
-//!                    [--exposure E]
+//!                    [--exposure E] [--light NAME=I]...
 //! plenoptic render PACK --path PATH.json [--mode image|volume|geometry]
 //!     [--shading materials|radiance] [--reflections shaded|marched] [--supersampling N]
-//!     [--frames N] [--exposure E] --out DIR
+//!     [--frames N] [--exposure E] [--light NAME=I]... --out DIR
 //! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
 //!                   [--plot OUT.svg]
 //! ```
@@ -147,6 +147,10 @@ enum Command {
         /// reference can be shown at the same one).
         #[arg(long)]
         exposure: Option<f32>,
+        /// A light group's colour × intensity, NAME=I or NAME=R,G,B (repeatable; `default`
+        /// names the emitters no group names; unset groups are 1).
+        #[arg(long = "light", value_name = "NAME=I")]
+        lights: Vec<String>,
         /// Output directory.
         #[arg(long, default_value = "frames")]
         out: PathBuf,
@@ -203,6 +207,9 @@ enum Command {
         /// Exposure of the PNGs (default: automatic from the first frame).
         #[arg(long)]
         exposure: Option<f32>,
+        /// A light group's colour × intensity, as `plenoptic render --light` takes it.
+        #[arg(long = "light", value_name = "NAME=I")]
+        lights: Vec<String>,
     },
 }
 
@@ -273,6 +280,7 @@ fn run(command: Command) -> Result<()> {
             supersampling,
             frames,
             exposure,
+            lights,
             out,
         } => {
             let mode = plenoptic_recon::Mode::parse(&mode).ok_or_else(|| {
@@ -283,6 +291,7 @@ fn run(command: Command) -> Result<()> {
                 shaded_reflections: parse_reflections(&reflections)?,
                 supersampling,
                 exposure,
+                lights,
             };
             cmd_render(&pack, &path, (mode, frames), look, &out)
         }
@@ -301,7 +310,8 @@ fn run(command: Command) -> Result<()> {
             seed,
             halves,
             exposure,
-        } => cmd_reference(&recipe, &path, &out, spp, seed, halves, exposure),
+            lights,
+        } => cmd_reference(&recipe, &path, &out, (spp, seed, halves), exposure, &lights),
     }
 }
 
@@ -336,13 +346,14 @@ fn cmd_bake(recipe_path: &Path, options: &BakeOptions) -> Result<()> {
 }
 
 /// How `plenoptic render` shows the frames (its `--shading`, `--reflections`,
-/// `--supersampling` and `--exposure`).
-#[derive(Clone, Copy)]
+/// `--supersampling`, `--exposure` and `--light`).
+#[derive(Clone)]
 struct Look {
     shading: plenoptic_recon::Shading,
     shaded_reflections: bool,
     supersampling: u32,
     exposure: Option<f32>,
+    lights: Vec<String>,
 }
 
 /// `--shading`: materials or radiance.
@@ -375,12 +386,15 @@ fn cmd_render(
     look: Look,
     out: &Path,
 ) -> Result<()> {
+    let mut rec = plenoptic_recon::Reconstructor::open(pack)
+        .map_err(|e| BakeError::Invalid(format!("render: {e}")))?;
+    let names = (rec.pack().manifest().light_groups.as_ref()).map_or(&[][..], |g| &g.names[..]);
+    rec.set_light_weights(plenoptic_bake::groups::weights(names, &look.lights)?);
+    rec.settings.shading = look.shading;
+    rec.settings.shaded_reflections = look.shaded_reflections;
+    rec.settings.supersampling = look.supersampling;
     let render = || -> std::result::Result<_, plenoptic_eval::EvalError> {
         let camera_path = plenoptic_recon::CameraPath::load(path)?;
-        let mut rec = plenoptic_recon::Reconstructor::open(pack)?;
-        rec.settings.shading = look.shading;
-        rec.settings.shaded_reflections = look.shaded_reflections;
-        rec.settings.supersampling = look.supersampling;
         plenoptic_eval::tools::render_path_with(
             &rec,
             &camera_path,
@@ -635,12 +649,12 @@ fn cmd_reference(
     recipe_path: &Path,
     path: &Path,
     out: &Path,
-    spp: Option<u32>,
-    seed: Option<u64>,
-    halves: bool,
+    (spp, seed, halves): (Option<u32>, Option<u64>, bool),
     exposure: Option<f32>,
+    lights: &[String],
 ) -> Result<()> {
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
+    let scene = plenoptic_bake::groups::relit_scene(&scene, lights)?;
     let frames = plenoptic_bake::reference::path_frames(path)?;
     let spp = spp.unwrap_or(recipe.quality.reference_samples_per_pixel);
     let seed = seed.unwrap_or(0);

@@ -28,6 +28,35 @@ use crate::cube::{rgb9e5_pack, rgb9e5_unpack};
 use crate::error::{PackError, Result};
 use crate::volume::MAX_BLOCK_SAMPLES;
 
+/// The name that sets the default group's weight (emitters no group names).
+pub const DEFAULT_GROUP: &str = "default";
+
+/// Parses a group setting `NAME=I` (an intensity) or `NAME=R,G,B` (a colour × intensity),
+/// as `plenoptic render --light` and the tour take it. Values must be finite and
+/// non-negative.
+pub fn parse_setting(text: &str) -> std::result::Result<(String, Vec3), String> {
+    let bad = || {
+        format!(
+            "light group setting '{text}': expected NAME=I or NAME=R,G,B with finite, non-negative values"
+        )
+    };
+    let (name, value) = text.split_once('=').ok_or_else(bad)?;
+    let parts: Vec<f32> = value
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| bad())?;
+    let w = match parts[..] {
+        [i] => Vec3::splat(i),
+        [r, g, b] => Vec3::new(r, g, b),
+        _ => return Err(bad()),
+    };
+    if name.trim().is_empty() || !w.is_finite() || w.min_element() < 0.0 {
+        return Err(bad());
+    }
+    Ok((name.trim().to_owned(), w))
+}
+
 /// Most light groups a pack may declare (directory kind codes leave room for 256).
 pub const MAX_LIGHT_GROUPS: usize = 16;
 
@@ -120,12 +149,13 @@ impl LayerBlend {
         self.base == Vec3::ONE && self.layers.is_empty()
     }
 
-    /// The blended value of one texel or sample: `base · total + Σ c · layer(g)`, clamped at
-    /// zero (quantised layers may overshoot the total by their rounding).
-    pub fn apply(&self, total: Vec3, layer: impl Fn(u32) -> Vec3) -> Vec3 {
+    /// The blended value of one texel or sample: `base · total + Σ_k c_k · layer(k)`, where
+    /// `layer(k)` is the value of the `k`-th entry of [`LayerBlend::layers`]; clamped at zero
+    /// (quantised layers may overshoot the total by their rounding).
+    pub fn apply(&self, total: Vec3, layer: impl Fn(usize) -> Vec3) -> Vec3 {
         let mut v = self.base * total;
-        for &(g, c) in &self.layers {
-            v += c * layer(g);
+        for (k, &(_, c)) in self.layers.iter().enumerate() {
+            v += c * layer(k);
         }
         v.max(Vec3::ZERO)
     }
@@ -143,6 +173,32 @@ impl GroupWeights {
             None => self.default,
             Some(g) => self.groups.get(g as usize).copied().unwrap_or(Vec3::ONE),
         }
+    }
+
+    /// Weights from `settings` (`(group name, colour × intensity)`; `default` names the
+    /// default group) over the groups `names`; groups not set are 1. An unknown name is an
+    /// error that lists the groups.
+    pub fn from_names(
+        names: &[String],
+        settings: &[(String, Vec3)],
+    ) -> std::result::Result<Self, String> {
+        let mut out = Self {
+            default: Vec3::ONE,
+            groups: vec![Vec3::ONE; names.len()],
+        };
+        for (name, w) in settings {
+            if name == DEFAULT_GROUP {
+                out.default = *w;
+            } else if let Some(g) = names.iter().position(|n| n == name) {
+                out.groups[g] = *w;
+            } else {
+                return Err(format!(
+                    "no light group '{name}': the pack's groups are {}{DEFAULT_GROUP}",
+                    names.iter().map(|n| format!("{n}, ")).collect::<String>()
+                ));
+            }
+        }
+        Ok(out)
     }
 
     /// How to combine the layers of a pack with `entry`'s groups at these weights (the
@@ -272,7 +328,7 @@ mod tests {
         for g in [[0.0, 1.0, 1.0], [0.5, 2.0, 0.0], [3.0, 0.0, 0.0]] {
             let b = w(g).blend(Some(&e));
             let expected: Vec3 = (0..3).map(|i| layers[i] * g[i]).sum();
-            let got = b.apply(total, |i| layers[i as usize]);
+            let got = b.apply(total, |k| layers[b.layers[k].0 as usize]);
             assert!(
                 got.abs_diff_eq(expected, 1e-5),
                 "{g:?}: {got} vs {expected}"
@@ -306,6 +362,34 @@ mod tests {
         );
         assert!(decode_group_volume(&bytes[..bytes.len() - 1]).is_err());
         assert!(encode_group_volume(&values, &[0]).is_err());
+    }
+
+    #[test]
+    fn settings_parse_and_name_their_groups() {
+        assert_eq!(
+            parse_setting("lamp=0.5"),
+            Ok(("lamp".into(), Vec3::splat(0.5)))
+        );
+        assert_eq!(
+            parse_setting("sky=1,0.5,0.25"),
+            Ok(("sky".into(), Vec3::new(1.0, 0.5, 0.25)))
+        );
+        for bad in ["lamp", "lamp=-1", "lamp=1,2", "=1", "lamp=nan", "lamp=x"] {
+            assert!(parse_setting(bad).is_err(), "{bad}");
+        }
+        let names = vec!["lamp".to_owned(), "sun".to_owned()];
+        let w = GroupWeights::from_names(
+            &names,
+            &[
+                ("sun".into(), Vec3::ZERO),
+                ("default".into(), Vec3::splat(2.0)),
+            ],
+        )
+        .unwrap();
+        assert_eq!(w.groups, vec![Vec3::ONE, Vec3::ZERO]);
+        assert_eq!(w.default, Vec3::splat(2.0));
+        let e = GroupWeights::from_names(&names, &[("moon".into(), Vec3::ONE)]).unwrap_err();
+        assert!(e.contains("lamp, sun, default"), "{e}");
     }
 
     #[test]

@@ -79,7 +79,7 @@ pub use environment::{
     encode_environment_image,
 };
 pub use error::{ChunkRef, PackError, Result, Section};
-pub use groups::{GroupWeights, LayerBlend, LightGroupsEntry, MAX_LIGHT_GROUPS};
+pub use groups::{DEFAULT_GROUP, GroupWeights, LayerBlend, LightGroupsEntry, MAX_LIGHT_GROUPS};
 pub use header::{HEADER_LEN, Header, MAGIC, OLDEST_MAJOR, VERSION_MAJOR, VERSION_MINOR};
 pub use manifest::{
     Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, LightPlacement, Manifest,

@@ -76,7 +76,7 @@ pub(crate) fn show(rec: &Reconstructor, camera: &Camera, t: f32, mode: Mode, fra
     if e.is_none() {
         return;
     }
-    let env = e.at(t);
+    let env = rec.environment_at(t);
     match rec.proxy() {
         Some(proxy) if mode != Mode::GeometryAssisted => {
             let mask = proxy.mask_raster(camera, t);

@@ -92,7 +92,7 @@ pub(crate) fn render(
     let shot = Shot::new(rec, camera, t, None);
     let mut behind = shading::render(shot, Layer::Without(&ids), report)?;
     background::apply(
-        &rec.environment().at(t),
+        &rec.environment_at(t),
         camera,
         Coverage::FrameObjects,
         &mut behind,

@@ -38,6 +38,8 @@ pub struct RuntimeLamp {
     pub direction: Vec3,
     /// Colour × intensity (candela).
     pub radiant: Vec3,
+    /// Its index in the manifest's lights.
+    pub light: usize,
     /// Range, metres (infinite: none).
     pub range: f32,
     /// A spot light's cosines of its outer cone angle and `1 / (cos inner − cos outer)`;
@@ -51,7 +53,7 @@ pub struct RuntimeLamp {
 /// area light, a pack before 4.1, too many lamps). Directional lights are not lamps.
 pub fn runtime_lamps(manifest: &Manifest) -> Option<Vec<RuntimeLamp>> {
     let mut lamps = Vec::new();
-    for l in &manifest.lights {
+    for (i, l) in manifest.lights.iter().enumerate() {
         let cone = match l.kind {
             LightKind::Directional => continue,
             LightKind::Area { .. } => return None,
@@ -69,6 +71,7 @@ pub fn runtime_lamps(manifest: &Manifest) -> Option<Vec<RuntimeLamp>> {
             position: placed.position,
             direction: placed.direction,
             radiant: l.colour * l.intensity,
+            light: i,
             range: placed.range.unwrap_or(f32::INFINITY),
             cone,
         });
@@ -197,6 +200,7 @@ mod tests {
             position,
             direction: -position.normalize(),
             radiant: Vec3::splat(10.0),
+            light: 0,
             range: 5.0,
             cone,
         };

@@ -22,7 +22,7 @@ use crate::lookup::PackedTexels;
 use crate::proxy::{GeometryMask, ProxyGeometry};
 pub use crate::settings::{CubeFilter, ReconSettings, Shading};
 use crate::shading::Channel;
-use crate::streamed::{KeySource, StreamedCube};
+use crate::streamed::KeySource;
 use crate::temporal::{bezier_weights, nearest_key};
 use crate::volume::BlockBins;
 use crate::warp::{ViewCubes, Warped, background_fill, blend_warped, warp_view};
@@ -30,13 +30,13 @@ use crate::{Error, Result};
 
 /// Reconstructs frames from one pack.
 pub struct Reconstructor {
-    pack: PackReader,
+    pub(crate) pack: PackReader,
     proxy: Option<ProxyGeometry>,
     proxy_missing: Vec<String>,
     environment: PackEnvironment,
     /// Settings (may be changed between frames).
     pub settings: ReconSettings,
-    cache: Mutex<Cache>,
+    pub(crate) cache: Mutex<Cache>,
     /// Volume blocks binned by direction for the geometry-assisted fallback, by (view,
     /// bucket); an entry is rebuilt when the chunk cache has reloaded its block.
     bins: Mutex<HashMap<(u32, u32), Arc<BlockBins>>>,
@@ -51,9 +51,13 @@ pub struct Reconstructor {
     /// scene), built on first use.
     rays: std::sync::OnceLock<Option<crate::shadow::ShadowScene>>,
     /// Where cube chunks come from when a runtime streams them ([`crate::streamed`]).
-    source: std::sync::RwLock<Option<Arc<dyn KeySource>>>,
+    pub(crate) source: std::sync::RwLock<Option<Arc<dyn KeySource>>>,
     /// Chunks read from the pack so far.
-    chunks_read: std::sync::atomic::AtomicU64,
+    pub(crate) chunks_read: std::sync::atomic::AtomicU64,
+    /// The light groups' weights and what they make of the pack ([`crate::relight`]).
+    pub(crate) relight: Arc<crate::relight::Relight>,
+    /// Lighting, non-diffuse cubes and volume blocks blended at the groups' weights.
+    pub(crate) relit: Mutex<crate::relight::Memo>,
 }
 
 impl std::fmt::Debug for Reconstructor {
@@ -93,7 +97,6 @@ impl Reconstructor {
         let (environment, env_error) = PackEnvironment::from_pack(&pack);
         proxy_missing.extend(env_error);
         Reconstructor {
-            pack,
             proxy,
             proxy_missing,
             environment,
@@ -106,6 +109,12 @@ impl Reconstructor {
             rays: std::sync::OnceLock::new(),
             source: std::sync::RwLock::new(None),
             chunks_read: std::sync::atomic::AtomicU64::new(0),
+            relight: Arc::new(crate::relight::Relight::new(
+                pack.manifest(),
+                &plenoptic_pack::GroupWeights::identity(),
+            )),
+            relit: Mutex::new(crate::relight::Memo::default()),
+            pack,
         }
     }
 
@@ -166,86 +175,6 @@ impl Reconstructor {
     /// The temporal filter half-width in use.
     pub fn time_epsilon(&self) -> f32 {
         self.settings.time_epsilon_on(self.pack.manifest())
-    }
-
-    pub(crate) fn cached(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
-        if crate::streamed::is_cube(kind) {
-            let source = self
-                .source
-                .read()
-                .unwrap_or_else(|e| e.into_inner())
-                .clone();
-            if let Some(source) = source {
-                return match source.cube(kind, view, key) {
-                    Some(StreamedCube::Colour(c)) => Cached::Radiance(c),
-                    Some(StreamedCube::Distance(c)) => Cached::Distance(c),
-                    Some(StreamedCube::Ids(c)) => Cached::Ids(c),
-                    Some(StreamedCube::Normal(c)) => Cached::Normal(c),
-                    None => Cached::Absent,
-                };
-            }
-        }
-        {
-            let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-            c.tick += 1;
-            let tick = c.tick;
-            if let Some(entry) = c.map.get_mut(&(kind, view, key)) {
-                entry.1 = tick;
-                return entry.0.clone();
-            }
-        }
-        let what = |e: plenoptic_pack::PackError| Cached::Failed(e.to_string());
-        self.chunks_read
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let value = match kind {
-            ChunkKind::RadianceCube => self
-                .pack
-                .radiance(view, key)
-                .map(|c| Cached::Radiance(Arc::new(c))),
-            ChunkKind::LightingCube => self
-                .pack
-                .lighting(view, key)
-                .map(|c| Cached::Radiance(Arc::new(c))),
-            ChunkKind::NonDiffuseCube => self
-                .pack
-                .non_diffuse(view, key)
-                .map(|c| Cached::Radiance(Arc::new(c))),
-            ChunkKind::DistanceCube => self
-                .pack
-                .distance(view, key)
-                .map(|c| Cached::Distance(Arc::new(c))),
-            ChunkKind::ObjectIdCube => self
-                .pack
-                .object_id(view, key)
-                .map(|c| Cached::Ids(Arc::new(c))),
-            ChunkKind::NormalCube => self
-                .pack
-                .normal(view, key)
-                .map(|c| Cached::Normal(Arc::new(c))),
-            ChunkKind::VolumeConnectivity => self
-                .pack
-                .connectivity(view, key)
-                .map(|t| Cached::Connectivity(Arc::new(t))),
-            _ => self
-                .pack
-                .volume_block(view, key)
-                .map(|b| Cached::Volume(Arc::new(b))),
-        }
-        .unwrap_or_else(what);
-        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        c.tick += 1;
-        let tick = c.tick;
-        c.bytes += value.bytes();
-        c.map.insert((kind, view, key), (value.clone(), tick));
-        while c.bytes > self.settings.cache_bytes && c.map.len() > 1 {
-            let Some((&k, _)) = c.map.iter().min_by_key(|(_, v)| v.1) else {
-                break;
-            };
-            if let Some((v, _)) = c.map.remove(&k) {
-                c.bytes = c.bytes.saturating_sub(v.bytes());
-            }
-        }
-        value
     }
 
     /// The radiance, distance, id (and normal) cubes of (view, key), or a description of

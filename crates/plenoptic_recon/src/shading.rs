@@ -260,7 +260,7 @@ impl Layered<'_> {
         let start = Instant::now();
         let sun = rec.runtime_sun().zip(rec.proxy_rays()).map(|(s, shadows)| {
             let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
-            s.at(shadows, proxy, t, rays)
+            s.at(shadows, proxy, t, rays).scaled(rec.relight.sun)
         });
         let glossy = specular::glossy_allowed(rec);
         let with_footprint = sun.is_some();

@@ -257,8 +257,8 @@ impl<'r> Reflections<'r> {
         Reflections {
             views,
             rays,
-            environment: rec.environment().at(t),
-            lamps: crate::lamps::runtime_lamps(manifest).unwrap_or_default(),
+            environment: rec.environment_at(t),
+            lamps: rec.runtime_lamps().unwrap_or_default(),
             far: march_distance(manifest),
             depth_tolerance: rec.settings.depth_tolerance,
             angular_power: rec.settings.angular_power,

@@ -71,6 +71,14 @@ pub struct PlacedSun<'s> {
     shadows: PlacedShadows<'s>,
 }
 
+impl PlacedSun<'_> {
+    /// The sun with its illuminance multiplied by `weight` (its light group's).
+    pub fn scaled(mut self, weight: Vec3) -> Self {
+        self.illuminance *= weight;
+        self
+    }
+}
+
 impl RuntimeSun {
     /// The runtime sun of `pack`, when its lighting leaves the sun out.
     pub fn load(pack: &PackReader) -> Option<Self> {

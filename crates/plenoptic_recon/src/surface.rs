@@ -227,6 +227,7 @@ impl<'a> Surfaces<'a> {
         let emission = if emits && (marched || self.runtime_emission) {
             self.materials
                 .emission(self.rec.pack(), &t.material.material, uv, uv_footprint)
+                * self.rec.relight.object(t.object)
         } else {
             Vec3::ZERO
         };
@@ -331,7 +332,7 @@ pub(crate) fn surface_at(
     let ng = t.normal;
     let emits = m.material.double_sided || dir.dot(ng) < 0.0;
     let emission = if emits && rec.pack().runtime_emission() {
-        materials.emission(rec.pack(), &m.material, uv, uv_footprint)
+        materials.emission(rec.pack(), &m.material, uv, uv_footprint) * rec.relight.object(id)
     } else {
         Vec3::ZERO
     };

@@ -1,0 +1,263 @@
+//! Light groups at runtime: the baked animation relit by a colour × intensity per group
+//! (docs/pack-format.md, "Light groups"; the blend is [`plenoptic_pack::groups`]'s).
+//!
+//! What the pack stores is scaled where it is read, once per chunk and set of weights: the
+//! lighting and non-diffuse cubes and the volume blocks' values are blended from the total
+//! and the layers of the groups whose weight differs ([`GroupWeights::blend`]) when the
+//! chunk cache hands them out, and kept until the weights change. A lookup then reads one
+//! blended texel as before, so the frame costs what it cost without groups; a change of
+//! weights costs one pass over each resident chunk. What the runtime computes itself is
+//! scaled where it is computed: the runtime sun by the sun's group, a placed lamp's highlight
+//! by its light's group, the emission at a pixel's UV by its object's group, and the
+//! environment (background, reflections, glazing) by the sky's group.
+//!
+//! Image and volume modes warp the stored radiance, which is not split by group: they show
+//! the pack at its own intensities.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::Vec3;
+use plenoptic_pack::{
+    ChunkKind, CubeImage, GroupWeights, LayerBlend, Manifest, VolumeBlock, VolumeSample,
+};
+
+use crate::Reconstructor;
+use crate::cache::Cached;
+
+/// The light groups' weights and what they give each emitter of a pack.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Relight {
+    /// The weights as set.
+    pub weights: GroupWeights,
+    /// How the stored layers combine at them.
+    pub blend: LayerBlend,
+    /// The runtime sun's multiplier.
+    pub sun: Vec3,
+    /// The environment's multiplier.
+    pub sky: Vec3,
+    /// Per manifest light.
+    lights: Vec<Vec3>,
+    /// Per object id whose emission is scaled (absent: 1).
+    objects: HashMap<u32, Vec3>,
+}
+
+impl Relight {
+    /// The multipliers of `manifest`'s emitters at `weights`. A pack without groups has one
+    /// group, the default, whose weight scales everything.
+    pub fn new(manifest: &Manifest, weights: &GroupWeights) -> Self {
+        let entry = manifest.light_groups.as_ref();
+        let of = |g: Option<u32>| weights.weight(g);
+        let lights = (0..manifest.lights.len())
+            .map(|i| of(entry.and_then(|e| e.lights.get(i).copied().flatten())))
+            .collect();
+        let objects = manifest
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                (
+                    o.id,
+                    of(entry.and_then(|e| e.objects.get(i).copied().flatten())),
+                )
+            })
+            .filter(|(_, w)| *w != Vec3::ONE)
+            .collect();
+        Self {
+            weights: weights.clone(),
+            blend: weights.blend(entry),
+            sun: of(entry.and_then(|e| e.sun)),
+            sky: of(entry.and_then(|e| e.sky)),
+            lights,
+            objects,
+        }
+    }
+
+    /// Manifest light `i`'s multiplier.
+    pub fn light(&self, i: usize) -> Vec3 {
+        self.lights.get(i).copied().unwrap_or(Vec3::ONE)
+    }
+
+    /// The multiplier of object `id`'s emission.
+    pub fn object(&self, id: u32) -> Vec3 {
+        self.objects.get(&id).copied().unwrap_or(Vec3::ONE)
+    }
+}
+
+/// Chunks blended at the current weights, by (kind, view, key); cleared when they change.
+#[derive(Default)]
+pub(crate) struct Memo {
+    map: HashMap<(ChunkKind, u32, u32), Cached>,
+    bytes: usize,
+}
+
+/// Whether chunks of `kind` hold light that the groups' weights scale.
+pub(crate) fn blended(kind: ChunkKind) -> bool {
+    matches!(
+        kind,
+        ChunkKind::LightingCube | ChunkKind::NonDiffuseCube | ChunkKind::VolumeBlock
+    )
+}
+
+/// The group layer of `kind` for group `g`.
+fn layer_kind(kind: ChunkKind, g: u32) -> ChunkKind {
+    match kind {
+        ChunkKind::LightingCube => ChunkKind::GroupLighting(g),
+        ChunkKind::NonDiffuseCube => ChunkKind::GroupNonDiffuse(g),
+        _ => ChunkKind::GroupVolume(g),
+    }
+}
+
+/// `blend` of a colour cube's total and its layers (same face size, else `None`).
+fn blend_cube(
+    blend: &LayerBlend,
+    total: &CubeImage<Vec3>,
+    layers: &[Arc<CubeImage<Vec3>>],
+) -> Option<CubeImage<Vec3>> {
+    if layers.iter().any(|l| l.face_size != total.face_size) {
+        return None;
+    }
+    let texels = (0..total.texels.len())
+        .map(|i| blend.apply(total.texels[i], |k| layers[k].texels[i]))
+        .collect();
+    Some(CubeImage {
+        face_size: total.face_size,
+        texels,
+    })
+}
+
+/// `blend` of a volume block's samples' lighting and non-diffuse values (each layer as long
+/// as the block, else `None`). The radiance stays the total's.
+fn blend_block(
+    blend: &LayerBlend,
+    block: &VolumeBlock,
+    layers: &[Arc<Vec<[Vec3; 2]>>],
+) -> Option<VolumeBlock> {
+    if layers.iter().any(|l| l.len() != block.samples.len()) {
+        return None;
+    }
+    let samples = (block.samples.iter().enumerate())
+        .map(|(i, s)| VolumeSample {
+            lighting: blend.apply(s.lighting, |k| layers[k][i][0]),
+            non_diffuse: blend.apply(s.non_diffuse, |k| layers[k][i][1]),
+            ..*s
+        })
+        .collect();
+    Some(VolumeBlock {
+        samples,
+        ..block.clone()
+    })
+}
+
+impl Reconstructor {
+    /// Sets each light group's colour × intensity (a pack without groups has the default group
+    /// alone); frames from now on show the pack relit (see the module doc).
+    pub fn set_light_weights(&mut self, weights: GroupWeights) {
+        let relight = Relight::new(self.pack.manifest(), &weights);
+        if relight != *self.relight {
+            self.relight = Arc::new(relight);
+            *self.relit.lock().unwrap_or_else(|e| e.into_inner()) = Memo::default();
+        }
+    }
+
+    /// The pack's environment at time `t` (sky, ground, image or colour), scaled by the sky's
+    /// group.
+    pub fn environment_at(&self, t: f32) -> plenoptic_pack::plenoptic_sky::PlacedEnvironment {
+        self.environment().at(t).scaled(self.relight.sky)
+    }
+
+    /// The pack's runtime lamps ([`crate::lamps::runtime_lamps`]), each scaled by its light's
+    /// group.
+    pub fn runtime_lamps(&self) -> Option<Vec<crate::lamps::RuntimeLamp>> {
+        let mut lamps = crate::lamps::runtime_lamps(self.pack.manifest())?;
+        for lamp in &mut lamps {
+            lamp.radiant *= self.relight.light(lamp.light);
+        }
+        Some(lamps)
+    }
+
+    /// The light groups' weights in use.
+    pub fn light_weights(&self) -> &GroupWeights {
+        &self.relight.weights
+    }
+
+    /// The chunk of `kind` (lighting, non-diffuse or volume block) at the current weights,
+    /// blended on first use and kept until the weights change.
+    pub(crate) fn relit(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
+        let id = (kind, view, key);
+        if let Some(c) = self
+            .relit
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .map
+            .get(&id)
+        {
+            return c.clone();
+        }
+        let blend = &self.relight.blend;
+        let layer = |g: u32| self.cached_stored(layer_kind(kind, g), view, key);
+        let failed = |what: &str| {
+            Cached::Failed(format!(
+                "light group layers of {kind:?} (base view {view}, key {key}) {what}"
+            ))
+        };
+        let value = match self.cached_stored(kind, view, key) {
+            Cached::Radiance(total) => {
+                let mut layers = Vec::with_capacity(blend.layers.len());
+                for &(g, _) in &blend.layers {
+                    match layer(g) {
+                        Cached::Radiance(c) => layers.push(c),
+                        Cached::Failed(e) => return Cached::Failed(e),
+                        _ => return failed("are missing"),
+                    }
+                }
+                blend_cube(blend, &total, &layers).map_or_else(
+                    || failed("differ in size"),
+                    |c| Cached::Radiance(Arc::new(c)),
+                )
+            }
+            Cached::Volume(block) => {
+                let mut layers = Vec::with_capacity(blend.layers.len());
+                for &(g, _) in &blend.layers {
+                    match layer(g) {
+                        Cached::GroupVolume(v) => layers.push(v),
+                        Cached::Failed(e) => return Cached::Failed(e),
+                        _ => return failed("are missing"),
+                    }
+                }
+                blend_block(blend, &block, &layers).map_or_else(
+                    || failed("differ in length"),
+                    |b| Cached::Volume(Arc::new(b)),
+                )
+            }
+            other => return other,
+        };
+        let mut memo = self.relit.lock().unwrap_or_else(|e| e.into_inner());
+        memo.bytes += value.bytes();
+        if memo.bytes > self.settings.cache_bytes {
+            *memo = Memo::default();
+            memo.bytes = value.bytes();
+        }
+        memo.map.insert(id, value.clone());
+        value
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cube_blends_its_total_with_the_layers_that_changed() {
+        let blend = LayerBlend {
+            base: Vec3::ONE,
+            layers: vec![(0, Vec3::splat(-1.0))],
+        };
+        let total = CubeImage::filled(1, Vec3::splat(3.0));
+        let lamp = Arc::new(CubeImage::filled(1, Vec3::splat(1.0)));
+        let relit = blend_cube(&blend, &total, &[lamp]).unwrap();
+        assert!(relit.texels.iter().all(|&t| t == Vec3::splat(2.0)));
+        let other = Arc::new(CubeImage::filled(2, Vec3::ONE));
+        assert!(blend_cube(&blend, &total, &[other]).is_none());
+    }
+}
