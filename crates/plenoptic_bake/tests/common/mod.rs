@@ -1,6 +1,8 @@
 //! Tiny test scenes and recipes.
 #![allow(dead_code)]
 
+pub mod sunlit_room;
+
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -99,6 +101,17 @@ max_space_depth = 1
 /// Writes `scene.glb` and `recipe.toml` into `dir`; returns the recipe's path.
 /// `view` is the `[view_space]` body, `quality` extra `[quality]` lines (after [`TINY`]).
 pub fn write_recipe(dir: &Path, scene: &SceneBuilder, view: &str, quality: &str) -> PathBuf {
+    write_recipe_with(dir, scene, view, quality, "")
+}
+
+/// [`write_recipe`] with `extra` tables (`[sky]`, `[[light_group]]`, …) after `[quality]`.
+pub fn write_recipe_with(
+    dir: &Path,
+    scene: &SceneBuilder,
+    view: &str,
+    quality: &str,
+    extra: &str,
+) -> PathBuf {
     scene.write_glb(&dir.join("scene.glb")).unwrap();
     // Later lines override earlier ones with the same key.
     let mut lines: Vec<(String, String)> = Vec::new();
@@ -114,7 +127,7 @@ pub fn write_recipe(dir: &Path, scene: &SceneBuilder, view: &str, quality: &str)
     let quality: String = lines.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
     let text = format!(
         "output = \"out/scene.pack\"\n\n[[scene]]\nfile = \"scene.glb\"\n\n[view_space]\n{view}\n\n\
-         [time]\nstart = 0.0\nend = 1.0\nframe_rate = 8.0\n\n[quality]\n{quality}"
+         [time]\nstart = 0.0\nend = 1.0\nframe_rate = 8.0\n\n[quality]\n{quality}\n{extra}"
     );
     let path = dir.join("recipe.toml");
     std::fs::write(&path, text).unwrap();
