@@ -54,7 +54,10 @@ fn lit_room(lamp: f32, daylight: f32) -> SceneBuilder {
 /// The `[sky]` table with the sky at `daylight` times its radiance.
 fn sky(daylight: f32) -> String {
     let c = SKY * daylight;
-    format!("[sky]\nkind = \"uniform\"\ncolor = [{}, {}, {}]\n", c.x, c.y, c.z)
+    format!(
+        "[sky]\nkind = \"uniform\"\ncolor = [{}, {}, {}]\n",
+        c.x, c.y, c.z
+    )
 }
 
 /// Bakes `room` with `extra` recipe tables into `dir`; returns the recipe's path.
@@ -79,7 +82,11 @@ fn frame(rec: &Reconstructor) -> Image<Vec3> {
 #[test]
 fn groups_relight_the_room_as_the_path_tracer_and_a_bake_of_that_lighting_do() {
     let dir = tempfile::tempdir().unwrap();
-    let recipe = bake(dir.path(), &lit_room(1.0, 1.0), &format!("{}\n{GROUPS}", sky(1.0)));
+    let recipe = bake(
+        dir.path(),
+        &lit_room(1.0, 1.0),
+        &format!("{}\n{GROUPS}", sky(1.0)),
+    );
     let (_, scene) = plenoptic_bake::input::load_recipe(&recipe).unwrap();
     assert_eq!(scene.light_groups.names, ["lamp", "daylight"]);
     let mut rec = Reconstructor::open(dir.path().join("out/scene.pack")).unwrap();
@@ -121,7 +128,10 @@ fn groups_relight_the_room_as_the_path_tracer_and_a_bake_of_that_lighting_do() {
             lrms / base,
             mean_luminance_ratio(&plain, &reference)
         );
-        assert!((ratio - 1.0).abs() < 0.03, "({lamp}, {daylight}): mean {ratio:.4}");
+        assert!(
+            (ratio - 1.0).abs() < 0.03,
+            "({lamp}, {daylight}): mean {ratio:.4}"
+        );
         assert!(
             lrms <= 1.2 * control,
             "({lamp}, {daylight}): LRMS {lrms:.4} against the ungrouped bake's {control:.4}"

@@ -8,14 +8,19 @@ use std::io::Cursor;
 use common::*;
 use plenoptic_pack::*;
 
-/// The packs mutated: every chunk kind of 1.1, and (1.2) materials, textures and proxy
-/// attributes.
+/// The packs mutated: every chunk kind of 1.1, (1.2) materials, textures and proxy
+/// attributes, and (4.2) light groups' layers.
 fn fixtures() -> Vec<Vec<u8>> {
     let dir = tempfile::tempdir().unwrap();
-    let (a, b) = (dir.path().join("m.pack"), dir.path().join("mat.pack"));
+    let (a, b, c) = (
+        dir.path().join("m.pack"),
+        dir.path().join("mat.pack"),
+        dir.path().join("groups.pack"),
+    );
     write_small_pack(&a);
     write_material_pack(&b);
-    vec![std::fs::read(a).unwrap(), std::fs::read(b).unwrap()]
+    write_group_pack(&c);
+    [a, b, c].map(|p| std::fs::read(p).unwrap()).to_vec()
 }
 
 #[test]

@@ -132,7 +132,6 @@ pub fn sunlit(p: Vec3) -> bool {
     p.y < -HALF + 1e-2 && (y0..y1).contains(&q.y) && (z0..z1).contains(&q.z)
 }
 
-
 /// A camera in the room's south-west corner looking down at the sun patch.
 pub fn camera(width: u32, height: u32) -> plenoptic_recon::Camera {
     plenoptic_recon::Camera::look_at(

@@ -435,3 +435,52 @@ pub fn write_material_pack(path: &std::path::Path) -> Manifest {
     w.finish(&m).unwrap();
     m
 }
+
+/// Writes a pack with two light groups ([`plenoptic_pack::groups`]): two range images and a
+/// volume block, each with both groups' layers; returns the manifest.
+pub fn write_group_pack(path: &std::path::Path) -> Manifest {
+    let mut m = manifest(1);
+    m.light_groups = Some(LightGroupsEntry {
+        names: vec!["lamp".into(), "daylight".into()],
+        lights: vec![None; m.lights.len()],
+        objects: vec![Some(0); m.objects.len()],
+        sun: Some(1),
+        sky: Some(1),
+        default_has_emitters: false,
+    });
+    let mut w = PackWriter::create(path).unwrap();
+    for k in 0..2u32 {
+        let image = room_image(4, k as f32 * 0.3);
+        w.add_range_image(0, k, &image, CubeFormats::default())
+            .unwrap();
+        for g in 0..2u32 {
+            let share = |c: &CubeImage<glam::Vec3>| CubeImage {
+                face_size: c.face_size,
+                texels: c
+                    .texels
+                    .iter()
+                    .map(|t| *t * (0.25 + 0.5 * g as f32))
+                    .collect(),
+            };
+            let l = encode_radiance(&share(&image.lighting), RadianceFormat::Rgb9e5).unwrap();
+            w.add_chunk(ChunkKind::GroupLighting(g), 0, k, &l).unwrap();
+            let n = encode_radiance(&share(&image.non_diffuse), RadianceFormat::Rgb9e5).unwrap();
+            w.add_chunk(ChunkKind::GroupNonDiffuse(g), 0, k, &n)
+                .unwrap();
+        }
+    }
+    let s = volume_samples(32, 0.0, 0.5, 3);
+    let order = w.add_volume_block(0, 0, (0.0, 0.5), &s, None).unwrap();
+    for g in 0..2u32 {
+        let values: Vec<[glam::Vec3; 2]> = s
+            .iter()
+            .map(|x| [x.lighting * (0.25 + 0.5 * g as f32), x.non_diffuse * 0.5])
+            .collect();
+        let (bytes, len) = groups::encode_group_volume(&values, &order).unwrap();
+        w.add_raw_chunk(ChunkKind::GroupVolume(g), 0, 0, &bytes, len, None)
+            .unwrap();
+    }
+    w.add_proxy_mesh(&proxy_mesh(1, true)).unwrap();
+    w.finish(&m).unwrap();
+    m
+}
