@@ -682,13 +682,15 @@ fn validate_entries(
 /// Whether the pack at `path` is of an older format than this crate writes: one it refuses
 /// (version 1, [`PackError::NeedsRebake`]) or one it reads but a bake would improve (version
 /// 2 keeps the sun's direct light in its lighting; 4.0 does not place its lamps, so glossy
-/// surfaces keep the highlights the base views saw). A newer minor is not outdated. A file
-/// that cannot be opened for another reason is not outdated (opening it reports that).
+/// surfaces keep the highlights the base views saw). 4.1 is current: 4.2 only adds light
+/// groups, which a bake writes when its recipe declares them. A newer minor is not
+/// outdated. A file that cannot be opened for another reason is not outdated (opening it
+/// reports that).
 pub fn is_outdated(path: impl AsRef<Path>) -> bool {
     match PackReader::open(path) {
         Ok(r) => {
             let h = r.header();
-            (h.version_major, h.version_minor) < (crate::VERSION_MAJOR, crate::VERSION_MINOR)
+            (h.version_major, h.version_minor) < (crate::VERSION_MAJOR, 1)
         }
         Err(e) => matches!(e, PackError::NeedsRebake { .. }),
     }

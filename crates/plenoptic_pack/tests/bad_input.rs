@@ -440,6 +440,7 @@ fn older_formats_are_outdated() {
         (3, 2, true),
         (4, 0, true),
         (4, 1, false),
+        (4, 2, false),
         (4, 7, false),
     ] {
         let mut b = small_pack();
