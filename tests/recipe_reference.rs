@@ -11,13 +11,14 @@ use plenoptic_scene::recipe::Preset;
 use syn::{Fields, Item, ItemStruct};
 
 /// The recipe's tables, in the order a recipe is written: heading, struct, source file.
-const TABLES: [(&str, &str, &str); 6] = [
+const TABLES: [(&str, &str, &str); 7] = [
     ("top level", "Recipe", "mod.rs"),
     ("`[[scene]]`", "SceneEntry", "mod.rs"),
     ("`[view_space]`", "ViewSpaceToml", "mod.rs"),
     ("`[time]`", "TimeToml", "mod.rs"),
     ("`[sun]`", "SunToml", "daylight.rs"),
     ("`[sky]`", "SkyToml", "daylight.rs"),
+    ("`[[light_group]]`", "LightGroupToml", "groups.rs"),
 ];
 
 fn root() -> PathBuf {
@@ -73,7 +74,15 @@ fn keys(s: &ItemStruct) -> Vec<(String, String)> {
     let Fields::Named(fields) = &s.fields else {
         panic!("{} has no named fields", s.ident)
     };
-    let tables = ["scene", "view_space", "time", "quality", "sun", "sky"];
+    let tables = [
+        "scene",
+        "view_space",
+        "time",
+        "quality",
+        "sun",
+        "sky",
+        "light_group",
+    ];
     fields
         .named
         .iter()

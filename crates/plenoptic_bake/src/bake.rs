@@ -147,6 +147,7 @@ pub fn bake(recipe: &BakeRecipe, scene: &Scene, options: &BakeOptions) -> Result
         .zip(&layer_fields)
         .map(|(((group, _), accel), fields)| Layer {
             group: *group,
+            stored: crate::groups::is_stored(scene, *group),
             accel,
             fields,
         })

@@ -6,9 +6,10 @@
 //! scene's and is shared; each layer gets its own scene, acceleration structure and ambient
 //! fields at the plan's ambient key times. Every range image and volume sample is rendered per
 //! layer with the same random streams; the total the pack stores in its lighting cubes is the
-//! layers' sum, and each declared group's lighting and non-diffuse radiance are stored beside
-//! it. So the total equals the sum of its groups exactly (up to quantisation) and a reader
-//! may scale each. The geometry (distance, id, normal) does not depend on the emitters and is
+//! layers' sum, and the declared groups' lighting and non-diffuse radiance are stored beside
+//! it (all but the last when the default group is empty: that one is the total less the
+//! others, [`LightGroupsEntry::stored`]). So the total equals the sum of its groups exactly
+//! (up to quantisation) and a reader may scale each. The geometry (distance, id, normal) does not depend on the emitters and is
 //! taken from the first layer.
 //!
 //! Cost: every rendering of the bake is done once per layer, so the range images, volumes and
@@ -40,6 +41,9 @@ pub fn layer_scenes(scene: &Scene) -> Vec<(Option<u32>, Scene)> {
 pub struct Layer<'a> {
     /// Its group (`None`: the default group).
     pub group: Option<u32>,
+    /// Whether its lighting is stored as a layer of its own (else it is the total less the
+    /// stored layers).
+    pub stored: bool,
     /// The scene with only the group's emitters on.
     pub accel: &'a SceneAccel<'a>,
     /// Its ambient fields at the plan's ambient key times.
@@ -71,6 +75,12 @@ pub fn sum_images(images: &[&RangeImage]) -> Option<RangeImage> {
         add(&mut total.non_diffuse, &image.non_diffuse);
     }
     Some(total)
+}
+
+/// Whether the pack of `scene` stores `group`'s layers ([`LightGroupsEntry::stored`]).
+pub fn is_stored(scene: &Scene, group: Option<u32>) -> bool {
+    let entry = manifest_entry(scene);
+    group.is_some_and(|g| entry.is_some_and(|e| e.stored().contains(&g)))
 }
 
 /// The manifest's `light_groups` for `scene` (`None` without groups). Manifest lights and

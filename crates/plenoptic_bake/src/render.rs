@@ -109,14 +109,15 @@ impl<'a> BakeRenderer<'a> {
         self
     }
 
-    /// What is rendered: `(group, scene, its fields)` per layer, or the scene itself.
+    /// What is rendered: `(the group whose layer is stored, scene, its fields)` per layer, or
+    /// the scene itself.
     fn sources(&self) -> Vec<(Option<u32>, &'a SceneAccel<'a>, &'a [AmbientField])> {
         if self.layers.is_empty() {
             return vec![(None, self.accel, self.fields)];
         }
         self.layers
             .iter()
-            .map(|l| (l.group, l.accel, l.fields))
+            .map(|l| (l.group.filter(|_| l.stored), l.accel, l.fields))
             .collect()
     }
 
@@ -168,7 +169,7 @@ impl<'a> BakeRenderer<'a> {
             .expect("at least one source");
         let groups = images
             .into_iter()
-            .filter_map(|(g, image)| g.filter(|_| !self.layers.is_empty()).map(|g| (g, image)))
+            .filter_map(|(g, image)| g.map(|g| (g, image)))
             .collect();
         Ok(LayeredImage { total, groups })
     }
@@ -222,7 +223,7 @@ impl<'a> BakeRenderer<'a> {
             if !self.plan.quality.runtime_sun {
                 bake_the_sun(&mut s);
             }
-            if let Some(g) = group.filter(|_| !self.layers.is_empty()) {
+            if let Some(g) = group {
                 let (lighting, non_diffuse) = crate::denoise::split_sample(&s);
                 groups.push((g, [lighting, non_diffuse]));
             }

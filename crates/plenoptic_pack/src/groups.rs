@@ -15,10 +15,13 @@
 //! L(w) = Σ_g w_g · L_g = w_0 · T + Σ_{g ≥ 1} (w_g − w_0) · L_g
 //! ```
 //!
-//! (`T` the total). [`GroupWeights::blend`] picks `w_0` when the default group has no emitter
-//! (it is then free) so that as few layers as possible are read: at equal weights none, a
-//! lamp switched off one. A reader that knows nothing of groups reads the total (the
-//! kinds are skipped by a 4.1 reader), which is the pack at every group's own intensity.
+//! (`T` the total). When the default group has no emitter, `T` is the sum of the declared
+//! groups, so the last declared group's layers are not stored: it takes the default group's
+//! place (`L_last = T − Σ_{g < last} L_g`, and `w_0` is its weight). So a pack stores one layer
+//! less than it has groups ([`LightGroupsEntry::stored`]), and a reader reads only the layers
+//! whose weight differs from the derived group's: at equal weights none, a lamp switched off
+//! one. A reader that knows nothing of groups reads the total (the kinds are skipped by a
+//! 4.1 reader), which is the pack at every group's own intensity.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -80,6 +83,17 @@ pub struct LightGroupsEntry {
 }
 
 impl LightGroupsEntry {
+    /// The groups whose layers the pack stores: every declared group when the default group
+    /// has emitters, else all but the last (whose light is the total less the others').
+    pub fn stored(&self) -> std::ops::Range<u32> {
+        let n = self.names.len() as u32;
+        if self.default_has_emitters {
+            0..n
+        } else {
+            0..n.saturating_sub(1)
+        }
+    }
+
     /// Checks the entry against the manifest's light and object counts: names unique, not
     /// empty, at most [`MAX_LIGHT_GROUPS`], every index inside.
     pub fn validate(&self, lights: usize, objects: usize) -> std::result::Result<(), String> {
@@ -210,22 +224,14 @@ impl GroupWeights {
                 layers: Vec::new(),
             };
         };
-        let n = entry.names.len() as u32;
+        let stored = entry.stored();
+        // The group whose light is the total less the stored layers.
         let base = if entry.default_has_emitters {
             self.default
         } else {
-            // The default group is empty: w₀ is free; take the weight most groups have.
-            let mut best = (self.weight(Some(0)), 0);
-            for g in 0..n {
-                let w = self.weight(Some(g));
-                let count = (0..n).filter(|&h| self.weight(Some(h)) == w).count();
-                if count > best.1 {
-                    best = (w, count);
-                }
-            }
-            best.0
+            self.weight(Some(stored.end))
         };
-        let layers = (0..n)
+        let layers = stored
             .map(|g| (g, self.weight(Some(g)) - base))
             .filter(|(_, c)| *c != Vec3::ZERO)
             .collect();
@@ -308,6 +314,11 @@ mod tests {
     #[test]
     fn equal_weights_read_no_layer_and_a_lamp_off_reads_one() {
         let e = entry(false);
+        assert_eq!(
+            e.stored(),
+            0..2,
+            "the sky's light is the total less the others'"
+        );
         let w = |g: [f32; 3]| GroupWeights {
             default: Vec3::ONE,
             groups: g.map(Vec3::splat).to_vec(),
@@ -318,7 +329,7 @@ mod tests {
         let off = w([0.0, 1.0, 1.0]).blend(Some(&e));
         assert_eq!(off.base, Vec3::ONE);
         assert_eq!(off.layers, vec![(0, Vec3::splat(-1.0))]);
-        // T = L0 + L1 + L2: the blend is Σ w_g L_g whatever base it picked.
+        // T = L0 + L1 + L2: the blend is Σ w_g L_g whatever it reads.
         let layers = [
             Vec3::new(1.0, 2.0, 3.0),
             Vec3::splat(4.0),
@@ -327,6 +338,10 @@ mod tests {
         let total = layers.iter().sum::<Vec3>();
         for g in [[0.0, 1.0, 1.0], [0.5, 2.0, 0.0], [3.0, 0.0, 0.0]] {
             let b = w(g).blend(Some(&e));
+            assert!(
+                b.layers.iter().all(|&(g, _)| g < 2),
+                "only stored layers are read"
+            );
             let expected: Vec3 = (0..3).map(|i| layers[i] * g[i]).sum();
             let got = b.apply(total, |k| layers[b.layers[k].0 as usize]);
             assert!(

@@ -594,16 +594,18 @@ fn validate_light_groups(
     groups: Option<&crate::LightGroupsEntry>,
 ) -> Result<()> {
     let declared = groups.map_or(0, |g| g.names.len() as u32);
+    let stored = groups.map_or(0..0, |g| g.stored());
     for (i, e) in entries.iter().enumerate() {
         let mismatch = |problem: String| PackError::LightGroupMismatch {
             chunk: e.chunk_ref(i),
             problem,
         };
         if let Some(g) = e.kind.light_group()
-            && g >= declared
+            && !stored.contains(&g)
         {
             return Err(mismatch(format!(
-                "light group {g}, but the manifest declares {declared} groups"
+                "light group {g}, but the manifest declares {declared} groups of which {} are stored",
+                stored.len()
             )));
         }
         let needs: &[fn(u32) -> ChunkKind] = match e.kind {
@@ -613,7 +615,7 @@ fn validate_light_groups(
         };
         for kind in needs {
             if let Some(g) =
-                (0..declared).find(|&g| !index.contains_key(&(kind(g), e.base_view, e.key)))
+                (stored.clone()).find(|&g| !index.contains_key(&(kind(g), e.base_view, e.key)))
             {
                 return Err(mismatch(format!(
                     "no {:?} chunk for light group {g} of the {declared} the manifest declares",

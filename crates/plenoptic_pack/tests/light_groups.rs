@@ -4,7 +4,6 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
 use plenoptic_pack::*;
 
 #[test]

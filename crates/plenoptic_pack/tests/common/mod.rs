@@ -446,7 +446,7 @@ pub fn write_group_pack(path: &std::path::Path) -> Manifest {
         objects: vec![Some(0); m.objects.len()],
         sun: Some(1),
         sky: Some(1),
-        default_has_emitters: false,
+        default_has_emitters: true,
     });
     let mut w = PackWriter::create(path).unwrap();
     for k in 0..2u32 {
