@@ -6,7 +6,7 @@
 //! plenoptic merge RECIPE [--keep-work]              join shards into the pack
 //! plenoptic inspect PACK [--chunks] [--extract N OUT]
 //! plenoptic reference RECIPE --path PATH.json --out DIR [--spp N] [--seed S] [--halves]
-//!                    [--exposure E] [--light NAME=I]...
+//!                    [--exposure E] [--light NAME=I]... [--frames N]
 //! plenoptic render PACK --path PATH.json [--mode image|volume|geometry]
 //!     [--shading materials|radiance] [--reflections shaded|marched] [--supersampling N]
 //!     [--frames N] [--exposure E] [--light NAME=I]... --out DIR
@@ -210,6 +210,10 @@ enum Command {
         /// A light group's colour × intensity, as `plenoptic render --light` takes it.
         #[arg(long = "light", value_name = "NAME=I")]
         lights: Vec<String>,
+        /// Render N frames spread evenly over the whole path, the frames `plenoptic render
+        /// --frames N` renders, instead of every frame.
+        #[arg(long)]
+        frames: Option<usize>,
     },
 }
 
@@ -311,7 +315,11 @@ fn run(command: Command) -> Result<()> {
             halves,
             exposure,
             lights,
-        } => cmd_reference(&recipe, &path, &out, (spp, seed, halves), exposure, &lights),
+            frames,
+        } => {
+            let samples = plenoptic_bake::reference::path_frames(&path, frames)?;
+            cmd_reference(&recipe, &samples, &out, (spp, seed, halves), exposure, &lights)
+        }
     }
 }
 
@@ -647,7 +655,7 @@ fn cmd_inspect(pack_path: &Path, chunks: bool, extract: Option<Vec<String>>) -> 
 
 fn cmd_reference(
     recipe_path: &Path,
-    path: &Path,
+    frames: &[plenoptic_recon::PathSample],
     out: &Path,
     (spp, seed, halves): (Option<u32>, Option<u64>, bool),
     exposure: Option<f32>,
@@ -655,7 +663,6 @@ fn cmd_reference(
 ) -> Result<()> {
     let (recipe, scene) = plenoptic_bake::input::load_recipe(recipe_path)?;
     let scene = plenoptic_bake::groups::relit_scene(&scene, lights)?;
-    let frames = plenoptic_bake::reference::path_frames(path)?;
     let spp = spp.unwrap_or(recipe.quality.reference_samples_per_pixel);
     let seed = seed.unwrap_or(0);
     // Two halves: half the samples each, seeds S and S + 1 (independent streams), the same
@@ -675,7 +682,7 @@ fn cmd_reference(
     for (dir, spp, seed) in runs {
         let summary = plenoptic_bake::reference::render_reference(
             &scene,
-            &frames,
+            frames,
             spp,
             Some(seed),
             &dir,

@@ -77,9 +77,13 @@ pub fn render_reference(
     })
 }
 
-/// Every frame of the camera path file `path` (its frame rate and size).
-pub fn path_frames(path: &Path) -> Result<Vec<PathSample>> {
+/// The frames of the camera path file `path` (its frame rate and size): every frame, or
+/// `spread` frames spread evenly over it ([`CameraPath::spread`]).
+pub fn path_frames(path: &Path, spread: Option<usize>) -> Result<Vec<PathSample>> {
     let camera_path = CameraPath::load(path)
         .map_err(|e| BakeError::Invalid(format!("{}: {e}", path.display())))?;
-    Ok(camera_path.frames().collect())
+    Ok(match spread {
+        Some(n) => camera_path.spread(n),
+        None => camera_path.frames().collect(),
+    })
 }
