@@ -58,7 +58,10 @@ fn weights(rec: &Reconstructor, settings: &[(&str, f32)]) -> GroupWeights {
 
 fn render_all(rec: &Reconstructor, frames: &[PathSample]) {
     for f in frames {
-        black_box(rec.render(&f.camera, f.scene_time, Mode::GeometryAssisted).unwrap());
+        black_box(
+            rec.render(&f.camera, f.scene_time, Mode::GeometryAssisted)
+                .unwrap(),
+        );
     }
 }
 

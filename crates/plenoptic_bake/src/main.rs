@@ -318,7 +318,14 @@ fn run(command: Command) -> Result<()> {
             frames,
         } => {
             let samples = plenoptic_bake::reference::path_frames(&path, frames)?;
-            cmd_reference(&recipe, &samples, &out, (spp, seed, halves), exposure, &lights)
+            cmd_reference(
+                &recipe,
+                &samples,
+                &out,
+                (spp, seed, halves),
+                exposure,
+                &lights,
+            )
         }
     }
 }

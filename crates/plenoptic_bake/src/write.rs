@@ -84,7 +84,7 @@ pub fn range_image_chunks(bv: u32, key: u32, layered: &LayeredImage) -> Result<V
         ),
     ];
     for (g, group) in &layered.groups {
-        let group = crate::quantise::coarsen(group);
+        let group = crate::quantise::coarsen_group(group, &layered.total);
         out.push(c(
             ChunkKind::GroupLighting(*g),
             encode_radiance(&group.lighting, FORMATS.radiance)?,
@@ -147,7 +147,13 @@ pub fn volume_chunks(plan: &Plan, bv: u32, volume: &LayeredVolume) -> Result<Vec
         for (g, values) in &volume.groups {
             let values: Vec<[glam::Vec3; 2]> = members
                 .iter()
-                .map(|&i| values[i].map(crate::quantise::coarsen_colour))
+                .map(|&i| {
+                    let (total, [l, nd]) = (&volume.samples[i], values[i]);
+                    [
+                        crate::quantise::coarsen_layer(l, total.lighting),
+                        crate::quantise::coarsen_layer(nd, total.radiance),
+                    ]
+                })
                 .collect();
             let (bytes, len) = plenoptic_pack::groups::encode_group_volume(&values, &enc.order)?;
             out.push(chunk(ChunkKind::GroupVolume(*g), len, bytes));
