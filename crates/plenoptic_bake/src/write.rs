@@ -148,10 +148,12 @@ pub fn volume_chunks(plan: &Plan, bv: u32, volume: &LayeredVolume) -> Result<Vec
             let values: Vec<[glam::Vec3; 2]> = members
                 .iter()
                 .map(|&i| {
+                    // A sample's group radiance is not kept: its non-diffuse part is rounded
+                    // against the total's radiance alone.
                     let (total, [l, nd]) = (&volume.samples[i], values[i]);
                     [
-                        crate::quantise::coarsen_layer(l, total.lighting),
-                        crate::quantise::coarsen_layer(nd, total.radiance),
+                        crate::quantise::coarsen_layer(l, l, total.lighting),
+                        crate::quantise::coarsen_layer(nd, total.radiance, total.radiance),
                     ]
                 })
                 .collect();
