@@ -11,8 +11,13 @@
 //! by its light's group, the emission at a pixel's UV by its object's group, and the
 //! environment (background, reflections, glazing) by the sky's group.
 //!
-//! Image and volume modes warp the stored radiance, which is not split by group: they show
-//! the pack at its own intensities.
+//! The radiance (radiance cubes, volume samples' radiance), which glossy reflections answer
+//! from and image and volume modes warp, is not split by group: it is scaled per texel and
+//! channel by the ratio of the blended lighting + non-diffuse radiance to the stored one
+//! ([`relit_radiance`]), and a texel that sees no object by the sky's weight. That is exact
+//! where the texel's light is indirect or from one group; the sun's direct light and an
+//! emitter's own emission, which the radiance holds and the lighting does not, are scaled by
+//! the ratio of the light around them instead of their own group's weight.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -95,8 +100,19 @@ pub(crate) struct Memo {
 pub(crate) fn blended(kind: ChunkKind) -> bool {
     matches!(
         kind,
-        ChunkKind::LightingCube | ChunkKind::NonDiffuseCube | ChunkKind::VolumeBlock
+        ChunkKind::RadianceCube
+            | ChunkKind::LightingCube
+            | ChunkKind::NonDiffuseCube
+            | ChunkKind::VolumeBlock
     )
+}
+
+/// Stored radiance `radiance` relit by the ratio, per channel, of the relit light `new` to
+/// the stored light `old` (each lighting + non-diffuse radiance); `fallback` where the stored
+/// light is zero.
+pub(crate) fn relit_radiance(radiance: Vec3, old: Vec3, new: Vec3, fallback: Vec3) -> Vec3 {
+    let ratio = Vec3::select(old.cmpgt(Vec3::splat(1e-12)), new / old, fallback);
+    radiance * ratio
 }
 
 /// The group layer of `kind` for group `g`.
@@ -129,18 +145,26 @@ fn blend_cube(
 /// `blend` of a volume block's samples' lighting and non-diffuse values (each layer as long
 /// as the block, else `None`). The radiance stays the total's.
 fn blend_block(
-    blend: &LayerBlend,
+    relight: &Relight,
     block: &VolumeBlock,
     layers: &[Arc<Vec<[Vec3; 2]>>],
 ) -> Option<VolumeBlock> {
     if layers.iter().any(|l| l.len() != block.samples.len()) {
         return None;
     }
+    let blend = &relight.blend;
     let samples = (block.samples.iter().enumerate())
-        .map(|(i, s)| VolumeSample {
-            lighting: blend.apply(s.lighting, |k| layers[k][i][0]),
-            non_diffuse: blend.apply(s.non_diffuse, |k| layers[k][i][1]),
-            ..*s
+        .map(|(i, s)| {
+            let lighting = blend.apply(s.lighting, |k| layers[k][i][0]);
+            let non_diffuse = blend.apply(s.non_diffuse, |k| layers[k][i][1]);
+            let fallback = if s.object_id == 0 { relight.sky } else { blend.base };
+            let (old, new) = (s.lighting + s.non_diffuse, lighting + non_diffuse);
+            VolumeSample {
+                radiance: relit_radiance(s.radiance, old, new, fallback),
+                lighting,
+                non_diffuse,
+                ..*s
+            }
         })
         .collect();
     Some(VolumeBlock {
@@ -194,6 +218,10 @@ impl Reconstructor {
         {
             return c.clone();
         }
+        if kind == ChunkKind::RadianceCube {
+            let value = self.relit_radiance_cube(view, key);
+            return self.remember(id, value);
+        }
         let blend = &self.relight.blend;
         let layer = |g: u32| self.cached_stored(layer_kind(kind, g), view, key);
         let failed = |what: &str| {
@@ -225,13 +253,19 @@ impl Reconstructor {
                         _ => return failed("are missing"),
                     }
                 }
-                blend_block(blend, &block, &layers).map_or_else(
+                blend_block(&self.relight, &block, &layers).map_or_else(
                     || failed("differ in length"),
                     |b| Cached::Volume(Arc::new(b)),
                 )
             }
             other => return other,
         };
+        self.remember(id, value)
+    }
+
+    /// Keeps a blended chunk until the weights change (all are dropped when they exceed the
+    /// cache budget); returns it.
+    fn remember(&self, id: (ChunkKind, u32, u32), value: Cached) -> Cached {
         let mut memo = self.relit.lock().unwrap_or_else(|e| e.into_inner());
         memo.bytes += value.bytes();
         if memo.bytes > self.settings.cache_bytes {
@@ -240,6 +274,46 @@ impl Reconstructor {
         }
         memo.map.insert(id, value.clone());
         value
+    }
+
+    /// The radiance cube of (view, key) relit ([`relit_radiance`], the module doc): its
+    /// stored lighting and non-diffuse cubes against their blends, the sky's weight where the
+    /// texel sees no object. The stored radiance where either light cube is missing.
+    fn relit_radiance_cube(&self, view: u32, key: u32) -> Cached {
+        let stored = self.cached_stored(ChunkKind::RadianceCube, view, key);
+        let Cached::Radiance(radiance) = &stored else {
+            return stored;
+        };
+        let cube = |c: Cached| match c {
+            Cached::Radiance(c) if c.face_size == radiance.face_size => Some(c),
+            _ => None,
+        };
+        let light = (
+            cube(self.cached_stored(ChunkKind::LightingCube, view, key)),
+            cube(self.cached_stored(ChunkKind::NonDiffuseCube, view, key)),
+            cube(self.relit(ChunkKind::LightingCube, view, key)),
+            cube(self.relit(ChunkKind::NonDiffuseCube, view, key)),
+        );
+        let (Some(l), Some(nd), Some(lw), Some(ndw)) = light else {
+            return stored;
+        };
+        let ids = match self.cached_stored(ChunkKind::ObjectIdCube, view, key) {
+            Cached::Ids(ids) if ids.face_size == radiance.face_size => Some(ids),
+            _ => None,
+        };
+        let base = self.relight.blend.base;
+        let texels = (0..radiance.texels.len())
+            .map(|i| {
+                let sky = ids.as_ref().is_some_and(|ids| ids.texels[i] == 0);
+                let fallback = if sky { self.relight.sky } else { base };
+                let (old, new) = (l.texels[i] + nd.texels[i], lw.texels[i] + ndw.texels[i]);
+                relit_radiance(radiance.texels[i], old, new, fallback)
+            })
+            .collect();
+        Cached::Radiance(Arc::new(CubeImage {
+            face_size: radiance.face_size,
+            texels,
+        }))
     }
 }
 
