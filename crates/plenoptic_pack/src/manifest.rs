@@ -152,7 +152,7 @@ impl Manifest {
         }
         if let Some(g) = &self.light_groups {
             g.validate(self.lights.len(), self.objects.len())
-                .or_else(|reason| bad(reason))?;
+                .or_else(&bad)?;
         }
         for (i, l) in self.lights.iter().enumerate() {
             if let Some(p) = &l.placed {

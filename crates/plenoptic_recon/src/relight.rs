@@ -157,7 +157,11 @@ fn blend_block(
         .map(|(i, s)| {
             let lighting = blend.apply(s.lighting, |k| layers[k][i][0]);
             let non_diffuse = blend.apply(s.non_diffuse, |k| layers[k][i][1]);
-            let fallback = if s.object_id == 0 { relight.sky } else { blend.base };
+            let fallback = if s.object_id == 0 {
+                relight.sky
+            } else {
+                blend.base
+            };
             let (old, new) = (s.lighting + s.non_diffuse, lighting + non_diffuse);
             VolumeSample {
                 radiance: relit_radiance(s.radiance, old, new, fallback),
