@@ -16,9 +16,14 @@
 //! ambient fields take about as many times as long as there are layers.
 
 use glam::Vec3;
-use plenoptic_pack::{CubeImage, GroupWeights, LightGroupsEntry, RangeImage};
+use plenoptic_pack::{
+    ChunkKind, CubeImage, GroupWeights, LightGroupsEntry, RangeImage, encode_radiance,
+};
 use plenoptic_scene::Scene;
 use plenoptic_trace::{AmbientField, SceneAccel};
+
+use crate::volume::LayeredVolume;
+use crate::work::ItemChunk;
 
 /// The light layers of `scene`: `(group, scene with only that group on)`, declared groups
 /// first, then the default group (`None`) when it holds an emitter. Empty for a scene
@@ -119,6 +124,65 @@ pub fn relit_scene(scene: &Scene, settings: &[String]) -> crate::Result<Scene> {
     }
     let w = weights(&scene.light_groups.names, settings)?;
     Ok(scene.relit(|g| w.weight(g)))
+}
+
+/// The light groups' chunks of a range image: each stored group's lighting and non-diffuse
+/// cubes, rounded against the total ([`crate::quantise::coarsen_group`]).
+pub fn layer_chunks(bv: u32, key: u32, layered: &LayeredImage) -> crate::Result<Vec<ItemChunk>> {
+    let mut out = Vec::with_capacity(2 * layered.groups.len());
+    let format = crate::write::FORMATS.radiance;
+    for (g, group) in &layered.groups {
+        let group = crate::quantise::coarsen_group(group, &layered.total);
+        for (kind, cube) in [
+            (ChunkKind::GroupLighting(*g), &group.lighting),
+            (ChunkKind::GroupNonDiffuse(*g), &group.non_diffuse),
+        ] {
+            out.push(ItemChunk {
+                kind,
+                base_view: bv,
+                key,
+                uncompressed_length: 0,
+                bytes: encode_radiance(cube, format)?,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The light groups' chunks of the volume block of base view `bv` in bucket `bucket`, whose
+/// samples are `volume`'s `members` stored in `order`: each stored group's values, rounded
+/// against the total's.
+pub fn volume_layer_chunks(
+    bv: u32,
+    bucket: u32,
+    volume: &LayeredVolume,
+    members: &[usize],
+    order: &[u32],
+) -> crate::Result<Vec<ItemChunk>> {
+    let mut out = Vec::with_capacity(volume.groups.len());
+    for (g, values) in &volume.groups {
+        let values: Vec<[Vec3; 2]> = members
+            .iter()
+            .map(|&i| {
+                // A sample's group radiance is not kept: its non-diffuse part is rounded
+                // against the total's radiance alone.
+                let (total, [l, nd]) = (&volume.samples[i], values[i]);
+                [
+                    crate::quantise::coarsen_layer(l, l, total.lighting),
+                    crate::quantise::coarsen_layer(nd, total.radiance, total.radiance),
+                ]
+            })
+            .collect();
+        let (bytes, len) = plenoptic_pack::groups::encode_group_volume(&values, order)?;
+        out.push(ItemChunk {
+            kind: ChunkKind::GroupVolume(*g),
+            base_view: bv,
+            key: bucket,
+            uncompressed_length: len,
+            bytes,
+        });
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -83,17 +83,7 @@ pub fn range_image_chunks(bv: u32, key: u32, layered: &LayeredImage) -> Result<V
             encode_normal(&image.normal, FORMATS.normal)?,
         ),
     ];
-    for (g, group) in &layered.groups {
-        let group = crate::quantise::coarsen_group(group, &layered.total);
-        out.push(c(
-            ChunkKind::GroupLighting(*g),
-            encode_radiance(&group.lighting, FORMATS.radiance)?,
-        ));
-        out.push(c(
-            ChunkKind::GroupNonDiffuse(*g),
-            encode_radiance(&group.non_diffuse, FORMATS.radiance)?,
-        ));
-    }
+    out.extend(crate::groups::layer_chunks(bv, key, layered)?);
     Ok(out)
 }
 
@@ -144,22 +134,9 @@ pub fn volume_chunks(plan: &Plan, bv: u32, volume: &LayeredVolume) -> Result<Vec
         if let Some((bytes, len)) = complex {
             out.push(chunk(ChunkKind::VolumeConnectivity, len, bytes));
         }
-        for (g, values) in &volume.groups {
-            let values: Vec<[glam::Vec3; 2]> = members
-                .iter()
-                .map(|&i| {
-                    // A sample's group radiance is not kept: its non-diffuse part is rounded
-                    // against the total's radiance alone.
-                    let (total, [l, nd]) = (&volume.samples[i], values[i]);
-                    [
-                        crate::quantise::coarsen_layer(l, l, total.lighting),
-                        crate::quantise::coarsen_layer(nd, total.radiance, total.radiance),
-                    ]
-                })
-                .collect();
-            let (bytes, len) = plenoptic_pack::groups::encode_group_volume(&values, &enc.order)?;
-            out.push(chunk(ChunkKind::GroupVolume(*g), len, bytes));
-        }
+        out.extend(crate::groups::volume_layer_chunks(
+            bv, b, volume, &members, &enc.order,
+        )?);
     }
     Ok(out)
 }

@@ -29,7 +29,11 @@ use serde::{Deserialize, Serialize};
 use crate::bytes::{ByteReader, PutLe, zstd_compress, zstd_decompress_exact};
 use crate::cube::{rgb9e5_pack, rgb9e5_unpack};
 use crate::error::{PackError, Result};
+use crate::range_image::RadianceCube;
+use crate::reader::{Chunk, PackReader};
 use crate::volume::MAX_BLOCK_SAMPLES;
+use crate::{ChunkEntry, ChunkKind};
+use std::collections::HashMap;
 
 /// The name that sets the default group's weight (emitters no group names).
 pub const DEFAULT_GROUP: &str = "default";
@@ -294,6 +298,79 @@ pub fn decode_group_volume(bytes: &[u8]) -> Result<Vec<[Vec3; 2]>> {
     (0..n)
         .map(|_| Ok([rgb9e5_unpack(r.u32()?), rgb9e5_unpack(r.u32()?)]))
         .collect()
+}
+
+/// Checks the light-group chunks against the manifest's groups: every group chunk names a
+/// declared group, and every lighting cube and volume block has each declared group's layers.
+pub(crate) fn validate_chunks(
+    entries: &[ChunkEntry],
+    index: &HashMap<(ChunkKind, u32, u32), usize>,
+    groups: Option<&crate::LightGroupsEntry>,
+) -> Result<()> {
+    let declared = groups.map_or(0, |g| g.names.len() as u32);
+    let stored = groups.map_or(0..0, |g| g.stored());
+    for (i, e) in entries.iter().enumerate() {
+        let mismatch = |problem: String| PackError::LightGroupMismatch {
+            chunk: e.chunk_ref(i),
+            problem,
+        };
+        if let Some(g) = e.kind.light_group()
+            && !stored.contains(&g)
+        {
+            return Err(mismatch(format!(
+                "light group {g}, but the manifest declares {declared} groups of which {} are stored",
+                stored.len()
+            )));
+        }
+        let needs: &[fn(u32) -> ChunkKind] = match e.kind {
+            ChunkKind::LightingCube => &[ChunkKind::GroupLighting, ChunkKind::GroupNonDiffuse],
+            ChunkKind::VolumeBlock => &[ChunkKind::GroupVolume],
+            _ => &[],
+        };
+        for kind in needs {
+            if let Some(g) =
+                (stored.clone()).find(|&g| !index.contains_key(&(kind(g), e.base_view, e.key)))
+            {
+                return Err(mismatch(format!(
+                    "no {:?} chunk for light group {g} of the {declared} the manifest declares",
+                    kind(g)
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+impl PackReader {
+    /// Light group `group`'s diffuse-lighting cube of `base_view` at time key `key`.
+    pub fn group_lighting(&self, base_view: u32, key: u32, group: u32) -> Result<RadianceCube> {
+        match self.get(ChunkKind::GroupLighting(group), base_view, key)? {
+            Chunk::GroupLighting(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// Light group `group`'s non-diffuse radiance cube of `base_view` at time key `key`.
+    pub fn group_non_diffuse(&self, base_view: u32, key: u32, group: u32) -> Result<RadianceCube> {
+        match self.get(ChunkKind::GroupNonDiffuse(group), base_view, key)? {
+            Chunk::GroupNonDiffuse(c) => Ok(c),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
+
+    /// Light group `group`'s values of the volume block of `base_view` in `bucket`, in the
+    /// block's stored order.
+    pub fn group_volume(
+        &self,
+        base_view: u32,
+        bucket: u32,
+        group: u32,
+    ) -> Result<Vec<[glam::Vec3; 2]>> {
+        match self.get(ChunkKind::GroupVolume(group), base_view, bucket)? {
+            Chunk::GroupVolume(v) => Ok(v),
+            _ => unreachable!("decoded by kind"),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -297,7 +297,7 @@ impl PackReader {
             manifest_range,
             directory_range,
         )?;
-        validate_light_groups(&entries, &index, manifest.light_groups.as_ref())?;
+        crate::groups::validate_chunks(&entries, &index, manifest.light_groups.as_ref())?;
         let has_texture_chunk =
             |i: u32| index.contains_key(&(ChunkKind::MaterialTexture, NO_BASE_VIEW, i));
         validate_materials(&manifest, Some(&has_texture_chunk)).map_err(|reason| {
@@ -507,36 +507,6 @@ impl PackReader {
         }
     }
 
-    /// Light group `group`'s diffuse-lighting cube of `base_view` at time key `key`.
-    pub fn group_lighting(&self, base_view: u32, key: u32, group: u32) -> Result<RadianceCube> {
-        match self.get(ChunkKind::GroupLighting(group), base_view, key)? {
-            Chunk::GroupLighting(c) => Ok(c),
-            _ => unreachable!("decoded by kind"),
-        }
-    }
-
-    /// Light group `group`'s non-diffuse radiance cube of `base_view` at time key `key`.
-    pub fn group_non_diffuse(&self, base_view: u32, key: u32, group: u32) -> Result<RadianceCube> {
-        match self.get(ChunkKind::GroupNonDiffuse(group), base_view, key)? {
-            Chunk::GroupNonDiffuse(c) => Ok(c),
-            _ => unreachable!("decoded by kind"),
-        }
-    }
-
-    /// Light group `group`'s values of the volume block of `base_view` in `bucket`, in the
-    /// block's stored order.
-    pub fn group_volume(
-        &self,
-        base_view: u32,
-        bucket: u32,
-        group: u32,
-    ) -> Result<Vec<[glam::Vec3; 2]>> {
-        match self.get(ChunkKind::GroupVolume(group), base_view, bucket)? {
-            Chunk::GroupVolume(v) => Ok(v),
-            _ => unreachable!("decoded by kind"),
-        }
-    }
-
     /// The proxy mesh of object `object_id`.
     pub fn proxy_mesh(&self, object_id: u32) -> Result<ProxyMesh> {
         match self.get(ChunkKind::ProxyMesh, NO_BASE_VIEW, object_id)? {
@@ -584,47 +554,6 @@ fn read_range(
 
 fn overlaps(a: (u64, u64), b: (u64, u64)) -> bool {
     a.1 > 0 && b.1 > 0 && a.0 < b.0.saturating_add(b.1) && b.0 < a.0.saturating_add(a.1)
-}
-
-/// Checks the light-group chunks against the manifest's groups: every group chunk names a
-/// declared group, and every lighting cube and volume block has each declared group's layers.
-fn validate_light_groups(
-    entries: &[ChunkEntry],
-    index: &HashMap<(ChunkKind, u32, u32), usize>,
-    groups: Option<&crate::LightGroupsEntry>,
-) -> Result<()> {
-    let declared = groups.map_or(0, |g| g.names.len() as u32);
-    let stored = groups.map_or(0..0, |g| g.stored());
-    for (i, e) in entries.iter().enumerate() {
-        let mismatch = |problem: String| PackError::LightGroupMismatch {
-            chunk: e.chunk_ref(i),
-            problem,
-        };
-        if let Some(g) = e.kind.light_group()
-            && !stored.contains(&g)
-        {
-            return Err(mismatch(format!(
-                "light group {g}, but the manifest declares {declared} groups of which {} are stored",
-                stored.len()
-            )));
-        }
-        let needs: &[fn(u32) -> ChunkKind] = match e.kind {
-            ChunkKind::LightingCube => &[ChunkKind::GroupLighting, ChunkKind::GroupNonDiffuse],
-            ChunkKind::VolumeBlock => &[ChunkKind::GroupVolume],
-            _ => &[],
-        };
-        for kind in needs {
-            if let Some(g) =
-                (stored.clone()).find(|&g| !index.contains_key(&(kind(g), e.base_view, e.key)))
-            {
-                return Err(mismatch(format!(
-                    "no {:?} chunk for light group {g} of the {declared} the manifest declares",
-                    kind(g)
-                )));
-            }
-        }
-    }
-    Ok(())
 }
 
 fn validate_entries(
