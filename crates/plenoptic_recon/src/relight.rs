@@ -209,8 +209,8 @@ impl Reconstructor {
         &self.relight.weights
     }
 
-    /// The chunk of `kind` (lighting, non-diffuse or volume block) at the current weights,
-    /// blended on first use and kept until the weights change.
+    /// The chunk of `kind` (radiance, lighting, non-diffuse or volume block) at the current
+    /// weights, blended on first use and kept until the weights change.
     pub(crate) fn relit(&self, kind: ChunkKind, view: u32, key: u32) -> Cached {
         let id = (kind, view, key);
         if let Some(c) = self
