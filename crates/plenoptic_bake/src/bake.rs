@@ -112,19 +112,24 @@ pub fn bake(recipe: &BakeRecipe, scene: &Scene, options: &BakeOptions) -> Result
 
     let clock = Instant::now();
     let bar = progress.phase("ambient field", 0);
-    let fields = plan::ambient_phase(&mut plan, scene, &accel)?;
-    plan.volume_complex = options.volume_complex;
-    // Light groups: one scene per layer, sharing the plan (crate::groups).
+    // Light groups: one scene per layer, sharing the plan (crate::groups); the ambient key
+    // times are chosen on the sum of the layers' fields, so the whole scene's are not needed.
     let layer_scenes = crate::groups::layer_scenes(scene);
     let layer_accels = layer_scenes
         .iter()
         .map(|(_, s)| SceneAccel::new(s))
         .collect::<std::result::Result<Vec<_>, _>>()?;
-    let layer_fields = layer_scenes
-        .iter()
-        .zip(&layer_accels)
-        .map(|((_, s), a)| plan::layer_fields(&plan, s, a))
-        .collect::<Result<Vec<_>>>()?;
+    let (fields, layer_fields) = if layer_scenes.is_empty() {
+        (plan::ambient_phase(&mut plan, scene, &accel)?, Vec::new())
+    } else {
+        let layers: Vec<_> = layer_scenes
+            .iter()
+            .map(|(_, s)| s)
+            .zip(&layer_accels)
+            .collect();
+        (Vec::new(), plan::layered_ambient_phase(&mut plan, &layers)?)
+    };
+    plan.volume_complex = options.volume_complex;
     bar.finish_and_clear();
     timings.insert("ambient_field".to_owned(), clock.elapsed().as_secs_f64());
 

@@ -91,7 +91,7 @@ pub struct LayeredSample {
 
 impl<'a> BakeRenderer<'a> {
     /// A renderer over a plan, its scene's acceleration structure and its ambient fields (at
-    /// least one).
+    /// least one; none when [`BakeRenderer::with_layers`] gives the light layers' own).
     pub fn new(plan: &'a Plan, accel: &'a SceneAccel<'a>, fields: &'a [AmbientField]) -> Self {
         Self {
             plan,

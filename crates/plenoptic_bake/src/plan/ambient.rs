@@ -30,43 +30,60 @@ pub fn settings(quality: &Quality, seed: u64) -> AmbientSettings {
     }
 }
 
-/// Key times and the fields gathered at them.
-pub struct AmbientKeys {
+/// Key times and what was gathered at them.
+pub struct AmbientKeys<V = AmbientField> {
     /// Key times, ascending.
     pub times: Vec<f32>,
-    /// The field at each key time.
-    pub fields: Vec<AmbientField>,
+    /// The field (or one field per light layer) at each key time.
+    pub fields: Vec<V>,
     /// Intervals tested.
     pub tested: u64,
 }
 
-/// Chooses the ambient key times over `[start, end]` (one key at `start` when `animated` is
-/// false or the range is empty) and gathers the fields at them.
-#[allow(clippy::too_many_arguments)]
-pub fn key_times(
-    scene: &Scene,
-    accel: &SceneAccel<'_>,
-    settings: &AmbientSettings,
-    start: f32,
-    end: f32,
-    max_depth: u32,
-    max_rms: f32,
-    animated: bool,
-) -> Result<AmbientKeys> {
-    let layout = Arc::new(FieldLayout::new(scene, settings.quality)?);
-    let gather = |t: f32| AmbientField::compute(&accel.at_time(t), layout.clone(), settings);
+/// The time range and its subdivision limits, as the plan gives them.
+#[derive(Debug, Clone, Copy)]
+pub struct KeyRange {
+    /// First time.
+    pub start: f32,
+    /// Last time.
+    pub end: f32,
+    /// Deepest bisection of the range.
+    pub max_depth: u32,
+    /// Largest relative RMS change between an interval's ends.
+    pub max_rms: f32,
+    /// Whether anything changes (else one key at `start`).
+    pub animated: bool,
+}
+
+/// Bisects `range` on the time lattice while `field` of what `gather` returns at an
+/// interval's ends differs by more than `range.max_rms` (both ways round).
+fn choose<V>(
+    range: KeyRange,
+    gather: impl Fn(f32) -> V,
+    field: impl Fn(&V) -> &AmbientField,
+) -> AmbientKeys<V> {
+    let KeyRange {
+        start,
+        end,
+        max_depth,
+        max_rms,
+        animated,
+    } = range;
     if !animated || end <= start {
-        return Ok(AmbientKeys {
+        return AmbientKeys {
             times: vec![start],
             fields: vec![gather(start)],
             tested: 0,
-        });
+        };
     }
     let lattice = 1u32 << max_depth.min(16);
     let (keys, tested, mut values) = subdivide(
         &[0, lattice],
         |k| gather(key_time(start, end, lattice, k)),
-        |a, b| a.relative_rms(b).max(b.relative_rms(a)) <= f64::from(max_rms),
+        |a, b| {
+            let (a, b) = (field(a), field(b));
+            a.relative_rms(b).max(b.relative_rms(a)) <= f64::from(max_rms)
+        },
     );
     let times: Vec<f32> = keys
         .iter()
@@ -80,26 +97,61 @@ pub fn key_times(
                 .unwrap_or_else(|| gather(key_time(start, end, lattice, *k)))
         })
         .collect();
-    Ok(AmbientKeys {
+    AmbientKeys {
         times,
         fields,
         tested,
-    })
+    }
 }
 
-/// The fields of `scene` (one light group's: the same geometry as the scene whose
-/// [`key_times`] chose `times`, other emitters) gathered at `times`.
-pub fn fields_at(
+/// Chooses the ambient key times over the range (one key at its start when nothing is
+/// animated or the range is empty) and gathers the fields at them.
+pub fn key_times(
     scene: &Scene,
     accel: &SceneAccel<'_>,
     settings: &AmbientSettings,
-    times: &[f32],
-) -> Result<Vec<AmbientField>> {
+    range: KeyRange,
+) -> Result<AmbientKeys> {
     let layout = Arc::new(FieldLayout::new(scene, settings.quality)?);
-    Ok(times
-        .iter()
-        .map(|&t| AmbientField::compute(&accel.at_time(t), layout.clone(), settings))
-        .collect())
+    let gather = |t: f32| AmbientField::compute(&accel.at_time(t), layout.clone(), settings);
+    Ok(choose(range, gather, |f| f))
+}
+
+/// [`key_times`] for a scene baked as light layers ([`crate::groups`]): each layer's field is
+/// gathered at every time tested, and the key times are chosen on their sum (the whole
+/// scene's field, by linearity), so no field of the whole scene is gathered. Returns each
+/// key time's fields, one per layer in `layers`' order. The layers share one geometry and so
+/// one field layout.
+pub fn layered_key_times(
+    layers: &[(&Scene, &SceneAccel<'_>)],
+    settings: &AmbientSettings,
+    range: KeyRange,
+) -> Result<AmbientKeys<Vec<AmbientField>>> {
+    let Some((scene, _)) = layers.first() else {
+        return Ok(AmbientKeys {
+            times: Vec::new(),
+            fields: Vec::new(),
+            tested: 0,
+        });
+    };
+    let layout = Arc::new(FieldLayout::new(scene, settings.quality)?);
+    let gather = |t: f32| {
+        let fields: Vec<AmbientField> = layers
+            .iter()
+            .map(|(_, a)| AmbientField::compute(&a.at_time(t), layout.clone(), settings))
+            .collect();
+        // One layout for all: the sum cannot fail.
+        let sum = AmbientField::sum(&fields).and_then(|s| s.ok());
+        (fields, sum)
+    };
+    let keys = choose(range, gather, |(fields, sum)| {
+        sum.as_ref().unwrap_or(&fields[0])
+    });
+    Ok(AmbientKeys {
+        times: keys.times,
+        fields: keys.fields.into_iter().map(|(f, _)| f).collect(),
+        tested: keys.tested,
+    })
 }
 
 /// The field at time `t`: the key field itself at a key time, else the linear interpolation

@@ -410,14 +410,15 @@ fn ambient_settings(plan: &Plan) -> plenoptic_trace::AmbientSettings {
     ambient::settings(&plan.quality, plan.seed ^ 0xa3b1)
 }
 
-/// The fields of one light layer's scene (the planned scene with other emitters,
-/// [`crate::groups`]) at the key times [`ambient_phase`] chose.
-pub fn layer_fields(
-    plan: &Plan,
-    scene: &Scene,
-    accel: &SceneAccel<'_>,
-) -> Result<Vec<AmbientField>> {
-    ambient::fields_at(scene, accel, &ambient_settings(plan), &plan.ambient_keys)
+/// The plan's time range and ambient subdivision limits.
+fn ambient_range(plan: &Plan) -> ambient::KeyRange {
+    ambient::KeyRange {
+        start: plan.start,
+        end: plan.end,
+        max_depth: plan.quality.max_time_depth,
+        max_rms: plan.quality.ambient_rms,
+        animated: plan.animated,
+    }
 }
 
 /// Fills `plan.ambient_keys` and returns the fields at them.
@@ -426,18 +427,26 @@ pub fn ambient_phase(
     scene: &Scene,
     accel: &SceneAccel<'_>,
 ) -> Result<Vec<AmbientField>> {
-    let settings = ambient_settings(plan);
-    let keys = ambient::key_times(
-        scene,
-        accel,
-        &settings,
-        plan.start,
-        plan.end,
-        plan.quality.max_time_depth,
-        plan.quality.ambient_rms,
-        plan.animated,
-    )?;
+    let keys = ambient::key_times(scene, accel, &ambient_settings(plan), ambient_range(plan))?;
     plan.ambient_keys = keys.times;
     plan.counters.ambient_intervals_tested = keys.tested;
     Ok(keys.fields)
+}
+
+/// [`ambient_phase`] for a scene baked as light layers ([`crate::groups`]): the key times
+/// chosen on the sum of the layers' fields; returns each layer's fields at them.
+pub fn layered_ambient_phase(
+    plan: &mut Plan,
+    layers: &[(&Scene, &SceneAccel<'_>)],
+) -> Result<Vec<Vec<AmbientField>>> {
+    let keys = ambient::layered_key_times(layers, &ambient_settings(plan), ambient_range(plan))?;
+    plan.ambient_keys = keys.times;
+    plan.counters.ambient_intervals_tested = keys.tested;
+    let mut per_layer: Vec<Vec<AmbientField>> = vec![Vec::new(); layers.len()];
+    for at_key in keys.fields {
+        for (layer, field) in per_layer.iter_mut().zip(at_key) {
+            layer.push(field);
+        }
+    }
+    Ok(per_layer)
 }

@@ -261,6 +261,29 @@ impl AmbientField {
         })
     }
 
+    /// The sum of fields of one scene lit by different emitters (light groups: light
+    /// transport is linear in the emitters), on the same layout. `None` for no fields.
+    pub fn sum(fields: &[Self]) -> Option<Result<Self>> {
+        let (first, rest) = fields.split_first()?;
+        let mut out = first.clone();
+        for f in rest {
+            if !Arc::ptr_eq(&out.layout, &f.layout) && out.layout != f.layout {
+                return Some(Err(TraceError::FieldMismatch(
+                    "the fields were built on different layouts".into(),
+                )));
+            }
+            for (p, q) in out.irradiance.iter_mut().zip(&f.irradiance) {
+                *p += *q;
+            }
+            out.bounces = out.bounces.min(f.bounces);
+            out.invalid_points = out.invalid_points.max(f.invalid_points);
+            for (x, y) in out.guarded.iter_mut().zip(&f.guarded) {
+                *x |= *y;
+            }
+        }
+        Some(Ok(out))
+    }
+
     /// Mean irradiance over all points (a cheap summary for tests and key-time selection).
     pub fn mean_irradiance(&self) -> Vec3 {
         let n = self.layout.point_count().max(1) as f32;
