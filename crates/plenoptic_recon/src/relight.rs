@@ -177,6 +177,23 @@ fn blend_block(
     })
 }
 
+/// The chunks of `blend`'s layers in its order, each `layer(g)` as `pick` takes it; `Err` with
+/// the first layer's failure, or `Err(None)` where a layer is absent or of another kind.
+fn stored_layers<T>(
+    blend: &LayerBlend,
+    layer: impl Fn(u32) -> Cached,
+    pick: impl Fn(Cached) -> Option<T>,
+) -> Result<Vec<T>, Option<Cached>> {
+    blend
+        .layers
+        .iter()
+        .map(|&(g, _)| match layer(g) {
+            failed @ Cached::Failed(_) => Err(Some(failed)),
+            other => pick(other).ok_or(None),
+        })
+        .collect()
+}
+
 impl Reconstructor {
     /// Sets each light group's colour × intensity (a pack without groups has the default group
     /// alone); frames from now on show the pack relit (see the module doc).
@@ -235,28 +252,26 @@ impl Reconstructor {
         };
         let value = match self.cached_stored(kind, view, key) {
             Cached::Radiance(total) => {
-                let mut layers = Vec::with_capacity(blend.layers.len());
-                for &(g, _) in &blend.layers {
-                    match layer(g) {
-                        Cached::Radiance(c) => layers.push(c),
-                        Cached::Failed(e) => return Cached::Failed(e),
-                        _ => return failed("are missing"),
-                    }
-                }
+                let layers = match stored_layers(blend, layer, |c| match c {
+                    Cached::Radiance(c) => Some(c),
+                    _ => None,
+                }) {
+                    Ok(layers) => layers,
+                    Err(e) => return e.unwrap_or_else(|| failed("are missing")),
+                };
                 blend_cube(blend, &total, &layers).map_or_else(
                     || failed("differ in size"),
                     |c| Cached::Radiance(Arc::new(c)),
                 )
             }
             Cached::Volume(block) => {
-                let mut layers = Vec::with_capacity(blend.layers.len());
-                for &(g, _) in &blend.layers {
-                    match layer(g) {
-                        Cached::GroupVolume(v) => layers.push(v),
-                        Cached::Failed(e) => return Cached::Failed(e),
-                        _ => return failed("are missing"),
-                    }
-                }
+                let layers = match stored_layers(blend, layer, |c| match c {
+                    Cached::GroupVolume(v) => Some(v),
+                    _ => None,
+                }) {
+                    Ok(layers) => layers,
+                    Err(e) => return e.unwrap_or_else(|| failed("are missing")),
+                };
                 blend_block(&self.relight, &block, &layers).map_or_else(
                     || failed("differ in length"),
                     |b| Cached::Volume(Arc::new(b)),

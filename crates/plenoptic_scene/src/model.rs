@@ -397,17 +397,12 @@ impl Scene {
 
     /// The environment at time `t` (a sky, and its ground, lit by the sun then), times
     /// [`EmitterWeights::sky`](crate::groups::EmitterWeights::sky). The ground is lit by the
-    /// sun at its own intensity: it is part of the sky's light group. A sky weighted to zero
-    /// is [`PlacedEnvironment::None`].
+    /// sun at its own intensity: it is part of the sky's light group.
     pub fn environment_at(&self, t: f32) -> PlacedEnvironment {
         let sun = self.sun.as_ref().map(|s| {
             let p = self.placed_light_unweighted(s.light, t);
             (-p.direction, p.emitted)
         });
-        if self.weights.sky == Vec3::ZERO {
-            // Off: nothing to sample (a zero sky would still be importance-sampled).
-            return PlacedEnvironment::None;
-        }
         self.environment.at_lit(sun).scaled(self.weights.sky)
     }
 

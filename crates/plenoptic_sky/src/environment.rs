@@ -235,6 +235,18 @@ impl PlacedEnvironment {
         e.as_vec3()
     }
 
+    /// Whether no direction sends light: none, a black colour, an image at zero intensity or
+    /// a black sky ([`Sky::is_black`]). Known without evaluating a direction, so that the
+    /// tracers need not build a sampling table to find that there is nothing to sample.
+    pub fn is_black(&self) -> bool {
+        match self {
+            PlacedEnvironment::None => true,
+            PlacedEnvironment::Uniform(c) => c.max_element() <= 0.0,
+            PlacedEnvironment::Image { intensity, .. } => intensity.max_element() <= 0.0,
+            PlacedEnvironment::Sky(sky) => sky.is_black(),
+        }
+    }
+
     /// The environment with its radiance multiplied by `weight` per channel: the sky's light
     /// group at a colour × intensity (the `sky` emitter of a recipe's `[[light_group]]`).
     pub fn scaled(self, weight: Vec3) -> Self {

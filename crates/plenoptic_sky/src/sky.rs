@@ -138,6 +138,13 @@ impl Sky {
         Ok(sky)
     }
 
+    /// Whether the sky sends no light at all: every channel's radiance scale and its ground
+    /// are zero (a night below the twilight fade, or a sky whose light group is off).
+    pub fn is_black(&self) -> bool {
+        let c = &self.coefficients;
+        c.radiances.iter().chain(&c.ground).all(|&x| x <= 0.0)
+    }
+
     /// The same sky with every radiance, its ground's included, multiplied by `weight` per
     /// channel: a light group's colour × intensity (light transport is linear in it).
     pub fn scaled(&self, weight: Vec3) -> Self {

@@ -169,7 +169,9 @@ impl EnvLight {
     }
 
     fn table(&self) -> Option<&Table> {
-        if self.env.is_none() {
+        // A black environment has an empty table: building one for every placement to find
+        // that out costs 164k evaluations each.
+        if self.env.is_black() {
             return None;
         }
         self.shared
@@ -269,6 +271,22 @@ mod tests {
     use crate::sampling::Sampler;
     use plenoptic_scene::Environment;
     use plenoptic_sky::SkyParams;
+
+    #[test]
+    fn a_black_sky_has_nothing_to_sample_and_builds_no_table() {
+        let sky = Environment::Sky(SkyParams::default()).at(Some(Vec3::new(0.3, 0.8, 0.2)));
+        assert!(EnvLight::new(sky.clone()).can_sample());
+        for black in [
+            sky.scaled(Vec3::ZERO),
+            PlacedEnvironment::Uniform(Vec3::ZERO),
+        ] {
+            assert!(black.is_black());
+            let light = EnvLight::new(black);
+            assert!(!light.can_sample());
+            assert!(light.own.get().is_none(), "no table built for a black sky");
+            assert_eq!(light.pdf(Vec3::Y), 0.0);
+        }
+    }
 
     /// E[L(ω) cos θ / p(ω)] over the upper hemisphere must equal the irradiance integral, and
     /// the density must agree with `pdf`.
