@@ -14,7 +14,7 @@
 //!
 //! Cost: every rendering of the bake is done once per layer; the ambient key times are chosen
 //! on the sum of the layers' fields ([`crate::plan::layered_ambient_phase`]), so the whole
-//! scene's fields are never gathered. The tour's three groups take 1.9× its ungrouped bake
+//! scene's fields are never gathered. The tour's three groups take 1.85× its ungrouped bake
 //! (docs/results/measurements.md, "Light groups on the tour").
 
 use glam::Vec3;
