@@ -24,6 +24,7 @@ mod pack;
 
 mod counters;
 mod harness;
+mod light_groups;
 mod lit;
 mod many_cameras;
 mod own_scene;

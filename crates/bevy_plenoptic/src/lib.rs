@@ -67,7 +67,7 @@ use bevy::asset::io::file::FileAssetReader;
 use bevy::prelude::*;
 
 pub use asset::{RadiancePack, RadiancePackLoader};
-pub use camera::{Playback, PlenopticCamera, ReconMode, ReconSettings};
+pub use camera::{LightSettings, Playback, PlenopticCamera, ReconMode, ReconSettings};
 pub use reconstruct::cpu;
 pub use settings::{
     Backend, GpuSupport, PlenopticEvent, PlenopticSettings, PlenopticSystems, ResolvedBackend,
@@ -76,8 +76,8 @@ pub use settings::{
 /// The usual imports.
 pub mod prelude {
     pub use crate::{
-        Backend, Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin, PlenopticSettings,
-        PlenopticSystems, RadiancePack, ReconMode, ReconSettings,
+        Backend, LightSettings, Playback, PlenopticCamera, PlenopticEvent, PlenopticPlugin,
+        PlenopticSettings, PlenopticSystems, RadiancePack, ReconMode, ReconSettings,
     };
 }
 

@@ -102,7 +102,7 @@ pub mod proxy;
 mod raster;
 pub mod reconstructor;
 mod reflected;
-mod relight;
+pub mod relight;
 mod sample;
 pub mod settings;
 mod shading;

@@ -30,9 +30,11 @@ use plenoptic_pack::{
 use crate::Reconstructor;
 use crate::cache::Cached;
 
-/// The light groups' weights and what they give each emitter of a pack.
+/// The light groups' weights and what they give each emitter of a pack: the one definition
+/// of every multiplier, which the CPU reconstructor applies and the plugin's GPU passes take
+/// as uniforms.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Relight {
+pub struct Relight {
     /// The weights as set.
     pub weights: GroupWeights,
     /// How the stored layers combine at them.
@@ -109,8 +111,8 @@ pub(crate) fn blended(kind: ChunkKind) -> bool {
 
 /// Stored radiance `radiance` relit by the ratio, per channel, of the relit light `new` to
 /// the stored light `old` (each lighting + non-diffuse radiance); `fallback` where the stored
-/// light is zero.
-pub(crate) fn relit_radiance(radiance: Vec3, old: Vec3, new: Vec3, fallback: Vec3) -> Vec3 {
+/// light is zero. The plugin's `relight.wgsl` does the same per texel.
+pub fn relit_radiance(radiance: Vec3, old: Vec3, new: Vec3, fallback: Vec3) -> Vec3 {
     let ratio = Vec3::select(old.cmpgt(Vec3::splat(1e-12)), new / old, fallback);
     radiance * ratio
 }

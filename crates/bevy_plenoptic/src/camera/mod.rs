@@ -2,10 +2,13 @@
 //! ([`layers`]).
 
 pub mod layers;
+pub mod lights;
 
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::prelude::*;
 pub use plenoptic_recon::ReconSettings;
+
+pub use lights::LightSettings;
 
 use crate::asset::RadiancePack;
 use crate::settings::PlenopticSystems;
@@ -61,6 +64,8 @@ pub struct PlenopticCamera {
     /// by the GPU passes (as uniforms) and the CPU backend alike, and by streaming (which
     /// base views the camera blends, `max_views` of them, must be resident).
     pub settings: ReconSettings,
+    /// A colour × intensity per light group of the pack ([`lights`]; as baked by default).
+    pub lights: LightSettings,
 }
 
 impl PlenopticCamera {
@@ -75,6 +80,7 @@ impl PlenopticCamera {
                 looping: true,
             },
             settings: ReconSettings::default(),
+            lights: LightSettings::default(),
         }
     }
 

@@ -141,5 +141,9 @@ impl frame::BindsView for LitMaterial {
             e.blended_geometry = geometry.clone();
             e.blended_terms = terms.clone();
         }
+        if let Some((cubes, shading)) = &view.keys {
+            e.cubes = cubes.clone();
+            e.shading_cubes = shading.clone();
+        }
     }
 }

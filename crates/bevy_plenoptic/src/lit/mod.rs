@@ -389,6 +389,7 @@ mod tests {
             normal: None,
             lighting: None,
             non_diffuse: None,
+            groups: Vec::new(),
             cpu: Vec::new(),
         };
         let a = radiance(&key(Vec3::new(1.0, 0.5, 0.25))).unwrap();

@@ -8,6 +8,24 @@ fn rgb9e5_decode(v: u32) -> vec3<f32> {
     return vec3<f32>(f32(v & 0x1ffu), f32((v >> 9u) & 0x1ffu), f32((v >> 18u) & 0x1ffu)) * s;
 }
 
+// plenoptic_pack::cube::rgb9e5_pack: the shared exponent from the largest channel (clamped
+// to the format's range, NaN as 0), each mantissa rounded to nearest.
+fn rgb9e5_encode(rgb: vec3<f32>) -> u32 {
+    let c = select(clamp(rgb, vec3<f32>(0.0), vec3<f32>(65408.0)), vec3<f32>(0.0), rgb != rgb);
+    let maxc = max(c.x, max(c.y, c.z));
+    var floor_log2 = -16;
+    if maxc > 0.0 {
+        floor_log2 = i32(floor(log2(maxc)));
+    }
+    var e = max(floor_log2, -16) + 16;
+    if i32(floor(maxc / exp2(f32(e - 24)) + 0.5)) == 512 {
+        e += 1;
+    }
+    e = clamp(e, 0, 31);
+    let q = min(vec3<u32>(floor(c / exp2(f32(e - 24)) + 0.5)), vec3<u32>(511u));
+    return q.x | (q.y << 9u) | (q.z << 18u) | (u32(e) << 27u);
+}
+
 // plenoptic_pack::cube::direction_to_face_uv followed by direction_to_texel.
 fn cube_texel(dir: vec3<f32>, n: u32) -> vec3<u32> {
     let a = abs(dir);

@@ -30,6 +30,7 @@ pub mod environment;
 pub mod frames;
 pub mod geometry;
 pub mod image;
+pub mod relight;
 pub mod upload;
 
 use std::collections::{HashMap, HashSet};

@@ -14,13 +14,14 @@ use bevy::image::ImageSampler;
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::{
-    Extent3d, Origin3d, TexelCopyBufferLayout, TexelCopyTextureInfo, TextureAspect,
-    TextureDimension, TextureFormat,
+    BufferDescriptor, BufferUsages, Extent3d, Origin3d, TexelCopyBufferLayout,
+    TexelCopyTextureInfo, TextureAspect, TextureDimension, TextureFormat,
 };
-use bevy::render::renderer::RenderQueue;
+use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::texture::GpuImage;
 use bevy::render::{MainWorld, Render, RenderApp, RenderSystems};
 
+use super::relight::{GROUP_TEXEL_BYTES, GroupLayers, MAX_GROUP_BUFFER, stored_groups};
 use super::{KeyTexture, KeyTextures, MAX_LAYERS};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
@@ -47,6 +48,15 @@ pub struct KeyUpload {
     pub shading_image: AssetId<Image>,
     /// Six faces of `face`² texels of 8 bytes (`Rg32Uint`).
     pub shading_data: Vec<u8>,
+    /// The pack, whose [`GroupLayers`] buffer holds the key's group layers.
+    pub pack: AssetId<RadiancePack>,
+    /// The key's light-group layers ([`interleave_groups`]; empty for a pack without them),
+    /// written at `slot ·` its length in a buffer of `slots ·` its length.
+    pub group_data: Vec<u8>,
+    /// The key's slot and the texture's slots.
+    pub slot: u32,
+    /// Slots of the pack's key texture.
+    pub slots: u32,
 }
 
 /// Key uploads queued this frame (main world; taken by the render world at extraction).
@@ -73,6 +83,7 @@ pub(super) fn build(app: &mut App) {
     if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
         render_app
             .init_resource::<PendingKeyUploads>()
+            .init_resource::<GroupLayers>()
             .add_systems(ExtractSchedule, extract_key_uploads)
             .add_systems(
                 Render,
@@ -100,8 +111,11 @@ pub(super) fn upload_keys(
         let tex = keys.0.entry(id).or_insert_with(|| {
             let face = pack.reader.manifest().bake.cube_face_size.max(1);
             let per_key = key_bytes(&pack.reader, (0, 0)).max(1);
-            let slots =
-                (settings.memory_budget_bytes / per_key).clamp(1, (MAX_LAYERS / 6) as u64) as u32;
+            let groups = u64::from(stored_groups(pack.reader.manifest()));
+            let per_slot_groups = groups * 6 * u64::from(face).pow(2) * GROUP_TEXEL_BYTES;
+            let most = (MAX_LAYERS / 6) as u64;
+            let most = most.min(MAX_GROUP_BUFFER / per_slot_groups.max(1));
+            let slots = (settings.memory_budget_bytes / per_key).clamp(1, most.max(1)) as u32;
             let texture = |format| {
                 let mut image = Image::new_uninit(
                     Extent3d {
@@ -146,8 +160,16 @@ pub(super) fn upload_keys(
                 );
                 continue;
             };
+            let Some(group_data) = interleave_groups(&r.data, tex.face) else {
+                warn_once!(
+                    "plenoptic: GPU light groups need RGB9E5 layers at face size {}; key {vk:?} \
+                     not shown",
+                    tex.face
+                );
+                continue;
+            };
             stats.keys += 1;
-            stats.bytes += (data.len() + shading_data.len()) as u64;
+            stats.bytes += (data.len() + shading_data.len() + group_data.len()) as u64;
             uploads.0.push(KeyUpload {
                 image: tex.image.id(),
                 first_layer: 6 * r.slot,
@@ -155,6 +177,10 @@ pub(super) fn upload_keys(
                 data,
                 shading_image: tex.shading.id(),
                 shading_data,
+                pack: id,
+                group_data,
+                slot: r.slot,
+                slots: tex.slots,
             });
             tex.uploaded.insert(r.slot, vk);
             if normals {
@@ -206,6 +232,23 @@ pub fn interleave(d: &DecodedKey, face: u32) -> Option<(Vec<u8>, Vec<u8>, bool)>
     Some((data, shading, normals.is_some()))
 }
 
+/// A key's light-group layers in the [`GroupLayers`] layout: per stored group, six faces
+/// of (lighting, non-diffuse) RGB9E5 texels. `None` when one is not RGB9E5 at face `face`.
+pub fn interleave_groups(d: &DecodedKey, face: u32) -> Option<Vec<u8>> {
+    let texels = (6 * face * face) as usize;
+    let mut out = Vec::with_capacity(d.groups.len() * texels * GROUP_TEXEL_BYTES as usize);
+    for [lighting, non_diffuse] in &d.groups {
+        if lighting.len() != texels * 4 || non_diffuse.len() != texels * 4 {
+            return None;
+        }
+        for (l, n) in lighting.chunks_exact(4).zip(non_diffuse.chunks_exact(4)) {
+            out.extend_from_slice(l);
+            out.extend_from_slice(n);
+        }
+    }
+    Some(out)
+}
+
 fn extract_key_uploads(mut main: ResMut<MainWorld>, mut pending: ResMut<PendingKeyUploads>) {
     if let Some(mut uploads) = main.get_resource_mut::<KeyUploads>() {
         pending.0.append(&mut uploads.0);
@@ -217,13 +260,28 @@ fn extract_key_uploads(mut main: ResMut<MainWorld>, mut pending: ResMut<PendingK
 /// wait.
 fn write_key_uploads(
     mut pending: ResMut<PendingKeyUploads>,
+    mut groups: ResMut<GroupLayers>,
     images: Res<RenderAssets<GpuImage>>,
-    queue: Res<RenderQueue>,
+    (device, queue): (Res<RenderDevice>, Res<RenderQueue>),
 ) {
     pending.0.retain(|u| {
         let (Some(gpu), Some(shading)) = (images.get(u.image), images.get(u.shading_image)) else {
             return true;
         };
+        if !u.group_data.is_empty() {
+            let per_slot = u.group_data.len() as u64;
+            let buffer = groups.0.entry(u.pack).or_insert_with(|| {
+                device.create_buffer(&BufferDescriptor {
+                    label: Some("plenoptic light-group layers"),
+                    size: per_slot * u64::from(u.slots),
+                    usage: BufferUsages::STORAGE | BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            });
+            if buffer.size() >= per_slot * u64::from(u.slot + 1) {
+                queue.write_buffer(buffer, per_slot * u64::from(u.slot), &u.group_data);
+            }
+        }
         for (texture, data, bytes) in [
             (&gpu.texture, &u.data, TEXEL_BYTES),
             (&shading.texture, &u.shading_data, SHADING_BYTES),

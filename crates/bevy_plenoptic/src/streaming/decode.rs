@@ -25,6 +25,9 @@ pub struct DecodedKey {
     pub lighting: Option<Vec<u8>>,
     /// Non-diffuse radiance texels (pack 2.0; the radiance formats).
     pub non_diffuse: Option<Vec<u8>>,
+    /// Per stored light group (pack 4.2, `LightGroupsEntry::stored`), its lighting and
+    /// non-diffuse texels (the radiance formats); empty for a pack without groups.
+    pub groups: Vec<[Vec<u8>; 2]>,
     /// On the CPU backend, the key's cubes decoded for `plenoptic_recon` instead of the
     /// GPU's texel bytes above (which are then empty): what its reconstructor looks up
     /// ([`decode_cpu_key`]).
@@ -39,7 +42,12 @@ impl DecodedKey {
             + self.object_id.len()
             + self.normal.as_ref().map_or(0, Vec::len)
             + self.lighting.as_ref().map_or(0, Vec::len)
-            + self.non_diffuse.as_ref().map_or(0, Vec::len)) as u64
+            + self.non_diffuse.as_ref().map_or(0, Vec::len)
+            + self
+                .groups
+                .iter()
+                .map(|g| g[0].len() + g[1].len())
+                .sum::<usize>()) as u64
             + self.cpu.iter().map(|(_, c)| c.bytes()).sum::<u64>()
     }
 }
@@ -57,9 +65,11 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
         let fail = |e: plenoptic_pack::PackError| (name(kind), e.to_string());
         let bytes = pack.chunk_bytes(i).map_err(fail)?;
         let formats = match kind {
-            ChunkKind::RadianceCube | ChunkKind::LightingCube | ChunkKind::NonDiffuseCube => {
-                &range_image::RADIANCE_FORMATS[..]
-            }
+            ChunkKind::RadianceCube
+            | ChunkKind::LightingCube
+            | ChunkKind::NonDiffuseCube
+            | ChunkKind::GroupLighting(_)
+            | ChunkKind::GroupNonDiffuse(_) => &range_image::RADIANCE_FORMATS[..],
             ChunkKind::DistanceCube => &range_image::DISTANCE_FORMATS[..],
             ChunkKind::ObjectIdCube => &range_image::OBJECT_ID_FORMATS[..],
             _ => &range_image::NORMAL_FORMATS[..],
@@ -75,6 +85,9 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
     let normal = read(ChunkKind::NormalCube)?.map(|n| n.1);
     let lighting = read(ChunkKind::LightingCube)?.map(|n| n.1);
     let non_diffuse = read(ChunkKind::NonDiffuseCube)?.map(|n| n.1);
+    let groups = group_kinds(pack)
+        .map(|[l, n]| Ok([required(l)?.1, required(n)?.1]))
+        .collect::<Result<_, (String, String)>>()?;
     Ok(DecodedKey {
         face_size,
         radiance,
@@ -83,8 +96,17 @@ pub fn decode_key(pack: &PackReader, (view, key): KeyRef) -> Result<DecodedKey, 
         normal,
         lighting,
         non_diffuse,
+        groups,
         cpu: Vec::new(),
     })
+}
+
+/// The chunk kinds of each stored light group's lighting and non-diffuse cubes.
+fn group_kinds(pack: &PackReader) -> impl Iterator<Item = [ChunkKind; 2]> {
+    let stored = pack.manifest().light_groups.as_ref().map(|e| e.stored());
+    stored
+        .unwrap_or_default()
+        .map(|g| [ChunkKind::GroupLighting(g), ChunkKind::GroupNonDiffuse(g)])
 }
 
 /// Reads and decodes one key for the CPU backend: its cubes as `plenoptic_recon` looks them
@@ -123,6 +145,7 @@ pub fn decode_cpu_key(
         normal: None,
         lighting: None,
         non_diffuse: None,
+        groups: Vec::new(),
         cpu,
     })
 }
@@ -148,6 +171,7 @@ pub fn cpu_key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
 pub fn key_bytes(pack: &PackReader, (view, key): KeyRef) -> u64 {
     CUBE_KINDS
         .into_iter()
+        .chain(group_kinds(pack).flatten())
         .filter_map(|k| pack.find(k, view, key))
         .map(|i| pack.entries()[i].uncompressed_length)
         .sum()
@@ -172,12 +196,15 @@ pub struct BinnedVolume {
     pub words: Vec<u32>,
     /// [`VOLUME_BIN_OFFSETS`] sample offsets: bin `b` holds samples `bins[b]..bins[b + 1]`.
     pub bins: Vec<u32>,
+    /// Per sample (in `words`' order), per stored light group, its lighting and non-diffuse
+    /// (RGB9E5): `2 · groups` words a sample; empty for a pack without groups.
+    pub groups: Vec<u32>,
 }
 
 impl BinnedVolume {
     /// Bytes held.
     pub fn bytes(&self) -> u64 {
-        4 * (self.words.len() + self.bins.len()) as u64
+        4 * (self.words.len() + self.bins.len() + self.groups.len()) as u64
     }
 
     /// Number of samples.
@@ -214,10 +241,30 @@ pub fn decode_volume(
     for i in 0..VOLUME_BIN_OFFSETS - 1 {
         bins[i + 1] += bins[i];
     }
+    let stored = pack.manifest().light_groups.as_ref().map(|e| e.stored());
+    let layers = stored
+        .unwrap_or_default()
+        .map(|g| {
+            let layer = pack.group_volume(view, bucket, g);
+            match layer {
+                Ok(l) if l.len() == block.samples.len() => Ok(l),
+                Ok(_) => Err("its sample count differs from the block's".to_string()),
+                Err(e) => Err(e.to_string()),
+            }
+            .map_err(|e| (format!("GroupVolume({g}) view {view} bucket {bucket}"), e))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let mut fill = bins.clone();
     let mut words = vec![0u32; block.samples.len() * VOLUME_SAMPLE_WORDS];
-    for (s, &b) in block.samples.iter().zip(&bin) {
-        let o = fill[b] as usize * VOLUME_SAMPLE_WORDS;
+    let mut groups = vec![0u32; block.samples.len() * 2 * layers.len()];
+    for (i, (s, &b)) in block.samples.iter().zip(&bin).enumerate() {
+        let at = fill[b] as usize;
+        for (g, layer) in layers.iter().enumerate() {
+            let o = 2 * (at * layers.len() + g);
+            groups[o] = cube::rgb9e5_pack(layer[i][0]);
+            groups[o + 1] = cube::rgb9e5_pack(layer[i][1]);
+        }
+        let o = at * VOLUME_SAMPLE_WORDS;
         fill[b] += 1;
         let f = [
             s.direction.x,
@@ -237,15 +284,20 @@ pub fn decode_volume(
         words[o + 10] = cube::rgb9e5_pack(s.lighting);
         words[o + 11] = cube::rgb9e5_pack(s.non_diffuse);
     }
-    Ok(BinnedVolume { words, bins })
+    Ok(BinnedVolume {
+        words,
+        bins,
+        groups,
+    })
 }
 
 /// Bytes a volume block will occupy once binned, from the directory (known before reading):
-/// its samples at 48 bytes (against [`plenoptic_pack::volume::SAMPLE_BYTES`] stored) plus the
-/// bin offsets.
+/// its samples at 48 bytes (against [`plenoptic_pack::volume::SAMPLE_BYTES`] stored) and 8
+/// more per stored light group, plus the bin offsets.
 pub fn volume_bytes(pack: &PackReader, (view, bucket): BlockRef) -> Option<u64> {
     let i = pack.find(ChunkKind::VolumeBlock, view, bucket)?;
     let samples =
         pack.entries()[i].uncompressed_length / plenoptic_pack::volume::SAMPLE_BYTES as u64;
-    Some(samples * 4 * VOLUME_SAMPLE_WORDS as u64 + 4 * VOLUME_BIN_OFFSETS as u64)
+    let groups = group_kinds(pack).count() as u64;
+    Some(samples * 4 * (VOLUME_SAMPLE_WORDS as u64 + 2 * groups) + 4 * VOLUME_BIN_OFFSETS as u64)
 }

@@ -33,6 +33,7 @@ use plenoptic_recon::background::PlacedEnvironment;
 
 use super::environment::{EnvironmentImages, EnvironmentUniform};
 use super::frames::{CpuFrameImage, FrameReplaced, ImageFrame, ViewDisplay};
+use super::relight::RelitKeys;
 use super::{KeyTextures, ReconstructSystems};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
@@ -307,7 +308,7 @@ pub(super) fn set_background(
 pub(super) fn update_backgrounds(
     keys: Res<KeyTextures>,
     packs: Res<Assets<RadiancePack>>,
-    cameras: Query<(&PlenopticCamera, &ViewDisplay)>,
+    cameras: Query<(&PlenopticCamera, &ViewDisplay, Option<&RelitKeys>)>,
     backgrounds: Query<(
         &PlenopticBackground,
         &MeshMaterial3d<PlenopticBackgroundMaterial>,
@@ -315,18 +316,30 @@ pub(super) fn update_backgrounds(
     mut background_materials: ResMut<Assets<PlenopticBackgroundMaterial>>,
 ) {
     for (bg, handle) in &backgrounds {
-        let Ok((cam, display)) = cameras.get(bg.camera) else {
+        let Ok((cam, display, relit)) = cameras.get(bg.camera) else {
             continue;
         };
         if bg.cpu {
             continue;
         }
         let id = cam.pack.id();
-        let face = keys.0.get(&id).map_or(1, |t| t.face);
+        let tex = keys.0.get(&id);
+        let face = tex.map_or(1, |t| t.face);
+        // The heaviest key is in the camera's relit keys when it has them.
+        let cubes = relit.map(|r| &r.image).or(tex.map(|t| &t.image));
+        if let Some(cubes) = cubes
+            && background_materials
+                .get(&handle.0)
+                .is_some_and(|m| m.cubes != *cubes)
+            && let Some(mut m) = background_materials.get_mut(&handle.0)
+        {
+            m.cubes = cubes.clone();
+        }
         let layer = display.heaviest_layer;
+        let sky = |p: &RadiancePack| cam.lights.relight(p.reader.manifest()).sky;
         let env = packs
             .get(id)
-            .map(|p| p.environment.at(cam.time))
+            .map(|p| p.environment.at(cam.time).scaled(sky(p)))
             .unwrap_or_default();
         set_background(
             &mut background_materials,

@@ -269,10 +269,15 @@ pub(crate) fn run_cpu_frames(
             continue;
         };
         // The camera's settings, applied while no frame task shares the reconstructor.
-        if let Some(r) = f.rec.as_mut().and_then(Arc::get_mut)
-            && r.settings != cam.settings
-        {
-            r.settings = cam.settings.clone();
+        if let Some(r) = f.rec.as_mut().and_then(Arc::get_mut) {
+            if r.settings != cam.settings {
+                r.settings = cam.settings.clone();
+            }
+            match cam.lights.weights(r.pack().manifest()) {
+                Ok(w) if w != *r.light_weights() => r.set_light_weights(w),
+                Ok(_) => {}
+                Err(e) => warn_once!("plenoptic: {e}; the camera shows the pack as baked"),
+            }
         }
         let Some(rec) = f.rec.clone() else {
             continue;

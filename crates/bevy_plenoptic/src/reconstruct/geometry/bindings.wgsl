@@ -28,6 +28,8 @@ const VIEW_SUN: u32 = 4u;
 const VIEW_MARCHED: u32 = 8u;
 // Holes of the opaque pass are filled by the screen-space fill kernel (screen_fill.rs).
 const VIEW_SCREEN_FILL: u32 = 16u;
+// The camera reads its relit keys (reconstruct/relight.rs): lookup k's key at layers 6k.
+const VIEW_RELIT: u32 = 32u;
 
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
@@ -72,6 +74,20 @@ struct ViewParams {
     volume: array<vec4<f32>, 8>,
     // Per volume block: first sample (x), first bin offset (y).
     volume_range: array<vec4<u32>, 8>,
+    // Light groups (reconstruct/relight.rs): groups stored per key and volume sample (0: the
+    // camera reads the pack's keys as stored); layers blended (of light_layers); the first
+    // vec4 of the volume samples' group words in volume_samples.
+    light_groups: u32,
+    light_layer_count: u32,
+    volume_groups: u32,
+    // The blend's weight of the total (xyz); the sky's multiplier (xyz).
+    light_base: vec4<f32>,
+    light_sky: vec4<f32>,
+    // Per layer blended: its coefficient (xyz) and stored group (w).
+    light_layers: array<vec4<f32>, 16>,
+    // Per lookup, with light groups: its key's first layer in the pack's key texture (x);
+    // `base[k].w` is then 6k, its layers in the camera's relit keys.
+    source_layer: array<vec4<u32>, 16>,
     // The pack's environment at the camera's time, for reflected rays that leave the scene
     // (not named `environment`: naga_oil would take the field for the imported function).
     env: Environment,

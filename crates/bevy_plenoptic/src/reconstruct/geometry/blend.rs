@@ -144,7 +144,7 @@ pub(super) fn prepare_blended_keys(
         } else {
             0
         };
-        let key_images = tex.map(|t| (t.image.clone(), t.shading.clone()));
+        let key_images = view.keys.clone();
         match blended {
             None => {
                 let (geometry, terms) = new_images(&mut images);
@@ -179,7 +179,7 @@ pub(super) fn prepare_blended_keys(
 /// The pass's pipeline and layouts: its outputs (group 0) and the keys and view buffer at
 /// the materials' binding numbers (group 1).
 #[derive(Resource)]
-struct BlendPipeline {
+pub(super) struct BlendPipeline {
     layouts: [BindGroupLayoutDescriptor; 2],
     id: CachedComputePipelineId,
 }
@@ -222,7 +222,7 @@ fn init_pipeline(
 
 /// Blends a view's key pairs before its opaque pass: one thread per texel of each pair's six
 /// faces.
-fn blend_keys(
+pub(super) fn blend_keys(
     view: ViewQuery<&BlendedKeys>,
     pipeline: Option<Res<BlendPipeline>>,
     pipeline_cache: Res<PipelineCache>,

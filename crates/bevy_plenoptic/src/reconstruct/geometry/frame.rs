@@ -43,9 +43,17 @@ pub(crate) struct FrameLookups {
 }
 
 impl FrameLookups {
-    /// The first array layer of the heaviest lookup's key, if there is one.
-    pub(crate) fn heaviest_layer(&self) -> Option<u32> {
-        self.heaviest.map(|h| 6 * self.lookups[h].slot)
+    /// The first array layer of the heaviest lookup's key, if there is one: in the pack's
+    /// key texture, or with `relit` in the camera's relit keys.
+    pub(crate) fn heaviest_layer(&self, relit: bool) -> Option<u32> {
+        let slot = |h: usize| {
+            if relit {
+                h as u32
+            } else {
+                self.lookups[h].slot
+            }
+        };
+        self.heaviest.map(|h| 6 * slot(h))
     }
 }
 
@@ -142,6 +150,8 @@ pub(crate) struct CameraFrame<'a> {
     pub(crate) lookups: &'a FrameLookups,
     /// Whether the camera shows the image-mode passes' frame.
     pub(crate) image_mode: bool,
+    /// With [`crate::reconstruct::relight::RelitKeys`]: the pack's stored light groups.
+    pub(crate) relit: Option<u32>,
 }
 
 /// What an object's uniform is made for.
@@ -171,6 +181,10 @@ impl ObjectShading<'_> {
             && cam.settings.shading == plenoptic_recon::Shading::Materials
         {
             factors.fill(&mut params);
+            if !cam.lights.is_identity() {
+                let relight = cam.lights.relight(pack.reader.manifest());
+                params.emissive *= relight.object(self.id).extend(1.0);
+            }
             if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
                 &cam.settings,
                 &factors.material,
@@ -224,6 +238,7 @@ impl CameraFrame<'_> {
     pub(crate) fn view_params(&self) -> ViewParams {
         let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
         let m = pack.reader.manifest();
+        let relight = cam.lights.relight(m);
         let mut params = ViewParams {
             lookup_count: f.lookups.len() as u32,
             face: tex.face,
@@ -240,7 +255,9 @@ impl CameraFrame<'_> {
             } else {
                 0
             },
-            environment: EnvironmentUniform::new(&pack.environment.at(cam.time)),
+            environment: EnvironmentUniform::new(
+                &pack.environment.at(cam.time).scaled(relight.sky),
+            ),
             ..default()
         };
         let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
@@ -268,8 +285,12 @@ impl CameraFrame<'_> {
         let taus: Vec<f32> = f.lookups.iter().map(|l| l.tau).collect();
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {
-            sun::fill(&mut params, pack, cam.time);
-            reflect::fill(&mut params, pack, &cam.settings);
+            sun::fill(&mut params, pack, cam.time, relight.sun);
+            reflect::fill(&mut params, pack, &cam.settings, &relight);
+        }
+        if let Some(groups) = self.relit {
+            params.flags |= ViewFlags::RELIT;
+            super::relight::fill(&mut params, &relight, groups);
         }
         params
     }

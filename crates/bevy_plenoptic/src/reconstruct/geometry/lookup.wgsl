@@ -9,6 +9,7 @@
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap, Footprint, footprint, tap_weight}
 #import plenoptic::fill_entry::unpack_pair
+#import plenoptic::geometry::relight::volume_terms
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME, C_NEIGHBOUR}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
@@ -546,11 +547,7 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
             let r = max(a.w, half_bin);
             if angle < r {
                 let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
-                var value = mat2x3<f32>(b.rgb, vec3<f32>(0.0));
-                if lit() {
-                    value = shaded(c.zw);
-                }
-                sum += value * w;
+                sum += volume_terms(first + j, c.zw, b.rgb) * w;
                 ws += w;
             }
         }

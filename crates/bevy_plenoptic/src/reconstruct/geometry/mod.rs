@@ -64,6 +64,7 @@ pub mod frame;
 pub mod prepare;
 pub mod rays;
 pub mod reflect;
+pub mod relight;
 pub mod screen_fill;
 pub mod sun;
 pub mod view;
@@ -103,9 +104,11 @@ impl Plugin for GeometryAssistedPlugin {
         bevy::shader::load_shader_library!(app, "bsdf.wgsl");
         bevy::shader::load_shader_library!(app, "sun.wgsl");
         bevy::shader::load_shader_library!(app, "specular.wgsl");
+        bevy::shader::load_shader_library!(app, "relight.wgsl");
         embedded_asset!(app, "geometry.wgsl");
         screen_fill::build(app);
         blend::build(app);
+        relight::build(app);
         app.add_plugins(MaterialPlugin::<PlenopticMaterial>::default())
             .init_resource::<volume::VolumeBuffers>()
             .init_resource::<rays::PackRays>()
@@ -123,7 +126,11 @@ impl Plugin for GeometryAssistedPlugin {
                         .in_set(ReconstructSystems::Resources),
                     prepare::attach_materials.in_set(ReconstructSystems::Attach),
                     sun::update_suns.in_set(ReconstructSystems::Jobs),
-                    (view::update_view_buffers, blend::prepare_blended_keys)
+                    (
+                        relight::add_relit_keys,
+                        view::update_view_buffers,
+                        (blend::prepare_blended_keys, relight::update_relit_keys),
+                    )
                         .chain()
                         .in_set(ReconstructSystems::Views),
                     prepare::update_materials.in_set(ReconstructSystems::Materials),

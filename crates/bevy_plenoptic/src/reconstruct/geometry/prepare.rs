@@ -155,5 +155,9 @@ impl frame::BindsView for PlenopticMaterial {
             self.blended_geometry = geometry.clone();
             self.blended_terms = terms.clone();
         }
+        if let Some((cubes, shading)) = &view.keys {
+            self.cubes = cubes.clone();
+            self.shading_cubes = shading.clone();
+        }
     }
 }

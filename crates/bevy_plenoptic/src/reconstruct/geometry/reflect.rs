@@ -18,6 +18,7 @@
 
 use plenoptic_recon::Specular;
 use plenoptic_recon::lamps::runtime_lamps;
+use plenoptic_recon::relight::Relight;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
 use super::view::ViewParams;
@@ -25,7 +26,12 @@ use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 
 /// The view buffer's reflection fields on `pack`, as the camera's `settings` ask.
-pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &ReconSettings) {
+pub(super) fn fill(
+    params: &mut ViewParams,
+    pack: &RadiancePack,
+    settings: &ReconSettings,
+    relight: &Relight,
+) {
     let manifest = pack.reader.manifest();
     let lamps = runtime_lamps(manifest).unwrap_or_default();
     params.lamp_count = lamps.len() as u32;
@@ -38,7 +44,7 @@ pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &Reco
         };
         params.lamps[3 * k] = lamp.position.extend(range);
         params.lamps[3 * k + 1] = lamp.direction.extend(cos_outer);
-        params.lamps[3 * k + 2] = lamp.radiant.extend(scale);
+        params.lamps[3 * k + 2] = (lamp.radiant * relight.light(lamp.light)).extend(scale);
     }
     if let Specular::Marched { max_roughness } = settings.specular {
         let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());

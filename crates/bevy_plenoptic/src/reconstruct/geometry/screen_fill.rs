@@ -55,7 +55,6 @@ use bevy::shader::ShaderDefVal;
 
 use super::view::ViewBuffer;
 use crate::camera::PlenopticCamera;
-use crate::reconstruct::KeyTextures;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::settings::{Backend, PlenopticSettings, ResolvedBackend};
 
@@ -199,7 +198,6 @@ pub(super) fn prepare_screen_fill(
     mut commands: Commands,
     backend: Res<ResolvedBackend>,
     (settings, early_depth): (Res<PlenopticSettings>, Option<Res<EarlyDepthSupport>>),
-    keys: Res<KeyTextures>,
     mut cameras: Query<(
         Entity,
         &Camera,
@@ -237,10 +235,7 @@ pub(super) fn prepare_screen_fill(
             holes,
             size,
             radius: cam.settings.hole_fill_radius,
-            keys: keys
-                .0
-                .get(&cam.pack.id())
-                .map(|k| (k.image.clone(), k.shading.clone())),
+            keys: view.keys.clone(),
             view: view.buffer.clone(),
             counters: counters.buffer.clone(),
             counting: settings.cost_counters,

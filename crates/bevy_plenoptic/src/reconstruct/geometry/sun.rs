@@ -45,11 +45,11 @@ pub fn sun_at(pack: &RadiancePack, t: f32) -> Option<(Vec3, Vec3)> {
 }
 
 /// The view buffer's sun fields for a camera at time `t` on `pack`.
-pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, t: f32) {
+pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, t: f32, weight: Vec3) {
     if let Some((towards, illuminance)) = sun_at(pack, t) {
         params.sun = towards.extend(0.0);
         params.flags |= super::view::ViewFlags::SUN;
-        params.sun_illuminance = illuminance.extend(0.0);
+        params.sun_illuminance = (illuminance * weight).extend(0.0);
     }
 }
 

@@ -37,8 +37,10 @@ use crate::camera::ReconSettings;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentUniform;
 use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
+use crate::reconstruct::relight::RelitKeys;
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
+use plenoptic_pack::MAX_LIGHT_GROUPS;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 
 /// One camera's lookups and settings, as the geometry-assisted shader reads them (`ViewParams`
@@ -95,6 +97,22 @@ pub struct ViewParams {
     pub volume: [Vec4; volume::MAX_VOLUMES],
     /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
     pub volume_range: [UVec4; volume::MAX_VOLUMES],
+    /// Light groups stored per key and volume sample ([`crate::reconstruct::relight`]; 0:
+    /// the camera reads the pack's keys as stored).
+    pub light_groups: u32,
+    /// Layers blended (of `light_layers`).
+    pub light_layer_count: u32,
+    /// First `vec4` of the volume samples' group words in the pack's sample buffer.
+    pub volume_groups: u32,
+    /// The blend's weight of the total (xyz).
+    pub light_base: Vec4,
+    /// The sky's multiplier (xyz): relit radiance where a texel sees no object.
+    pub light_sky: Vec4,
+    /// Per layer blended: its coefficient (xyz) and stored group (w).
+    pub light_layers: [Vec4; MAX_LIGHT_GROUPS],
+    /// Per lookup, with light groups: its key's first layer in the pack's key texture (x);
+    /// `base[k].w` is then `6k`, its layers in the camera's relit keys.
+    pub source_layer: [UVec4; MAX_LOOKUPS],
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see.
     pub environment: EnvironmentUniform,
@@ -120,6 +138,9 @@ impl ViewFlags {
     pub const MARCHED: u32 = 1 << 3;
     /// Holes of the opaque pass are left to the screen-space fill ([`super::screen_fill`]).
     pub const SCREEN_FILL: u32 = 1 << 4;
+    /// The camera reads its relit keys ([`crate::reconstruct::relight`]): lookup `k`'s key at
+    /// layers `6k..6k + 6`, volume samples blended with their group layers.
+    pub const RELIT: u32 = 1 << 5;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
@@ -141,6 +162,9 @@ pub struct ViewBuffer {
     pub hole_list: Handle<ShaderBuffer>,
     /// Its blended keys' two textures ([`BlendedKeys`]), which its materials bind too.
     pub blended: Option<(Handle<Image>, Handle<Image>)>,
+    /// The key and shading textures its lookups read: its [`RelitKeys`] when it has them,
+    /// else its pack's.
+    pub keys: Option<(Handle<Image>, Handle<Image>)>,
 }
 
 impl ViewBuffer {
@@ -192,6 +216,7 @@ pub(super) fn add_view_buffers(
                 fill_entries: Handle::default(),
                 hole_list: Handle::default(),
                 blended: None,
+                keys: None,
             },
             ViewDisplay::default(),
         ));
@@ -211,14 +236,20 @@ pub(super) fn update_view_buffers(
         &GlobalTransform,
         &ImageFrame,
         &CounterBuffer,
-        (Option<&ScreenFill>, Option<&BlendedKeys>),
+        (
+            Option<&ScreenFill>,
+            Option<&BlendedKeys>,
+            Option<&RelitKeys>,
+        ),
         &mut ViewBuffer,
         &mut ViewDisplay,
     )>,
     images: Res<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    for (cam, transform, frame, counters, (fill, blended), mut view, mut display) in &mut cameras {
+    for (cam, transform, frame, counters, (fill, blended, relit), mut view, mut display) in
+        &mut cameras
+    {
         let id = cam.pack.id();
         let (Some(pack), Some(tex)) = (packs.get(id), keys.0.get(&id)) else {
             continue;
@@ -240,6 +271,7 @@ pub(super) fn update_view_buffers(
             volumes: pack_volumes,
             lookups: &lookups,
             image_mode: warped(cam.mode) && frame.active,
+            relit: relit.map(|r| r.groups),
         };
         let mut params = ctx.view_params();
         if fill.is_some_and(ScreenFill::on) && !ctx.image_mode {
@@ -255,7 +287,7 @@ pub(super) fn update_view_buffers(
             b.set_data(params.clone());
         }
         let shown = ViewDisplay {
-            heaviest_layer: lookups.heaviest_layer(),
+            heaviest_layer: lookups.heaviest_layer(relit.is_some()),
             image_mode: params.flags & ViewFlags::IMAGE_MODE != 0,
         };
         if *display != shown {
@@ -288,6 +320,15 @@ pub(super) fn update_view_buffers(
             if view.blended.as_ref() != Some(&textures) {
                 view.blended = Some(textures);
             }
+        }
+        let keys = match relit {
+            Some(r) => (r.image.clone(), r.shading.clone()),
+            None => (tex.image.clone(), tex.shading.clone()),
+        };
+        keys.0.id().hash(&mut h);
+        keys.1.id().hash(&mut h);
+        if view.keys.as_ref() != Some(&keys) {
+            view.keys = Some(keys);
         }
         let bindings = h.finish();
         if view.bindings != bindings {

@@ -40,6 +40,9 @@ pub struct PackVolumes {
     /// Counts the repacks: the buffers are new ones after each, which the materials must
     /// bind again ([`super::view::ViewBuffer::bindings`]).
     pub generation: u64,
+    /// The first `vec4` of the samples' light-group words in `samples`, after every
+    /// block's samples ([`crate::streaming::BinnedVolume::groups`], block after block).
+    pub group_base: u32,
 }
 
 impl PackVolumes {
@@ -50,6 +53,7 @@ impl PackVolumes {
             bins: buffers.add(storage(&[0; VOLUME_BIN_OFFSETS])),
             layout: HashMap::new(),
             generation: 0,
+            group_base: 0,
         }
     }
 }
@@ -87,6 +91,7 @@ pub(crate) fn upload_volumes(
         resident.sort_by_key(|(b, _)| *b);
         let mut words = Vec::new();
         let mut bins = Vec::new();
+        let mut groups = Vec::new();
         let mut layout = HashMap::new();
         for (b, r) in resident {
             layout.insert(
@@ -98,8 +103,13 @@ pub(crate) fn upload_volumes(
             );
             words.extend_from_slice(&r.data.words);
             bins.extend_from_slice(&r.data.bins);
+            groups.extend_from_slice(&r.data.groups);
         }
         words.resize(words.len().max(VOLUME_SAMPLE_WORDS), 0);
+        // The group words start at a whole vec4 (three per sample).
+        pv.group_base = (words.len() / 4) as u32;
+        words.extend_from_slice(&groups);
+        words.resize(words.len().next_multiple_of(4), 0);
         bins.resize(bins.len().max(VOLUME_BIN_OFFSETS), 0);
         if let Some(mut s) = buffers.get_mut(&pv.samples) {
             *s = storage(&words);
@@ -139,6 +149,7 @@ pub(super) fn fill_params(
         }
     }
     params.volume_count = n as u32;
+    params.volume_groups = pv.group_base;
     params.time = t;
     params.time_window = eps;
 }

@@ -1,0 +1,110 @@
+//! Light groups on the GPU: each camera's resident keys relit at its
+//! [`LightSettings`](crate::camera::LightSettings)
+//! (docs/pack-format.md, "Light groups"; `plenoptic_recon::relight` holds the math).
+//!
+//! A pack with stored light-group layers keeps them beside its key texture in one storage
+//! buffer ([`GroupLayers`], written with the keys by [`super::upload`]): per slot and stored
+//! group, the six faces' (lighting, non-diffuse) RGB9E5 pairs. A camera on such a pack has
+//! [`RelitKeys`]: its own key and shading textures with room for its lookups' keys
+//! ([`MAX_LOOKUPS`] × 6 layers). Once per frame, before anything reads them, a compute pass
+//! (`geometry/relight.rs`) writes each key the camera looks up into them, relit: lighting
+//! and non-diffuse blended `base · total + Σ c · layer` over the groups whose weight differs
+//! from the base, radiance scaled by the ratio of the relit light to the stored light (the
+//! sky's multiplier where a texel sees no object). Every reader (the lookups, the key
+//! blend, the screen fill, reflections, the background) then reads the camera's relit
+//! textures, lookup `k`'s key at layers `6k..6k + 6`, at no extra cost per pixel. The runtime
+//! sun, lamps, emission and environment are scaled in the camera's view buffer and object
+//! uniforms, and the temporal-volume fallback blends its samples' layers where it reads them
+//! (it is rare, and its samples are not per key).
+//!
+//! Why per key and not per pixel: a lookup's footprint is 4 texels, and a pixel makes up to
+//! [`MAX_LOOKUPS`] of them, so blending per pixel reads `4 · lookups · layers` more texels
+//! for every pixel of every frame; relighting the keys reads `(2 + layers)` texels per key
+//! texel, `lookups · 6 · face²` of them, whatever the resolution (the cost counters'
+//! `relit texels`, `docs/results/measurements.md`).
+
+use std::collections::HashMap;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::image::ImageSampler;
+use bevy::prelude::*;
+use bevy::render::extract_component::ExtractComponent;
+use bevy::render::render_resource::{
+    Buffer, Extent3d, TextureDimension, TextureFormat, TextureUsages,
+};
+use bevy::render::storage::ShaderBuffer;
+use plenoptic_pack::Manifest;
+
+use super::MAX_LOOKUPS;
+use crate::asset::RadiancePack;
+
+/// Bytes of one texel of one group layer: (lighting, non-diffuse) RGB9E5.
+pub const GROUP_TEXEL_BYTES: u64 = 8;
+/// Largest group-layer buffer (wgpu's default storage-binding limit): a grouped pack's key
+/// slots are as many as fit in it.
+pub const MAX_GROUP_BUFFER: u64 = 128 << 20;
+
+/// Light groups whose layers `manifest`'s pack stores (0: none, the pack is shown as baked
+/// or scaled as a whole).
+pub fn stored_groups(manifest: &Manifest) -> u32 {
+    let stored = manifest.light_groups.as_ref().map(|e| e.stored().len());
+    stored.unwrap_or(0) as u32
+}
+
+/// A camera's relit keys (see the module doc), on cameras whose pack stores group layers.
+/// Extracted onto its render-world view with what the pass reads.
+#[derive(Component, Debug, Clone, ExtractComponent)]
+pub struct RelitKeys {
+    /// Per lookup, six faces of key texels (the pack key texture's layout), relit.
+    pub image: Handle<Image>,
+    /// Per lookup, six faces of (lighting, non-diffuse) texels, relit.
+    pub shading: Handle<Image>,
+    /// The keys' face size.
+    pub face: u32,
+    /// The pack.
+    pub pack: AssetId<RadiancePack>,
+    /// The pack's key texture and shading texture (what is relit).
+    pub keys: Option<(Handle<Image>, Handle<Image>)>,
+    /// Lookups this frame (the view buffer's `lookup_count`).
+    pub lookups: u32,
+    /// Stored groups of the pack.
+    pub groups: u32,
+    /// The camera's view buffer (the lookups' source layers and the blend).
+    pub view: Handle<ShaderBuffer>,
+}
+
+impl RelitKeys {
+    /// The camera's two textures at face size `face`.
+    pub fn textures(face: u32, images: &mut Assets<Image>) -> (Handle<Image>, Handle<Image>) {
+        let layers = 6 * MAX_LOOKUPS as u32;
+        (
+            images.add(relit_image(face, layers, TextureFormat::Rgba32Uint)),
+            images.add(relit_image(face, layers, TextureFormat::Rg32Uint)),
+        )
+    }
+}
+
+/// A texture of `layers` layers of `face` × `face` texels, written by the pass and read by
+/// the lookups (with their nearest sampler, as the pack's key texture).
+fn relit_image(face: u32, layers: u32, format: TextureFormat) -> Image {
+    let mut image = Image::new_uninit(
+        Extent3d {
+            width: face,
+            height: face,
+            depth_or_array_layers: layers,
+        },
+        TextureDimension::D2,
+        format,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    image.texture_descriptor.usage =
+        TextureUsages::STORAGE_BINDING | TextureUsages::TEXTURE_BINDING;
+    image.texture_view_descriptor = None;
+    image.sampler = ImageSampler::nearest();
+    image
+}
+
+/// Each pack's group layers on the GPU (render world): one storage buffer, per slot and
+/// stored group, six faces of `face`² [`GROUP_TEXEL_BYTES`]-byte texels.
+#[derive(Resource, Debug, Default)]
+pub struct GroupLayers(pub HashMap<AssetId<RadiancePack>, Buffer>);
