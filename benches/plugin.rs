@@ -56,6 +56,7 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::window::ExitCondition;
 use bevy_plenoptic::prelude::*;
 use bevy_plenoptic::reconstruct::counters::CostReport;
+use bevy_plenoptic::reconstruct::geometry::view::ViewBuffer;
 use bevy_plenoptic::streaming::{StreamState, decode_key, decode_volume, key_bytes, volume_bytes};
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use plenoptic_pack::PackReader;
@@ -139,6 +140,7 @@ struct View {
     vfov: Option<f32>,
     time: f32,
     settings: ReconSettings,
+    lights: LightSettings,
 }
 
 /// `cameras` split-screen players 0.5 m apart in the room of `room.pack`.
@@ -150,6 +152,7 @@ fn room_views(cameras: usize) -> Vec<View> {
             vfov: None,
             time: 0.7,
             settings: ReconSettings::default(),
+            lights: LightSettings::default(),
         })
         .collect()
 }
@@ -176,6 +179,7 @@ fn tour_view(file: &str, s: f32) -> View {
         vfov: Some(cam.vfov),
         time: sample.scene_time,
         settings: ReconSettings::default(),
+        lights: LightSettings::default(),
     }
 }
 
@@ -215,6 +219,7 @@ fn scene(assets: &std::path::Path, pack: &str, views: &[View], size: UVec2) -> S
                 playback: Playback::Manual,
                 time: view.time,
                 settings: view.settings.clone(),
+                lights: view.lights.clone(),
                 ..PlenopticCamera::new(handle.clone())
             },
         ));
@@ -403,6 +408,7 @@ fn frame(c: &mut Criterion) {
                     specular: plenoptic_recon::Specular::Baked,
                     ..v.settings.clone()
                 },
+                lights: v.lights.clone(),
                 ..*v
             })
             .collect();
@@ -486,8 +492,72 @@ fn costs(c: &mut Criterion) {
         for (case, views) in [("tour_1280x720", &views), ("tour_mirror_1280x720", &mirror)] {
             compared_fills(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
+        if let Some(groups) = std::env::var_os("PLENOPTIC_GROUPS_PACK") {
+            compared_groups(
+                &mut g,
+                (assets, name),
+                std::path::Path::new(&groups),
+                &views,
+            );
+        }
     }
     g.finish();
+}
+
+/// The tour's view on the pack baked with light groups (`PLENOPTIC_GROUPS_PACK`, from
+/// `tour_groups.toml`) with the lamp off and the daylight at 0.2, against the pack without
+/// groups, both with the screen fill: the fetches per pixel of each, and the relight pass's
+/// loads per pixel (per texel of each looked-up key: its key and shading texels and one per
+/// blended layer), printed with their ratio.
+fn compared_groups(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    (assets, name): (&std::path::Path, &str),
+    groups: &std::path::Path,
+    views: &[View],
+) {
+    let plain = counted_frames(g, "tour_1280x720_without_groups", true, || {
+        scene(assets, name, views, TOUR_SIZE)
+    });
+    let mut relit: Vec<View> = views
+        .iter()
+        .map(|v| View {
+            settings: v.settings.clone(),
+            lights: LightSettings::default(),
+            ..*v
+        })
+        .collect();
+    for v in &mut relit {
+        v.lights
+            .set("lamp", Vec3::ZERO)
+            .set("sun", Vec3::splat(0.2))
+            .set("sky", Vec3::splat(0.2));
+    }
+    let (group_assets, group_name) = tour_location(groups);
+    let mut pass = None;
+    let grouped = counted_frames_with(
+        g,
+        "tour_1280x720_groups_lamp_off_daylight_0.2",
+        true,
+        || scene(group_assets, group_name, &relit, TOUR_SIZE),
+        |s| {
+            let world = s.app.world();
+            let p = world
+                .get::<ViewBuffer>(s.cameras[0])
+                .map(|v| v.params().clone());
+            pass = p.map(|p| {
+                let texels = f64::from(p.lookup_count * 6 * p.face * p.face);
+                texels * f64::from(2 + p.light_layer_count) / f64::from(TOUR_SIZE.x * TOUR_SIZE.y)
+            });
+        },
+    );
+    if let (Some(a), Some(b), Some(pass)) = (plain, grouped, pass) {
+        let (a, b) = (a.loads + a.kernel_loads, b.loads + b.kernel_loads);
+        eprintln!(
+            "costs light groups: fetches per pixel {b:.2} with groups + {pass:.2} in the relight \
+             pass, {a:.2} without: {:.3}×",
+            (b + pass) / a.max(1e-9)
+        );
+    }
 }
 
 /// One case counted with the screen-space fill and with the fragment fill, and the ratio of
@@ -519,6 +589,17 @@ fn counted_frames(
     screen_fill: bool,
     make: impl Fn() -> Scene,
 ) -> Option<CostReport> {
+    counted_frames_with(g, name, screen_fill, make, |_| {})
+}
+
+/// [`counted_frames`], handing the settled scene to `inspect` once its counts are read.
+fn counted_frames_with(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    screen_fill: bool,
+    make: impl Fn() -> Scene,
+    mut inspect: impl FnMut(&Scene),
+) -> Option<CostReport> {
     let settled = settled_frames(g, name, || {
         let mut s = hdr_scene(make(), screen_fill);
         s.app
@@ -532,7 +613,9 @@ fn counted_frames(
         s.app.update();
         if let Some(r) = s.app.world().get::<CostReport>(s.cameras[0]) {
             print_costs(name, r);
-            return Some(r.clone());
+            let r = r.clone();
+            inspect(&s);
+            return Some(r);
         }
     }
     eprintln!("{name}: no cost report was read back");

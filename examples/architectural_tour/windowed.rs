@@ -4,9 +4,12 @@
 //! and the scene time); `Tab` hands the camera to Bevy's free-fly controller (WASD, Q/E,
 //! mouse with the right button held or `M` to capture, scroll for speed) with the animation
 //! playing on the clock, and back. `Space` pauses, `1`/`2`/`3` switch the reconstruction
-//! mode (geometry-assisted, image, volume), `Esc` quits. The window title shows the frame
-//! rate, the scene time, the mode and the plugin's resident streaming memory; the peak
-//! resident memory is printed when the window closes.
+//! mode (geometry-assisted, image, volume), `Esc` quits. On a pack baked with light groups
+//! (`--recipe examples/architectural_tour/assets/tour_groups.toml`), `L` switches room B's
+//! lamp off and on and `D` steps the daylight (the `sun` and `sky` groups) through 1, 0.2
+//! and 0: the camera's [`LightSettings`], applied by the plugin every frame. The window
+//! title shows the frame rate, the scene time, the mode, the lights and the plugin's
+//! resident streaming memory; the peak resident memory is printed when the window closes.
 //!
 //! `--screenshot FILE` (with `--screenshot-at SECONDS` along the path) holds the tour at that
 //! moment, waits until the plugin has streamed what the frame needs and the pipelines are
@@ -49,7 +52,14 @@ struct Tour {
     peak_resident: Arc<AtomicU64>,
     title_timer: Timer,
     screenshot: Option<ScreenshotPlan>,
+    /// Room B's lamp is on (`L`).
+    lamp_on: bool,
+    /// Index into [`DAYLIGHT`] of the daylight's intensity (`D`).
+    daylight: usize,
 }
+
+/// The daylight intensities `D` steps through.
+const DAYLIGHT: [f32; 3] = [1.0, 0.2, 0.0];
 
 /// A screenshot to take and then quit.
 pub struct ScreenshotPlan {
@@ -119,6 +129,8 @@ pub fn run(
         peak_resident: peak.clone(),
         title_timer: Timer::from_seconds(0.5, TimerMode::Repeating),
         screenshot,
+        lamp_on: true,
+        daylight: 0,
     })
     .add_systems(
         Startup,
@@ -158,6 +170,7 @@ pub fn run(
         Update,
         (
             keys,
+            light_keys,
             fly_tour.before(PlenopticSystems::Playback),
             title,
             take_screenshot,
@@ -221,6 +234,40 @@ fn keys(
     }
 }
 
+/// `L` and `D`: the lamp and the daylight, set on the camera for the groups its pack has.
+fn light_keys(
+    input: Res<ButtonInput<KeyCode>>,
+    mut tour: ResMut<Tour>,
+    packs: Res<Assets<RadiancePack>>,
+    mut cameras: Query<&mut PlenopticCamera>,
+) {
+    if input.just_pressed(KeyCode::KeyL) {
+        tour.lamp_on = !tour.lamp_on;
+    }
+    if input.just_pressed(KeyCode::KeyD) {
+        tour.daylight = (tour.daylight + 1) % DAYLIGHT.len();
+    }
+    let lamp = if tour.lamp_on { 1.0 } else { 0.0 };
+    let wanted = [
+        ("lamp", lamp),
+        ("sun", DAYLIGHT[tour.daylight]),
+        ("sky", DAYLIGHT[tour.daylight]),
+    ];
+    for mut camera in &mut cameras {
+        let Some(pack) = packs.get(camera.pack.id()) else {
+            continue;
+        };
+        let groups = pack.reader.manifest().light_groups.as_ref();
+        let names = groups.map(|g| &g.names[..]).unwrap_or_default();
+        for (name, w) in wanted {
+            let w = Vec3::splat(w);
+            if names.iter().any(|n| n == name) && camera.lights.get(name) != w {
+                camera.lights.set(name, w);
+            }
+        }
+    }
+}
+
 /// While flying the tour, the path sets the camera's pose, field of view and scene time.
 fn fly_tour(
     time: Res<Time>,
@@ -277,6 +324,15 @@ fn title(
         ReconMode::Image => "image",
         ReconMode::Volume => "volume",
     };
+    let lights = if camera.lights.is_identity() {
+        String::new()
+    } else {
+        format!(
+            ", lamp {}, daylight {}",
+            if tour.lamp_on { "on" } else { "off" },
+            DAYLIGHT[tour.daylight]
+        )
+    };
     let driver = if tour.flying_tour {
         "tour (Tab: free-fly)"
     } else {
@@ -285,7 +341,7 @@ fn title(
     for mut window in &mut windows {
         let previous = window.title.clone();
         window.title = format!(
-            "plenoptic tour — {fps:.0} fps, t = {:.1} s, {mode}, resident {:.0} MiB — {driver}{}",
+            "plenoptic tour — {fps:.0} fps, t = {:.1} s, {mode}{lights}, resident {:.0} MiB — {driver}{}",
             camera.time,
             resident / (1024.0 * 1024.0),
             if tour.paused { " — paused" } else { "" }
