@@ -24,7 +24,8 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use plenoptic_pack::{
-    ChunkKind, CubeImage, GroupWeights, LayerBlend, Manifest, VolumeBlock, VolumeSample,
+    ChunkKind, ChunkRef, CubeImage, GroupWeights, LayerBlend, Manifest, PackError, PackReader,
+    VolumeBlock, VolumeSample,
 };
 
 use crate::Reconstructor;
@@ -78,6 +79,36 @@ impl Relight {
             lights,
             objects,
         }
+    }
+
+    /// The volume block of base view `view` in `bucket` read from `pack` and relit at these
+    /// weights (its samples' lighting, non-diffuse and radiance, as the chunk cache hands
+    /// blocks out); as stored where the blend is the identity. The error names the chunk.
+    pub fn volume_block(
+        &self,
+        pack: &PackReader,
+        view: u32,
+        bucket: u32,
+    ) -> plenoptic_pack::Result<VolumeBlock> {
+        let block = pack.volume_block(view, bucket)?;
+        if self.blend.is_identity() {
+            return Ok(block);
+        }
+        let layers = (self.blend.layers.iter())
+            .map(|&(g, _)| pack.group_volume(view, bucket, g).map(Arc::new))
+            .collect::<plenoptic_pack::Result<Vec<_>>>()?;
+        blend_block(self, &block, &layers).ok_or_else(|| {
+            let kind = ChunkKind::GroupVolume(self.blend.layers[0].0);
+            PackError::LightGroupMismatch {
+                chunk: ChunkRef {
+                    index: pack.find(kind, view, bucket).unwrap_or(0),
+                    kind,
+                    base_view: view,
+                    key: bucket,
+                },
+                problem: "its samples are not the volume block's".to_string(),
+            }
+        })
     }
 
     /// Manifest light `i`'s multiplier.

@@ -77,6 +77,7 @@ impl Plugin for PlenopticReconstructPlugin {
         bevy::shader::load_shader_library!(app, "environment.wgsl");
         // The cost counters (`plenoptic::counters`).
         bevy::shader::load_shader_library!(app, "counters.wgsl");
+        bevy::shader::load_shader_library!(app, "relight.wgsl");
         upload::build(app);
         counters::build(app);
         app.init_resource::<KeyTextures>()

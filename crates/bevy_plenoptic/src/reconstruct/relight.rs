@@ -33,7 +33,8 @@ use bevy::render::render_resource::{
     Buffer, Extent3d, TextureDimension, TextureFormat, TextureUsages,
 };
 use bevy::render::storage::ShaderBuffer;
-use plenoptic_pack::Manifest;
+use plenoptic_pack::{MAX_LIGHT_GROUPS, Manifest};
+use plenoptic_recon::relight::Relight;
 
 use super::MAX_LOOKUPS;
 use crate::asset::RadiancePack;
@@ -108,3 +109,33 @@ fn relit_image(face: u32, layers: u32, format: TextureFormat) -> Image {
 /// stored group, six faces of `face`² [`GROUP_TEXEL_BYTES`]-byte texels.
 #[derive(Resource, Debug, Default)]
 pub struct GroupLayers(pub HashMap<AssetId<RadiancePack>, Buffer>);
+
+/// A [`Relight`]'s blend as the passes' uniforms take it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlendUniforms {
+    /// The total's weight (xyz).
+    pub base: Vec4,
+    /// The sky's multiplier (xyz): relit radiance where a texel sees no object.
+    pub sky: Vec4,
+    /// Per layer blended: its coefficient (xyz) and stored group (w).
+    pub layers: [Vec4; MAX_LIGHT_GROUPS],
+    /// Layers blended.
+    pub count: u32,
+}
+
+impl BlendUniforms {
+    /// The uniforms of `relight`.
+    pub fn new(relight: &Relight) -> Self {
+        let mut out = Self {
+            base: relight.blend.base.extend(0.0),
+            sky: relight.sky.extend(0.0),
+            layers: [Vec4::ZERO; MAX_LIGHT_GROUPS],
+            count: 0,
+        };
+        for (slot, (g, c)) in out.layers.iter_mut().zip(&relight.blend.layers) {
+            *slot = c.extend(*g as f32);
+            out.count += 1;
+        }
+        out
+    }
+}

@@ -31,7 +31,7 @@ use plenoptic_recon::relight::Relight;
 use super::view::{ViewBuffer, ViewParams};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
-use crate::reconstruct::relight::{GroupLayers, RelitKeys, stored_groups};
+use crate::reconstruct::relight::{BlendUniforms, GroupLayers, RelitKeys, stored_groups};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::settings::{Backend, ResolvedBackend};
 
@@ -106,22 +106,17 @@ pub(super) fn update_relit_keys(mut cameras: Query<(&ViewBuffer, &mut RelitKeys)
     }
 }
 
-/// The light-group fields of `params` for `relight` (sun, lamps, environment and emission
-/// are scaled where they are filled): the blend of the camera's relit keys when `groups`
-/// layers are stored (the lookups' layers moved to the relit keys: lookup `k` at `6k`), and
-/// the volume fallback's blend of its samples' layers.
+/// The light-group fields of `params` for a camera with relit keys on a pack that stores
+/// `groups` layers (sun, lamps, environment and emission are scaled where they are filled):
+/// the blend of its relit keys (the lookups' layers moved to the relit keys: lookup `k` at
+/// `6k`), and the volume fallback's blend of its samples' layers.
 pub(super) fn fill(params: &mut ViewParams, relight: &Relight, groups: u32) {
-    params.light_sky = relight.sky.extend(0.0);
-    if groups == 0 {
-        return;
-    }
     params.light_groups = groups;
-    params.light_base = relight.blend.base.extend(0.0);
-    let layers = relight.blend.layers.iter().take(params.light_layers.len());
-    for (k, (g, c)) in layers.enumerate() {
-        params.light_layers[k] = c.extend(*g as f32);
-        params.light_layer_count = k as u32 + 1;
-    }
+    let b = BlendUniforms::new(relight);
+    params.light_base = b.base;
+    params.light_sky = b.sky;
+    params.light_layers = b.layers;
+    params.light_layer_count = b.count;
     for k in 0..(params.lookup_count as usize).min(MAX_LOOKUPS) {
         params.source_layer[k].x = params.base[k].w as u32;
         params.base[k].w = (6 * k) as f32;

@@ -5,7 +5,7 @@
 // (group 1, MATERIAL_BIND_GROUP); the outputs and the pack's group layers in group 0.
 #import plenoptic::cube::{rgb9e5_decode, rgb9e5_encode}
 #import plenoptic::geometry::bindings::{cam, cubes, shading_cubes, MAX_LOOKUPS}
-#import plenoptic::geometry::relight::{blend_base, blend_layer, blend_end, relit_radiance}
+#import plenoptic::relight::{stored_terms, blend_base, blend_layer, blend_end, relit_radiance}
 
 @group(0) @binding(0) var keys_out: texture_storage_2d_array<rgba32uint, write>;
 @group(0) @binding(1) var shading_out: texture_storage_2d_array<rg32uint, write>;
@@ -22,20 +22,18 @@ fn relight_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     let face = id.z % 6u;
     let source = cam.source_layer[k].x;
     let key = textureLoad(cubes, id.xy, source + face, 0);
-    let s = textureLoad(shading_cubes, id.xy, source + face, 0).xy;
-    let stored = mat2x3<f32>(rgb9e5_decode(s.x), rgb9e5_decode(s.y));
-    var acc = blend_base(stored);
+    let stored = stored_terms(textureLoad(shading_cubes, id.xy, source + face, 0).xy);
+    var acc = blend_base(cam.light_base.xyz, stored);
     let texel = (face * n + id.y) * n + id.x;
     let slot = source / 6u;
     for (var l = 0u; l < cam.light_layer_count; l++) {
         let g = slot * cam.light_groups + u32(cam.light_layers[l].w);
-        acc = blend_layer(acc, l, group_layers[g * 6u * n * n + texel]);
+        acc = blend_layer(acc, cam.light_layers[l].xyz, group_layers[g * 6u * n * n + texel]);
     }
     let relit = blend_end(acc);
     // A texel that sees no object shows the sky.
     let fallback = select(cam.light_base.xyz, cam.light_sky.xyz, key.z == 0u);
-    let light = stored[0] + stored[1];
-    let radiance = relit_radiance(rgb9e5_decode(key.x), light, relit[0] + relit[1], fallback);
+    let radiance = relit_radiance(rgb9e5_decode(key.x), stored, relit, fallback);
     let layer = 6u * k + face;
     textureStore(keys_out, id.xy, layer, vec4<u32>(rgb9e5_encode(radiance), key.yzw));
     let terms = vec4<u32>(rgb9e5_encode(relit[0]), rgb9e5_encode(relit[1]), 0u, 0u);

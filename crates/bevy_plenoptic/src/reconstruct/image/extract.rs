@@ -9,9 +9,11 @@ use plenoptic_recon::temporal::bezier_weights;
 use super::volume::VolumeCubes;
 use super::{ImageJob, ImageParams, ImageWork, KEYS_PER_VIEW, MAX_IMAGE_VIEWS, frame_image};
 use crate::asset::RadiancePack;
+use crate::camera::LightSettings;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::reconstruct::KeyTextures;
 use crate::reconstruct::frames::{FrameReplaced, ImageFrame};
+use crate::reconstruct::relight::{BlendUniforms, stored_groups};
 use crate::settings::{Backend, ResolvedBackend};
 use crate::streaming::StreamCache;
 
@@ -108,6 +110,8 @@ fn job_for(
         params.size.w = volume.views.len() as u32;
         return Some(ImageWork {
             cubes: image,
+            shading: tex.shading.clone(),
+            pack: id,
             output: frame.clone(),
             params,
         });
@@ -158,9 +162,28 @@ fn job_for(
         return None;
     }
     params.size.w = n as u32;
+    relight(&mut params, &cam.lights, pack);
     Some(ImageWork {
         cubes: tex.image.clone(),
+        shading: tex.shading.clone(),
+        pack: id,
         output: frame.clone(),
         params,
     })
+}
+
+/// The light-group fields of `params`: the keys' radiance relit per texel at `lights`
+/// (`plenoptic_recon::relight`'s ratio of the relit to the stored light) unless they are as
+/// baked.
+fn relight(params: &mut ImageParams, lights: &LightSettings, pack: &RadiancePack) {
+    let m = pack.reader.manifest();
+    let relight = lights.relight(m);
+    if relight.blend.is_identity() && relight.sky == Vec3::ONE {
+        return;
+    }
+    let b = BlendUniforms::new(&relight);
+    params.light = UVec4::new(stored_groups(m), b.count, 1, 0);
+    params.light_base = b.base;
+    params.light_sky = b.sky;
+    params.light_layers = b.layers;
 }

@@ -4,6 +4,7 @@
 // farthest covered neighbour, pass after pass.
 
 #import plenoptic::cube::{rgb9e5_decode, texel_direction}
+#import plenoptic::relight::{stored_terms, blend_base, blend_layer, blend_end, relit_radiance}
 
 const MAX_VIEWS: u32 = 8u;
 const EMPTY: u32 = 0xffffffffu;
@@ -32,6 +33,14 @@ struct ImageParams {
     key_weights: array<vec4<f32>, 8>,
     // Per view: x: first layer of the nearest key (distance), y: key count.
     nearest: array<vec4<u32>, 8>,
+    // Light groups (reconstruct/relight.rs): stored groups (x), layers blended (y), 1 where
+    // the keys' radiance is relit per texel (z).
+    light: vec4<u32>,
+    // The blend's weight of the total (xyz); the sky's multiplier (xyz).
+    light_base: vec4<f32>,
+    light_sky: vec4<f32>,
+    // Per layer blended: its coefficient (xyz) and stored group (w).
+    light_layers: array<vec4<f32>, 16>,
 }
 
 @group(0) @binding(0) var cubes: texture_2d_array<u32>;
@@ -45,6 +54,10 @@ struct ImageParams {
 @group(0) @binding(4) var<storage, read_write> frame_in: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> frame_out: array<vec4<f32>>;
 @group(0) @binding(6) var output: texture_storage_2d<rgba32float, write>;
+// The keys' stored (lighting, non-diffuse) RGB9E5 pairs and, per key slot and stored light
+// group, six faces of its layer's pairs (reconstruct/relight.rs).
+@group(0) @binding(7) var shading_cubes: texture_2d_array<u32>;
+@group(0) @binding(8) var<storage, read> group_layers: array<vec2<u32>>;
 
 fn pixel_count() -> u32 {
     return params.size.x * params.size.y;
@@ -194,9 +207,29 @@ fn view_radiance(v: u32, i: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < params.nearest[v].y; k++) {
         let texel = textureLoad(cubes, t.xy, params.layers[v][k] + t.z, 0);
-        sum += rgb9e5_decode(texel.x) * params.key_weights[v][k];
+        var radiance = rgb9e5_decode(texel.x);
+        if params.light.z != 0u {
+            radiance = relit(params.layers[v][k], i, texel, radiance);
+        }
+        sum += radiance * params.key_weights[v][k];
     }
     return sum;
+}
+
+// Texel `i` (key texel `key`, its radiance `radiance`) of the key at first layer `layer`,
+// relit at the camera's light groups (plenoptic_recon's relight module).
+fn relit(layer: u32, i: u32, key: vec4<u32>, radiance: vec3<f32>) -> vec3<f32> {
+    let n = params.size.z;
+    let t = texel_coords(i, n);
+    let stored = stored_terms(textureLoad(shading_cubes, t.xy, layer + t.z, 0).xy);
+    var acc = blend_base(params.light_base.xyz, stored);
+    for (var l = 0u; l < params.light.y; l++) {
+        let g = (layer / 6u) * params.light.x + u32(params.light_layers[l].w);
+        acc = blend_layer(acc, params.light_layers[l].xyz, group_layers[g * 6u * n * n + i]);
+    }
+    // A texel that sees no object shows the sky.
+    let fallback = select(params.light_base.xyz, params.light_sky.xyz, key.z == 0u);
+    return relit_radiance(radiance, stored, blend_end(acc), fallback);
 }
 
 // plenoptic_recon::warp::blend_warped.

@@ -48,6 +48,8 @@ use bevy::render::render_resource::{
 use bevy::render::renderer::RenderGraph;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
+use plenoptic_pack::MAX_LIGHT_GROUPS;
+
 use super::ReconstructSystems;
 use super::frames::ImageFrame;
 use crate::camera::PlenopticCamera;
@@ -87,6 +89,15 @@ pub struct ImageParams {
     pub key_weights: [Vec4; MAX_IMAGE_VIEWS],
     /// Per view: x: first layer of the nearest key (distances), y: key count.
     pub nearest: [UVec4; MAX_IMAGE_VIEWS],
+    /// Light groups ([`crate::reconstruct::relight`]): stored groups (x), layers blended (y),
+    /// 1 where the keys' radiance is relit per texel (z: image mode at weights not as baked).
+    pub light: UVec4,
+    /// The blend's weight of the total (xyz).
+    pub light_base: Vec4,
+    /// The sky's multiplier (xyz).
+    pub light_sky: Vec4,
+    /// Per layer blended: its coefficient (xyz) and stored group (w).
+    pub light_layers: [Vec4; MAX_LIGHT_GROUPS],
 }
 
 /// A camera's image-mode work this frame: `Some` while it is in image (or volume) mode on
@@ -99,6 +110,11 @@ pub struct ImageJob(pub Option<ImageWork>);
 pub struct ImageWork {
     /// The pack's key texture.
     pub cubes: Handle<Image>,
+    /// The pack's shading texture (the keys' stored light, which relit radiance is scaled
+    /// by).
+    pub shading: Handle<Image>,
+    /// The pack, whose group layers relight the keys ([`crate::reconstruct::relight`]).
+    pub pack: AssetId<crate::asset::RadiancePack>,
     /// The output frame.
     pub output: Handle<Image>,
     /// The passes' uniform.

@@ -8,7 +8,8 @@ use bevy::asset::load_embedded_asset;
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
-    storage_buffer_sized, texture_2d_array, texture_storage_2d, uniform_buffer,
+    storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array, texture_storage_2d,
+    uniform_buffer,
 };
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, Buffer,
@@ -20,11 +21,14 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::texture::GpuImage;
 
 use super::{ImageJob, ImageParams, MAX_IMAGE_VIEWS};
+use crate::reconstruct::relight::GroupLayers;
 
 /// The image-mode pipelines and their bind group layout.
 #[derive(Resource)]
 pub(super) struct ImagePipelines {
     pub(super) layout: BindGroupLayoutDescriptor,
+    /// Bound as the group layers of a pack without them (bindings may not be missing).
+    no_layers: Buffer,
     /// clear, splat_depth, splat_centre, splat_texel, blend, fill, write_output.
     pub(super) passes: [CachedComputePipelineId; 7],
 }
@@ -44,6 +48,7 @@ pub(super) fn init_pipelines(
     mut commands: Commands,
     asset_server: Res<AssetServer>,
     pipeline_cache: Res<PipelineCache>,
+    device: Res<RenderDevice>,
 ) {
     let layout = BindGroupLayoutDescriptor::new(
         "plenoptic image mode",
@@ -57,6 +62,8 @@ pub(super) fn init_pipelines(
                 storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
                 texture_storage_2d(TextureFormat::Rgba32Float, StorageTextureAccess::WriteOnly),
+                texture_2d_array(TextureSampleType::Uint),
+                storage_buffer_read_only_sized(false, None),
             ),
         ),
     );
@@ -70,7 +77,17 @@ pub(super) fn init_pipelines(
             ..default()
         })
     });
-    commands.insert_resource(ImagePipelines { layout, passes });
+    let no_layers = device.create_buffer(&BufferDescriptor {
+        label: Some("plenoptic no light-group layers"),
+        size: 16,
+        usage: BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    commands.insert_resource(ImagePipelines {
+        layout,
+        passes,
+        no_layers,
+    });
 }
 
 /// Scratch buffers, grown as needed: splat keys, splat texels, two frame buffers.
@@ -96,6 +113,7 @@ pub(super) fn prepare_bind_groups(
     views: Query<(Entity, &ImageJob)>,
     pipelines: Option<Res<ImagePipelines>>,
     images: Res<RenderAssets<GpuImage>>,
+    group_layers: Res<GroupLayers>,
     mut buffers: ResMut<ImageBuffers>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
@@ -130,6 +148,11 @@ pub(super) fn prepare_bind_groups(
         let groups = (|| {
             let (work, pipelines) = (job.0.as_ref()?, pipelines.as_ref()?);
             let (cubes, output) = (images.get(&work.cubes)?, images.get(&work.output)?);
+            let shading = images.get(&work.shading)?;
+            let layers = group_layers
+                .0
+                .get(&work.pack)
+                .unwrap_or(&pipelines.no_layers);
             let p = work.params.size;
             if output.texture_descriptor.size.width != p.x
                 || output.texture_descriptor.size.height != p.y
@@ -152,6 +175,8 @@ pub(super) fn prepare_bind_groups(
                         fin.as_entire_binding(),
                         fout.as_entire_binding(),
                         &output.texture_view,
+                        &shading.texture_view,
+                        layers.as_entire_binding(),
                     )),
                 )
             };

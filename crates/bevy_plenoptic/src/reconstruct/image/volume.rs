@@ -29,6 +29,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy::tasks::{IoTaskPool, Task, futures::check_ready};
 use plenoptic_pack::{ChunkKind, PackReader, cube::rgb9e5_pack};
+use plenoptic_recon::relight::Relight;
 use plenoptic_recon::volume::{Cubes, samples_to_cube, slice_to_cube};
 
 use super::MAX_IMAGE_VIEWS;
@@ -70,13 +71,21 @@ impl std::fmt::Debug for VolumeCubes {
 /// A finished rebuild: the texels of the cubes, and (view, weight) of each.
 type Rebuilt = (Vec<u8>, Vec<(usize, f32)>);
 
-/// Pack, time bits, face size, and (view, weight bits) of the weighted views.
-type BuiltFor = (AssetId<RadiancePack>, u32, u32, Vec<(usize, u32)>);
+/// Pack, time bits, face size, (view, weight bits) of the weighted views, and the bits of
+/// the camera's light-group weights.
+type BuiltFor = (AssetId<RadiancePack>, u32, u32, Vec<(usize, u32)>, Vec<u32>);
 
 /// The cube of base view `view` at time `t`, as `plenoptic_recon`'s volume mode builds it;
 /// `None` when the view has no usable volume near t.
-/// `settings` give the face size, tε and the buckets.
-pub fn view_cube(r: &PackReader, view: usize, t: f32, settings: &ReconSettings) -> Option<Cubes> {
+/// `settings` give the face size, tε and the buckets; the samples are relit by `relight`
+/// (the camera's light groups).
+pub fn view_cube(
+    r: &PackReader,
+    view: usize,
+    t: f32,
+    settings: &ReconSettings,
+    relight: &Relight,
+) -> Option<Cubes> {
     let face = settings.volume_face_size.max(1);
     let m = r.manifest();
     let v = view as u32;
@@ -84,7 +93,10 @@ pub fn view_cube(r: &PackReader, view: usize, t: f32, settings: &ReconSettings) 
     let bucket = m.bucket_of(t);
     if r.find(ChunkKind::VolumeConnectivity, v, bucket).is_some()
         && r.find(ChunkKind::VolumeBlock, v, bucket).is_some()
-        && let (Ok(block), Ok(tets)) = (r.volume_block(v, bucket), r.connectivity(v, bucket))
+        && let (Ok(block), Ok(tets)) = (
+            relight.volume_block(r, v, bucket),
+            r.connectivity(v, bucket),
+        )
         && let Ok(Some(c)) = slice_to_cube(&block, &tets, t, face)
     {
         return Some(c);
@@ -96,7 +108,7 @@ pub fn view_cube(r: &PackReader, view: usize, t: f32, settings: &ReconSettings) 
         if r.find(ChunkKind::VolumeBlock, v, b).is_none() {
             continue;
         }
-        let Ok(block) = r.volume_block(v, b) else {
+        let Ok(block) = relight.volume_block(r, v, b) else {
             continue;
         };
         for s in &block.samples {
@@ -199,6 +211,7 @@ fn prepare(
     let m = pack.reader.manifest();
     let (t, position) = (cam.time, transform.translation());
     let settings = cam.settings.clone();
+    let relight = cam.lights.relight(m);
     let mut views = settings.view_weights(m, &pack.usable_views, position);
     views.truncate(MAX_IMAGE_VIEWS);
     let key = (
@@ -206,6 +219,7 @@ fn prepare(
         t.to_bits(),
         settings.volume_face_size.max(1),
         views.iter().map(|&(v, w)| (v, w.to_bits())).collect(),
+        weight_bits(&relight.weights),
     );
     if cubes.built_for.as_ref() == Some(&key) {
         return;
@@ -228,7 +242,7 @@ fn prepare(
             let mut data = Vec::new();
             let mut built = Vec::new();
             for (v, w) in views {
-                if let Some(c) = view_cube(&reader, v, t, &settings) {
+                if let Some(c) = view_cube(&reader, v, t, &settings, &relight) {
                     data.extend_from_slice(&texels(&c));
                     built.push((v, w));
                 }
@@ -236,6 +250,12 @@ fn prepare(
             (data, built)
         }),
     ));
+}
+
+/// The bits of every weight of `w`, which a rebuild is keyed on.
+fn weight_bits(w: &plenoptic_pack::GroupWeights) -> Vec<u32> {
+    let all = std::iter::once(w.default).chain(w.groups.iter().copied());
+    all.flat_map(|c| c.to_array().map(f32::to_bits)).collect()
 }
 
 /// Applies a finished rebuild: the views, and the texture (re)created.
