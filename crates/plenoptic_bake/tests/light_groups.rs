@@ -93,6 +93,7 @@ fn groups_relight_the_room_as_the_path_tracer_and_a_bake_of_that_lighting_do() {
     let entry = rec.pack().manifest().light_groups.clone().unwrap();
     assert!(!entry.default_has_emitters, "every emitter is in a group");
     let camera = camera(SIZE.0, SIZE.1);
+    radiance_cubes_relight_linearly(&rec);
 
     let mut at_one = None;
     for (lamp, daylight) in [(1.0, 1.0), (1.0, 0.0), (0.0, 1.0), (0.5, 2.0)] {
@@ -137,4 +138,41 @@ fn groups_relight_the_room_as_the_path_tracer_and_a_bake_of_that_lighting_do() {
             "({lamp}, {daylight}): LRMS {lrms:.4} against the ungrouped bake's {control:.4}"
         );
     }
+}
+
+/// `Relight::radiance_cube` (what the plugin's light probes read) is linear in the weights:
+/// the lamp alone plus the daylight alone is the radiance as baked, and both at a half is
+/// half of it, texel by texel within the layers' rounding.
+fn radiance_cubes_relight_linearly(rec: &Reconstructor) {
+    let (pack, manifest) = (rec.pack(), rec.pack().manifest());
+    let cube = |lamp: f32, daylight: f32| {
+        let weights = GroupWeights {
+            default: Vec3::ONE,
+            groups: vec![Vec3::splat(lamp), Vec3::splat(daylight)],
+        };
+        let relight = plenoptic_recon::relight::Relight::new(manifest, &weights);
+        relight.radiance_cube(pack, 0, 0).unwrap().texels
+    };
+    let (baked, lamp, day, half) = (
+        cube(1.0, 1.0),
+        cube(1.0, 0.0),
+        cube(0.0, 1.0),
+        cube(0.5, 0.5),
+    );
+    let error = |a: &[Vec3], b: &[Vec3]| {
+        let e = a
+            .iter()
+            .zip(b)
+            .map(|(a, b)| (*a - *b).abs().max_element() / (b.max_element() + 0.01));
+        e.sum::<f32>() / a.len() as f32
+    };
+    let sum: Vec<Vec3> = lamp.iter().zip(&day).map(|(a, b)| *a + *b).collect();
+    let halved: Vec<Vec3> = baked.iter().map(|b| *b * 0.5).collect();
+    let (e_sum, e_half) = (error(&sum, &baked), error(&half, &halved));
+    println!("relit radiance cubes: lamp + daylight against as baked {e_sum:.4}, half {e_half:.4}");
+    assert!(e_sum < 0.02 && e_half < 0.01, "{e_sum} {e_half}");
+    assert!(
+        error(&lamp, &baked) > 0.1,
+        "the lamp alone is not the room as baked"
+    );
 }

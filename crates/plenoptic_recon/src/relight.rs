@@ -111,6 +111,105 @@ impl Relight {
         })
     }
 
+    /// Whether these weights leave the pack as baked.
+    pub fn is_identity(&self) -> bool {
+        self.blend.is_identity() && self.sky == Vec3::ONE
+    }
+
+    /// The radiance cube of (view, key) read from `pack` and relit at these weights, as the
+    /// chunk cache hands it out: as stored at the identity or where the pack has no lighting
+    /// cubes. The error names the chunk.
+    pub fn radiance_cube(
+        &self,
+        pack: &PackReader,
+        view: u32,
+        key: u32,
+    ) -> plenoptic_pack::Result<plenoptic_pack::RadianceCube> {
+        let radiance = pack.radiance(view, key)?;
+        let lit = pack.find(ChunkKind::LightingCube, view, key).is_some()
+            && pack.find(ChunkKind::NonDiffuseCube, view, key).is_some();
+        if self.is_identity() || !lit {
+            return Ok(radiance);
+        }
+        let (l, nd) = (pack.lighting(view, key)?, pack.non_diffuse(view, key)?);
+        let ids = pack.object_id(view, key)?;
+        let mut layers = HashMap::new();
+        for &(g, _) in &self.blend.layers {
+            let lg = pack.group_lighting(view, key, g)?;
+            layers.insert(g, (lg, pack.group_non_diffuse(view, key, g)?));
+        }
+        let pick = |g: u32, nd: bool| {
+            let (a, b) = layers.get(&g)?;
+            Some(if nd { &b.texels[..] } else { &a.texels[..] })
+        };
+        let blended = (
+            self.blend_texels(&l.texels, |g| pick(g, false)),
+            self.blend_texels(&nd.texels, |g| pick(g, true)),
+        );
+        let n = radiance.texels.len();
+        let sizes_agree = [l.texels.len(), nd.texels.len(), ids.texels.len()] == [n; 3];
+        let (Some(lw), Some(ndw), true) = (blended.0, blended.1, sizes_agree) else {
+            let first = self.blend.layers.first();
+            let kind = first.map_or(ChunkKind::LightingCube, |l| ChunkKind::GroupLighting(l.0));
+            return Err(PackError::LightGroupMismatch {
+                chunk: ChunkRef {
+                    index: pack.find(kind, view, key).unwrap_or(0),
+                    kind,
+                    base_view: view,
+                    key,
+                },
+                problem: "its cubes are not the key's size".to_string(),
+            });
+        };
+        let texels = self.relit_texels(
+            &radiance.texels,
+            [&l.texels, &nd.texels],
+            [&lw, &ndw],
+            |i| ids.texels[i] == 0,
+        );
+        Ok(CubeImage {
+            face_size: radiance.face_size,
+            texels,
+        })
+    }
+
+    /// Radiance texels relit (the module doc): `stored` and `relit` are each texel's
+    /// (lighting, non-diffuse) before and after the blend, `sees_sky(i)` whether texel `i`
+    /// sees no object (scaled by the sky's weight where its stored light is zero).
+    pub fn relit_texels(
+        &self,
+        radiance: &[Vec3],
+        stored: [&[Vec3]; 2],
+        relit: [&[Vec3]; 2],
+        sees_sky: impl Fn(usize) -> bool,
+    ) -> Vec<Vec3> {
+        (0..radiance.len())
+            .map(|i| {
+                let fallback = if sees_sky(i) {
+                    self.sky
+                } else {
+                    self.blend.base
+                };
+                let old = stored[0][i] + stored[1][i];
+                relit_radiance(radiance[i], old, relit[0][i] + relit[1][i], fallback)
+            })
+            .collect()
+    }
+
+    /// A colour cube's texels blended from its total and its groups' layers (`layer(g)`: group
+    /// `g`'s texels, for each group the blend reads); `None` where a layer is missing or of
+    /// another length.
+    pub fn blend_texels<'a>(
+        &self,
+        total: &[Vec3],
+        layer: impl Fn(u32) -> Option<&'a [Vec3]>,
+    ) -> Option<Vec<Vec3>> {
+        let layers = (self.blend.layers.iter())
+            .map(|&(g, _)| layer(g).filter(|l| l.len() == total.len()))
+            .collect::<Option<Vec<_>>>()?;
+        Some(blend_slice(&self.blend, total, &layers))
+    }
+
     /// Manifest light `i`'s multiplier.
     pub fn light(&self, i: usize) -> Vec3 {
         self.lights.get(i).copied().unwrap_or(Vec3::ONE)
@@ -157,6 +256,13 @@ fn layer_kind(kind: ChunkKind, g: u32) -> ChunkKind {
     }
 }
 
+/// `blend` of texels `total` and their layers (each as long, in the blend's order).
+fn blend_slice(blend: &LayerBlend, total: &[Vec3], layers: &[&[Vec3]]) -> Vec<Vec3> {
+    (0..total.len())
+        .map(|i| blend.apply(total[i], |k| layers[k][i]))
+        .collect()
+}
+
 /// `blend` of a colour cube's total and its layers (same face size, else `None`).
 fn blend_cube(
     blend: &LayerBlend,
@@ -166,12 +272,10 @@ fn blend_cube(
     if layers.iter().any(|l| l.face_size != total.face_size) {
         return None;
     }
-    let texels = (0..total.texels.len())
-        .map(|i| blend.apply(total.texels[i], |k| layers[k].texels[i]))
-        .collect();
+    let layers: Vec<&[Vec3]> = layers.iter().map(|l| &l.texels[..]).collect();
     Some(CubeImage {
         face_size: total.face_size,
-        texels,
+        texels: blend_slice(blend, &total.texels, &layers),
     })
 }
 
@@ -353,15 +457,12 @@ impl Reconstructor {
             Cached::Ids(ids) if ids.face_size == radiance.face_size => Some(ids),
             _ => None,
         };
-        let base = self.relight.blend.base;
-        let texels = (0..radiance.texels.len())
-            .map(|i| {
-                let sky = ids.as_ref().is_some_and(|ids| ids.texels[i] == 0);
-                let fallback = if sky { self.relight.sky } else { base };
-                let (old, new) = (l.texels[i] + nd.texels[i], lw.texels[i] + ndw.texels[i]);
-                relit_radiance(radiance.texels[i], old, new, fallback)
-            })
-            .collect();
+        let texels = self.relight.relit_texels(
+            &radiance.texels,
+            [&l.texels, &nd.texels],
+            [&lw.texels, &ndw.texels],
+            |i| ids.as_ref().is_some_and(|ids| ids.texels[i] == 0),
+        );
         Cached::Radiance(Arc::new(CubeImage {
             face_size: radiance.face_size,
             texels,

@@ -52,10 +52,12 @@ use bevy::render::render_resource::{
     TextureViewDimension,
 };
 use plenoptic_pack::cube::{direction_to_texel, rgb9e5_unpack, texel_direction};
+use plenoptic_recon::relight::Relight;
 use plenoptic_recon::temporal::bracketing;
 
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
+use crate::reconstruct::relight::weight_bits;
 use crate::settings::{PlenopticSettings, PlenopticSystems};
 use crate::streaming::{DecodedKey, StreamCache};
 
@@ -116,8 +118,47 @@ pub struct PackEnvironmentLight {
     built_for: Option<Source>,
 }
 
-/// What a source cubemap holds: pack, view, and (key, weight bits) of each blended key.
-pub(crate) type Source = (AssetId<RadiancePack>, u32, Vec<(u32, u32)>);
+/// What a source cubemap holds: pack, view, (key, weight bits) of each blended key, and the
+/// bits of the light-group weights it is relit at.
+pub(crate) type Source = (AssetId<RadiancePack>, u32, Vec<(u32, u32)>, Vec<u32>);
+
+/// `radiance`, key `data`'s radiance, relit at `relight` (`plenoptic_recon::relight`): from
+/// its lighting, non-diffuse and group layers as the GPU streams them; as baked where it
+/// has none (a key decoded for the CPU backend keeps no group layers).
+fn relit(data: &DecodedKey, relight: &Relight, radiance: Vec<Vec3>) -> Vec<Vec3> {
+    if relight.is_identity() {
+        return radiance;
+    }
+    let n = radiance.len();
+    let words = |b: &[u8]| -> Option<Vec<u32>> {
+        (b.len() == 4 * n).then(|| {
+            let word = |c: &[u8]| u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+            b.chunks_exact(4).map(word).collect()
+        })
+    };
+    let colours = |b: &[u8]| words(b).map(|w| w.into_iter().map(rgb9e5_unpack).collect());
+    let stored: Option<[Vec<Vec3>; 2]> = (|| {
+        Some([
+            colours(data.lighting.as_deref()?)?,
+            colours(data.non_diffuse.as_deref()?)?,
+        ])
+    })();
+    let layers: Option<Vec<[Vec<Vec3>; 2]>> = (data.groups.iter())
+        .map(|[l, nd]| Some([colours(l)?, colours(nd)?]))
+        .collect();
+    let (Some([l, nd]), Some(layers), Some(ids)) = (stored, layers, words(&data.object_id)) else {
+        return radiance;
+    };
+    let layer = |g: u32, c: usize| layers.get(g as usize).map(|x| &x[c][..]);
+    let blended = (
+        relight.blend_texels(&l, |g| layer(g, 0)),
+        relight.blend_texels(&nd, |g| layer(g, 1)),
+    );
+    let (Some(lw), Some(ndw)) = blended else {
+        return radiance;
+    };
+    relight.relit_texels(&radiance, [&l, &nd], [&lw, &ndw], |i| ids[i] == 0)
+}
 
 /// The radiance of key `data` as linear RGB per texel, if its format is one the pack writes.
 fn radiance(data: &DecodedKey) -> Option<Vec<Vec3>> {
@@ -203,16 +244,17 @@ pub fn source_image(face: u32, keys: &[(Vec<Vec3>, f32)], map: &[usize]) -> Imag
 /// Radiance cubes (per texel) with their weights.
 pub(crate) type WeightedCubes = Vec<(Vec<Vec3>, f32)>;
 
-/// Base view `v` of `pack` at time `t` from the resident keys: what its blended source
-/// would hold (time weights quantised to `1 / steps`), its face and each key's radiance with
-/// its weight; `None` when none of its bracketing keys is resident or readable.
+/// Base view `v` of `pack` at time `t` from the resident keys, relit at `relight`: what its
+/// blended source would hold (time weights quantised to `1 / steps`), its face and each
+/// key's radiance with its weight; `None` when none of its bracketing keys is resident or
+/// readable.
 pub(crate) fn view_source(
     cache: &StreamCache,
-    id: AssetId<RadiancePack>,
-    pack: &RadiancePack,
+    (id, pack): (AssetId<RadiancePack>, &RadiancePack),
     v: usize,
     t: f32,
     steps: f32,
+    relight: &Relight,
 ) -> Option<(Source, u32, WeightedCubes)> {
     let m = pack.reader.manifest();
     let (k0, k1, f) = bracketing(&m.base_views.get(v)?.time_keys, t)?;
@@ -239,6 +281,7 @@ pub(crate) fn view_source(
             .iter()
             .map(|r| (r.0 as u32, ((r.1 / total) * steps).round() as u32))
             .collect(),
+        weight_bits(&relight.weights),
     );
     let face = resident[0].2.face_size;
     let keys = resident
@@ -247,7 +290,7 @@ pub(crate) fn view_source(
             (data.face_size == face)
                 .then(|| radiance(data))
                 .flatten()
-                .map(|r| (r, w / total))
+                .map(|r| (relit(data, relight, r), w / total))
         })
         .collect::<Option<Vec<_>>>()?;
     Some((source, face, keys))
@@ -295,7 +338,10 @@ fn update_environment_lights(
         let Some(&(v, _)) = views.first() else {
             continue;
         };
-        let Some((source, face, keys)) = view_source(&cache, id, pack, v, cam.time, 256.0) else {
+        let relight = cam.lights.relight(m);
+        let Some((source, face, keys)) =
+            view_source(&cache, (id, pack), v, cam.time, 256.0, &relight)
+        else {
             continue;
         };
         if ours.as_ref().and_then(|o| o.built_for.as_ref()) == Some(&source) {

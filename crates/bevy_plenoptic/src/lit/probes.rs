@@ -33,16 +33,19 @@ use plenoptic_pack::PackReader;
 use plenoptic_pack::cube::{direction_to_texel, texel_direction};
 use plenoptic_recon::temporal::bracketing;
 
+use plenoptic_recon::relight::Relight;
+
 use super::{Source, source_face, source_image, texel_map};
 use crate::asset::RadiancePack;
-use crate::camera::PlenopticCamera;
+use crate::camera::{LightSettings, PlenopticCamera};
+use crate::reconstruct::relight::weight_bits;
 use crate::settings::PlenopticSettings;
 
 /// Largest face of a probe's radiance (a power of two).
 pub const PROBE_FACE: u32 = 64;
 
-/// (pack, base view, key).
-type ProbeKey = (AssetId<RadiancePack>, u32, u32);
+/// (pack, base view, key, bits of the light-group weights it is relit at).
+type ProbeKey = (AssetId<RadiancePack>, u32, u32, Vec<u32>);
 /// A probe key's radiance: face and texels.
 type ProbeCube = (u32, Vec<Vec3>);
 
@@ -77,9 +80,10 @@ pub fn downsample(face: u32, texels: &[Vec3], out: u32) -> Vec<Vec3> {
         .collect()
 }
 
-/// Reads and decodes key `k` of view `v`, box-filtered to [`probe_face`].
-fn read_key(reader: &PackReader, v: u32, k: u32) -> Option<ProbeCube> {
-    let cube = reader.radiance(v, k).ok()?;
+/// Reads and decodes key `k` of view `v` relit at `relight`, box-filtered to
+/// [`probe_face`].
+fn read_key(reader: &PackReader, v: u32, k: u32, relight: &Relight) -> Option<ProbeCube> {
+    let cube = relight.radiance_cube(reader, v, k).ok()?;
     let out = probe_face(cube.face_size);
     Some((out, downsample(cube.face_size, &cube.texels, out)))
 }
@@ -135,18 +139,18 @@ pub(super) fn update_probes(
     mut images: ResMut<Assets<Image>>,
     mut maps: Local<HashMap<(u32, u32), Vec<usize>>>,
 ) {
-    // The time of each shown pack's first camera.
-    let mut times: Vec<(AssetId<RadiancePack>, f32)> = Vec::new();
+    // The time and light-group weights of each shown pack's first camera.
+    let mut times: Vec<(AssetId<RadiancePack>, f32, &LightSettings)> = Vec::new();
     if settings.environment_light {
         for cam in &cameras {
-            if !times.iter().any(|(id, _)| *id == cam.pack.id()) {
-                times.push((cam.pack.id(), cam.time));
+            if !times.iter().any(|(id, ..)| *id == cam.pack.id()) {
+                times.push((cam.pack.id(), cam.time, &cam.lights));
             }
         }
     }
     let mut existing: HashMap<(AssetId<RadiancePack>, u32), Entity> = HashMap::new();
     for (entity, probe) in &probes {
-        if times.iter().any(|(id, _)| *id == probe.pack) {
+        if times.iter().any(|(id, ..)| *id == probe.pack) {
             existing.insert((probe.pack, probe.view), entity);
         } else {
             commands.entity(entity).despawn();
@@ -157,16 +161,18 @@ pub(super) fn update_probes(
     keys.tasks.retain(|k, task| match check_ready(task) {
         Some(result) => {
             if let Some(r) = result {
-                keys.cubes.insert(*k, Arc::new(r));
+                keys.cubes.insert(k.clone(), Arc::new(r));
             }
             false
         }
         None => true,
     });
     let mut needed: Vec<ProbeKey> = Vec::new();
-    for (id, t) in times {
+    for (id, t, lights) in times {
         let Some(pack) = packs.get(id) else { continue };
         let m = pack.reader.manifest();
+        let relight = Arc::new(lights.relight(m));
+        let bits = weight_bits(&relight.weights);
         let positions: Vec<Vec3> = m.base_views.iter().map(|b| b.position).collect();
         let diagonal = (m.scene_bounds.max - m.scene_bounds.min).length();
         for v in 0..positions.len() {
@@ -182,20 +188,21 @@ pub(super) fn update_probes(
             }
             wanted.retain(|w| w.1 > 1e-4);
             for &(k, _) in &wanted {
-                let key = (id, v as u32, k);
-                needed.push(key);
+                let key = (id, v as u32, k, bits.clone());
                 if !keys.cubes.contains_key(&key) && !keys.tasks.contains_key(&key) {
-                    let reader = pack.reader.clone();
-                    let task = IoTaskPool::get().spawn(async move { read_key(&reader, key.1, k) });
-                    keys.tasks.insert(key, task);
+                    let (reader, relight) = (pack.reader.clone(), relight.clone());
+                    let task = IoTaskPool::get()
+                        .spawn(async move { read_key(&reader, v as u32, k, &relight) });
+                    keys.tasks.insert(key.clone(), task);
                 }
+                needed.push(key);
             }
             // Both keys read: the probe's cubemap, unless it already shows them (time weights in
             // steps of 1/64 of a key interval: many probes are rewritten per frame while
             // playing).
             let Some(cubes) = wanted
                 .iter()
-                .map(|&(k, w)| Some((keys.cubes.get(&(id, v as u32, k))?.clone(), w)))
+                .map(|&(k, w)| Some((keys.cubes.get(&(id, v as u32, k, bits.clone()))?.clone(), w)))
                 .collect::<Option<Vec<_>>>()
             else {
                 continue;
@@ -211,6 +218,7 @@ pub(super) fn update_probes(
                     .iter()
                     .map(|&(k, w)| (k, (w * 64.0).round() as u32))
                     .collect(),
+                bits.clone(),
             );
             let current = existing
                 .get(&(id, v as u32))

@@ -85,6 +85,12 @@ impl RelitKeys {
     }
 }
 
+/// The bits of every weight of `w`: what a result built at these weights is keyed on.
+pub fn weight_bits(w: &plenoptic_pack::GroupWeights) -> Vec<u32> {
+    let all = std::iter::once(w.default).chain(w.groups.iter().copied());
+    all.flat_map(|c| c.to_array().map(f32::to_bits)).collect()
+}
+
 /// A texture of `layers` layers of `face` × `face` texels, written by the pass and read by
 /// the lookups (with their nearest sampler, as the pack's key texture).
 fn relit_image(face: u32, layers: u32, format: TextureFormat) -> Image {

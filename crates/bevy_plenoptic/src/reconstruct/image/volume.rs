@@ -37,6 +37,7 @@ use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 use crate::camera::{PlenopticCamera, ReconMode};
 use crate::reconstruct::ReconstructSystems;
+use crate::reconstruct::relight::weight_bits;
 use crate::settings::Backend;
 use crate::settings::ResolvedBackend;
 use crate::streaming::StreamCache;
@@ -250,12 +251,6 @@ fn prepare(
             (data, built)
         }),
     ));
-}
-
-/// The bits of every weight of `w`, which a rebuild is keyed on.
-fn weight_bits(w: &plenoptic_pack::GroupWeights) -> Vec<u32> {
-    let all = std::iter::once(w.default).chain(w.groups.iter().copied());
-    all.flat_map(|c| c.to_array().map(f32::to_bits)).collect()
 }
 
 /// Applies a finished rebuild: the views, and the texture (re)created.
