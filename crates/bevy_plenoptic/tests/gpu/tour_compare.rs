@@ -2,7 +2,9 @@
 //! run by default: the pack is baked by the example). Set `PLENOPTIC_TOUR_DUMP` to a folder
 //! to get both frames of each point as PPM images. `cargo test -p bevy_plenoptic --test gpu tour_compare --
 //! --ignored --nocapture`; the pack is `target/architectural_tour/tour.pack` or
-//! `$PLENOPTIC_TOUR_PACK`.
+//! `$PLENOPTIC_TOUR_PACK`. On a pack baked with light groups, `PLENOPTIC_TOUR_LIGHTS` (as
+//! `lamp=0 sun=0.2 sky=0.2`: a group's name and its intensity or colour) relights both
+//! frames.
 
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -38,6 +40,15 @@ fn tour_gpu_against_cpu() {
     )
     .unwrap();
     let mut rec = Reconstructor::open(&pack).unwrap();
+    let mut lights = LightSettings::default();
+    for setting in std::env::var("PLENOPTIC_TOUR_LIGHTS")
+        .unwrap_or_default()
+        .split_whitespace()
+    {
+        let (name, weight) = plenoptic_pack::groups::parse_setting(setting).unwrap();
+        lights.set(name, weight);
+    }
+    rec.set_light_weights(lights.weights(rec.pack().manifest()).unwrap());
     // As the GPU path reconstructs: a mirror's ray shows the base views' radiance where it
     // meets a surface (the GPU does not shade that surface as a pixel yet).
     rec.settings.shaded_reflections = false;
@@ -83,6 +94,7 @@ fn tour_gpu_against_cpu() {
                 PlenopticCamera {
                     playback: Playback::Manual,
                     time: sample.scene_time,
+                    lights: lights.clone(),
                     ..PlenopticCamera::new(handle)
                 },
             ))
