@@ -12,10 +12,10 @@
 
 use crate::common::*;
 use crate::harness::{compare, compare_on, cpu_as_gpu};
+use crate::sky::settle;
 use bevy::camera::Hdr;
 use bevy::prelude::*;
 use bevy_plenoptic::prelude::*;
-use bevy_plenoptic::streaming::StreamState;
 
 fn assets() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/architectural_tour/assets")
@@ -92,19 +92,7 @@ fn plugin_frame(
             },
         ))
         .id();
-    let mut complete = 0;
-    for _ in 0..2000 {
-        app.update();
-        if app.world().get::<StreamState>(camera).unwrap().complete {
-            complete += 1;
-            if complete == 3 {
-                break;
-            }
-        }
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
-    assert!(app.world().get::<StreamState>(camera).unwrap().complete);
-    rgba16f_pixels(&settled_frame(&mut app, &image))
+    settle(&mut app, camera, &image)
 }
 
 /// `plenoptic_recon`'s frame of the camera at `lights` in `mode`, reconstructed as the GPU

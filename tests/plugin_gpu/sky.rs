@@ -48,7 +48,7 @@ fn assert_gpu_matches(gpu: &[Vec3], cpu: &[Vec3], which: &[usize], what: &str) -
 }
 
 /// Renders until the camera's keys are resident and two read-backs agree.
-fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
+pub(crate) fn settle(app: &mut App, camera: Entity, image: &Handle<Image>) -> Vec<Vec3> {
     let mut complete = 0;
     for _ in 0..500 {
         app.update();

@@ -30,8 +30,10 @@ use bevy::image::ImageSampler;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::render_resource::{
-    Buffer, Extent3d, TextureDimension, TextureFormat, TextureUsages,
+    Buffer, BufferDescriptor, BufferUsages, Extent3d, TextureDimension, TextureFormat,
+    TextureUsages,
 };
+use bevy::render::renderer::RenderDevice;
 use bevy::render::storage::ShaderBuffer;
 use plenoptic_pack::{MAX_LIGHT_GROUPS, Manifest};
 use plenoptic_recon::relight::Relight;
@@ -79,8 +81,8 @@ impl RelitKeys {
     pub fn textures(face: u32, images: &mut Assets<Image>) -> (Handle<Image>, Handle<Image>) {
         let layers = 6 * MAX_LOOKUPS as u32;
         (
-            images.add(relit_image(face, layers, TextureFormat::Rgba32Uint)),
-            images.add(relit_image(face, layers, TextureFormat::Rg32Uint)),
+            images.add(storage_image(face, layers, TextureFormat::Rgba32Uint)),
+            images.add(storage_image(face, layers, TextureFormat::Rg32Uint)),
         )
     }
 }
@@ -91,9 +93,10 @@ pub fn weight_bits(w: &plenoptic_pack::GroupWeights) -> Vec<u32> {
     all.flat_map(|c| c.to_array().map(f32::to_bits)).collect()
 }
 
-/// A texture of `layers` layers of `face` × `face` texels, written by the pass and read by
-/// the lookups (with their nearest sampler, as the pack's key texture).
-fn relit_image(face: u32, layers: u32, format: TextureFormat) -> Image {
+/// A texture of `layers` layers of `face` × `face` texels of `format`, written by a pass over
+/// a camera's keys and read by the lookups (with their nearest sampler, as the pack's key
+/// texture).
+pub(crate) fn storage_image(face: u32, layers: u32, format: TextureFormat) -> Image {
     let mut image = Image::new_uninit(
         Extent3d {
             width: face,
@@ -109,6 +112,17 @@ fn relit_image(face: u32, layers: u32, format: TextureFormat) -> Image {
     image.texture_view_descriptor = None;
     image.sampler = ImageSampler::nearest();
     image
+}
+
+/// A 16-byte storage buffer, bound as the group layers of a pack without them (bindings may
+/// not be missing).
+pub(crate) fn no_group_layers(device: &RenderDevice) -> Buffer {
+    device.create_buffer(&BufferDescriptor {
+        label: Some("plenoptic no light-group layers"),
+        size: 16,
+        usage: BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    })
 }
 
 /// Each pack's group layers on the GPU (render world): one storage buffer, per slot and

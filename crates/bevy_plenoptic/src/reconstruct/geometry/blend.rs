@@ -17,21 +17,16 @@
 
 use std::borrow::Cow;
 
-use bevy::asset::{RenderAssetUsages, load_embedded_asset};
+use bevy::asset::load_embedded_asset;
 use bevy::core_pipeline::core_3d::main_opaque_pass_3d;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
-use bevy::image::ImageSampler;
 use bevy::prelude::*;
-use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::render_asset::RenderAssets;
-use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, texture_2d_array, texture_storage_2d_array,
-};
+use bevy::render::render_resource::binding_types::texture_storage_2d_array;
 use bevy::render::render_resource::{
     BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedComputePipelineId,
-    ComputePassDescriptor, ComputePipelineDescriptor, Extent3d, PipelineCache, ShaderStages,
-    StorageTextureAccess, TextureDimension, TextureFormat, TextureSampleType, TextureUsages,
+    ComputePipelineDescriptor, PipelineCache, ShaderStages, StorageTextureAccess, TextureFormat,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
@@ -39,15 +34,15 @@ use bevy::render::texture::GpuImage;
 use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
+use super::key_pass::{dispatch_faces, keys_group, keys_layout};
 use super::view::ViewBuffer;
 use crate::camera::{PlenopticCamera, ReconSettings};
+use crate::reconstruct::relight::storage_image;
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::settings::{Backend, ResolvedBackend};
 
 /// Key pairs a camera blends at most (two lookups each).
 pub const MAX_PAIRS: u32 = (MAX_LOOKUPS / 2) as u32;
-/// The kernel's workgroup, 8 × 8 texels of one face.
-const GROUP: u32 = 8;
 
 /// A camera's blended keys (see the module doc), which its materials bind: two textures of
 /// 16 bytes per texel, six faces per pair (at face 64 and 4 views, 1.5 MiB each). Extracted
@@ -94,25 +89,6 @@ pub(super) fn build(app: &mut App) {
         );
 }
 
-/// A texture of `layers` layers of `face` × `face` 16-byte texels, written by the pass.
-fn blended_image(face: u32, layers: u32) -> Image {
-    let mut image = Image::new_uninit(
-        Extent3d {
-            width: face,
-            height: face,
-            depth_or_array_layers: layers,
-        },
-        TextureDimension::D2,
-        TextureFormat::Rgba32Uint,
-        RenderAssetUsages::RENDER_WORLD,
-    );
-    image.texture_descriptor.usage =
-        TextureUsages::STORAGE_BINDING | TextureUsages::TEXTURE_BINDING;
-    image.texture_view_descriptor = None;
-    image.sampler = ImageSampler::nearest();
-    image
-}
-
 /// Gives every plenoptic camera its [`BlendedKeys`] at its pack's face size, and keeps what
 /// the pass reads up to date.
 pub(super) fn prepare_blended_keys(
@@ -134,8 +110,8 @@ pub(super) fn prepare_blended_keys(
         let new_images = |images: &mut Assets<Image>| {
             let layers = 6 * room;
             (
-                images.add(blended_image(face, layers)),
-                images.add(blended_image(face, layers)),
+                images.add(storage_image(face, layers, TextureFormat::Rgba32Uint)),
+                images.add(storage_image(face, layers, TextureFormat::Rgba32Uint)),
             )
         };
         // The CPU backend draws no proxy material that would read them.
@@ -196,19 +172,7 @@ fn init_pipeline(
         "plenoptic key blend",
         &BindGroupLayoutEntries::sequential(ShaderStages::COMPUTE, (out(), out())),
     );
-    // The material's binding numbers (bindings.wgsl).
-    let keys = BindGroupLayoutDescriptor::new(
-        "plenoptic key blend keys",
-        &BindGroupLayoutEntries::with_indices(
-            ShaderStages::COMPUTE,
-            (
-                (0, texture_2d_array(TextureSampleType::Uint)),
-                (5, texture_2d_array(TextureSampleType::Uint)),
-                (10, storage_buffer_read_only_sized(false, None)),
-            ),
-        ),
-    );
-    let layouts = [outputs, keys];
+    let layouts = [outputs, keys_layout("plenoptic key blend keys")];
     let id = pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
         label: Some("plenoptic key blend".into()),
         layout: layouts.to_vec(),
@@ -258,28 +222,17 @@ pub(super) fn blend_keys(
         &pipeline_cache.get_bind_group_layout(&p.layouts[0]),
         &BindGroupEntries::sequential((&geometry.texture_view, &terms.texture_view)),
     );
-    let keys = device.create_bind_group(
-        "plenoptic key blend keys",
-        &pipeline_cache.get_bind_group_layout(&p.layouts[1]),
-        &BindGroupEntries::with_indices((
-            (0, &cubes.texture_view),
-            (5, &shading.texture_view),
-            (10, view.buffer.as_entire_binding()),
-        )),
+    let keys = keys_group(
+        (&device, &pipeline_cache),
+        ("plenoptic key blend keys", &p.layouts[1]),
+        (cubes, shading),
+        view,
     );
-    let diagnostics = ctx.diagnostic_recorder();
-    let diagnostics = diagnostics.as_deref();
-    let mut pass = ctx
-        .command_encoder()
-        .begin_compute_pass(&ComputePassDescriptor {
-            label: Some("plenoptic key blend"),
-            ..default()
-        });
-    let span = diagnostics.pass_span(&mut pass, "plenoptic/key_blend");
-    pass.set_pipeline(compute);
-    pass.set_bind_group(0, &outputs, &[]);
-    pass.set_bind_group(1, &keys, &[]);
-    let n = blended.face.div_ceil(GROUP);
-    pass.dispatch_workgroups(n, n, 6 * blended.pairs.min(blended.room));
-    span.end(&mut pass);
+    dispatch_faces(
+        &mut ctx,
+        ("plenoptic key blend", "plenoptic/key_blend"),
+        (compute, [&outputs, &keys]),
+        blended.face,
+        6 * blended.pairs.min(blended.room),
+    );
 }

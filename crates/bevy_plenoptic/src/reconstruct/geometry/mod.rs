@@ -61,6 +61,7 @@
 pub mod blend;
 pub mod fill_composite;
 pub mod frame;
+mod key_pass;
 pub mod prepare;
 pub mod rays;
 pub mod reflect;

@@ -10,16 +10,15 @@ use bevy::asset::load_embedded_asset;
 use bevy::core_pipeline::core_3d::main_opaque_pass_3d;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::prelude::*;
-use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, texture_2d_array, texture_storage_2d_array,
+    storage_buffer_read_only_sized, texture_storage_2d_array,
 };
 use bevy::render::render_resource::{
-    BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, Buffer, BufferDescriptor,
-    BufferUsages, CachedComputePipelineId, ComputePassDescriptor, ComputePipelineDescriptor,
-    PipelineCache, ShaderStages, StorageTextureAccess, TextureFormat, TextureSampleType,
+    BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries, Buffer,
+    CachedComputePipelineId, ComputePipelineDescriptor, PipelineCache, ShaderStages,
+    StorageTextureAccess, TextureFormat,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::storage::GpuShaderBuffer;
@@ -28,15 +27,15 @@ use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 use plenoptic_recon::relight::Relight;
 
+use super::key_pass::{dispatch_faces, keys_group, keys_layout};
 use super::view::{ViewBuffer, ViewParams};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
-use crate::reconstruct::relight::{BlendUniforms, GroupLayers, RelitKeys, stored_groups};
+use crate::reconstruct::relight::{
+    BlendUniforms, GroupLayers, RelitKeys, no_group_layers, stored_groups,
+};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::settings::{Backend, ResolvedBackend};
-
-/// The kernel's workgroup, 8 × 8 texels of one face.
-const GROUP: u32 = 8;
 
 /// Adds the relit keys' extraction and the pass.
 pub(super) fn build(app: &mut App) {
@@ -152,19 +151,7 @@ fn init_pipeline(
             ),
         ),
     );
-    // The material's binding numbers (bindings.wgsl).
-    let keys = BindGroupLayoutDescriptor::new(
-        "plenoptic relight keys",
-        &BindGroupLayoutEntries::with_indices(
-            ShaderStages::COMPUTE,
-            (
-                (0, texture_2d_array(TextureSampleType::Uint)),
-                (5, texture_2d_array(TextureSampleType::Uint)),
-                (10, storage_buffer_read_only_sized(false, None)),
-            ),
-        ),
-    );
-    let layouts = [outputs, keys];
+    let layouts = [outputs, keys_layout("plenoptic relight keys")];
     let id = pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
         label: Some("plenoptic relight".into()),
         layout: layouts.to_vec(),
@@ -173,12 +160,7 @@ fn init_pipeline(
         entry_point: Some(Cow::from("relight_keys")),
         ..default()
     });
-    let no_layers = device.create_buffer(&BufferDescriptor {
-        label: Some("plenoptic no light-group layers"),
-        size: 16,
-        usage: BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let no_layers = no_group_layers(&device);
     commands.insert_resource(RelightPipeline {
         layouts,
         id,
@@ -235,28 +217,17 @@ fn relight_keys(
             layers.as_entire_binding(),
         )),
     );
-    let keys = device.create_bind_group(
-        "plenoptic relight keys",
-        &pipeline_cache.get_bind_group_layout(&p.layouts[1]),
-        &BindGroupEntries::with_indices((
-            (0, &cubes.texture_view),
-            (5, &shading.texture_view),
-            (10, view.buffer.as_entire_binding()),
-        )),
+    let keys = keys_group(
+        (&device, &pipeline_cache),
+        ("plenoptic relight keys", &p.layouts[1]),
+        (cubes, shading),
+        view,
     );
-    let diagnostics = ctx.diagnostic_recorder();
-    let diagnostics = diagnostics.as_deref();
-    let mut pass = ctx
-        .command_encoder()
-        .begin_compute_pass(&ComputePassDescriptor {
-            label: Some("plenoptic relight"),
-            ..default()
-        });
-    let span = diagnostics.pass_span(&mut pass, "plenoptic/relight");
-    pass.set_pipeline(compute);
-    pass.set_bind_group(0, &outputs, &[]);
-    pass.set_bind_group(1, &keys, &[]);
-    let n = relit.face.div_ceil(GROUP);
-    pass.dispatch_workgroups(n, n, 6 * relit.lookups.min(MAX_LOOKUPS as u32));
-    span.end(&mut pass);
+    dispatch_faces(
+        &mut ctx,
+        ("plenoptic relight", "plenoptic/relight"),
+        (compute, [&outputs, &keys]),
+        relit.face,
+        6 * relit.lookups.min(MAX_LOOKUPS as u32),
+    );
 }

@@ -21,7 +21,7 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::texture::GpuImage;
 
 use super::{ImageJob, ImageParams, MAX_IMAGE_VIEWS};
-use crate::reconstruct::relight::GroupLayers;
+use crate::reconstruct::relight::{GroupLayers, no_group_layers};
 
 /// The image-mode pipelines and their bind group layout.
 #[derive(Resource)]
@@ -77,12 +77,7 @@ pub(super) fn init_pipelines(
             ..default()
         })
     });
-    let no_layers = device.create_buffer(&BufferDescriptor {
-        label: Some("plenoptic no light-group layers"),
-        size: 16,
-        usage: BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let no_layers = no_group_layers(&device);
     commands.insert_resource(ImagePipelines {
         layout,
         passes,
