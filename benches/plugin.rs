@@ -15,8 +15,9 @@
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes);
 //! - `plugin/costs`: the same frames with the shaders' cost counters on
 //!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA (as the tests' frames),
-//!   each case once with the screen-space hole fill and once with the fragment fill
-//!   (`PlenopticSettings::screen_fill`): each prints, per fragment, its lookups, loads by
+//!   each case with the lookup kernel and the screen-space hole fill (the defaults), with
+//!   the lookups in the fragments (`PlenopticSettings::lookup_kernel` off) and with the
+//!   fragment fill (`PlenopticSettings::screen_fill` off): each prints, per fragment, its lookups, loads by
 //!   width, samples, march steps and fallback entries, the screen-fill kernel's loads, the
 //!   loads of a diffuse fragment, and the mean over 32-pixel groups of the group's largest
 //!   loads and work against the mean (what divergence costs), then the two fills' ratio.
@@ -28,9 +29,10 @@
 //! `plugin/frame` also room A with its mirror in view, `tour_mirror_1280x720`, and the same
 //! with the baked specular instead of reflections marched for the camera,
 //! `tour_mirror_baked_specular_1280x720`). The `plugin/frame` cameras render to an 8-bit
-//! target with Bevy's default MSAA and take the screen-space hole fill; its
-//! `tour_hdr_screen_fill_1280x720` and `tour_hdr_fragment_fill_1280x720` cases are the tour
-//! on an HDR camera without MSAA with the screen-space fill and with the fragment fill. With
+//! target with Bevy's default MSAA and take the lookup kernel and the screen-space hole fill;
+//! its `tour_hdr_screen_fill_1280x720`, `tour_hdr_fragment_lookups_1280x720` and
+//! `tour_hdr_fragment_fill_1280x720` cases are the tour on an HDR camera without MSAA with
+//! the lookup kernel, with the lookups in the fragments, and with the fragment fill. With
 //! `PLENOPTIC_BENCH_PASSES` set, each frame case also prints its passes' CPU and GPU times
 //! (Bevy's render diagnostics).
 //!
@@ -419,17 +421,31 @@ fn frame(c: &mut Criterion) {
         ] {
             settled_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
-        // An HDR camera without MSAA, with the screen-space fill and with the fragment fill.
-        for (case, fill) in [
-            ("tour_hdr_screen_fill_1280x720", true),
-            ("tour_hdr_fragment_fill_1280x720", false),
+        // An HDR camera without MSAA: the lookup kernel with the screen-space fill, the
+        // lookups in the fragments with the screen-space fill, and the fragment fill.
+        for (case, fill, kernel) in [
+            ("tour_hdr_screen_fill_1280x720", true, true),
+            ("tour_hdr_fragment_lookups_1280x720", true, false),
+            ("tour_hdr_fragment_fill_1280x720", false, false),
         ] {
             settled_frames(&mut g, case, || {
-                hdr_scene(scene(assets, name, &views, TOUR_SIZE), fill)
+                lookups_in(
+                    hdr_scene(scene(assets, name, &views, TOUR_SIZE), fill),
+                    kernel,
+                )
             });
         }
     }
     g.finish();
+}
+
+/// `s` with the lookup kernel on or off (`PlenopticSettings::lookup_kernel`).
+fn lookups_in(mut s: Scene, kernel: bool) -> Scene {
+    s.app
+        .world_mut()
+        .resource_mut::<PlenopticSettings>()
+        .lookup_kernel = kernel;
+    s
 }
 
 /// `s` with HDR cameras without MSAA (one sample per pixel, as the counted frames), and the
@@ -560,22 +576,35 @@ fn compared_groups(
     }
 }
 
-/// One case counted with the screen-space fill and with the fragment fill, and the ratio of
-/// their fetches per pixel printed.
+/// One case counted with the lookup kernel and the screen-space fill, with the lookups in the
+/// fragments and the screen-space fill, and with the fragment fill; their fetches per pixel
+/// printed.
 fn compared_fills(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     case: &str,
     make: impl Fn() -> Scene,
 ) {
     let screen = counted_frames(g, &format!("{case}_screen_fill"), true, &make);
+    let in_fragments = counted_frames(g, &format!("{case}_fragment_lookups"), true, || {
+        lookups_in(make(), false)
+    });
     let fragment = counted_frames(g, &format!("{case}_fragment_fill"), false, &make);
-    if let (Some(s), Some(f)) = (screen, fragment) {
-        let (a, b) = (s.loads + s.kernel_loads, f.loads + f.kernel_loads);
+    if let (Some(s), Some(l), Some(f)) = (screen, in_fragments, fragment) {
+        let total = |r: &CostReport| r.loads + r.kernel_loads;
         eprintln!(
-            "costs {case}: fetches per pixel {a:.1} with the screen fill, {b:.1} with the \
-             fragment fill ({:.2}× fewer); largest in 32 {:.1} and {:.1}",
-            b / a.max(1e-9),
+            "costs {case}: fetches per pixel {:.1} (fragments {:.1}, kernels {:.1}) with the \
+             lookup kernel and the screen fill, {:.1} ({:.1} + {:.1}) with the lookups in the \
+             fragments, {:.1} with the fragment fill; a fragment's largest in 32 {:.1}, {:.1} \
+             and {:.1}",
+            total(&s),
+            s.loads,
+            s.kernel_loads,
+            total(&l),
+            l.loads,
+            l.kernel_loads,
+            total(&f),
             s.group_max_loads,
+            l.group_max_loads,
             f.group_max_loads,
         );
     }

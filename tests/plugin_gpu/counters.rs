@@ -63,9 +63,20 @@ fn counted(
     screen_fill: bool,
     tweak: impl Fn(&mut ReconSettings),
 ) -> (Vec<Vec<Vec3>>, CostReport, f64) {
+    counted_with(dir, (screen_fill, true), tweak)
+}
+
+/// [`counted`], with the lookup kernel on or off (`fills.1`) where the screen fill is on
+/// (`fills.0`).
+fn counted_with(
+    dir: &std::path::Path,
+    (screen_fill, lookup_kernel): (bool, bool),
+    tweak: impl Fn(&mut ReconSettings),
+) -> (Vec<Vec<Vec3>>, CostReport, f64) {
     let (mut app, cameras, targets) = plugin_cameras_with(dir, &[eye()], |s| {
         s.cost_counters = true;
         s.screen_fill = screen_fill;
+        s.lookup_kernel = lookup_kernel;
     });
     tweak(
         &mut app
@@ -119,9 +130,11 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
             (per - lookups).abs() < 1e-6 * lookups,
             "{per} lookups per reconstruction, the view has {lookups}"
         );
-        assert!(report.mean_of("loads_16").unwrap() >= report.mean_of("lookups").unwrap());
+        // A lookup loads its texel, in the fragment or in the lookup kernel.
+        let loads_16 = report.mean_of("loads_16").unwrap() + report.kernel_loads;
+        assert!(loads_16 >= report.mean_of("lookups").unwrap());
         assert!(report.group_max_loads >= report.loads && report.group_max_work >= report.work);
-        assert!(report.diffuse_fragments > 0 && report.diffuse_loads > 0.0);
+        assert!(report.diffuse_fragments > 0 && report.diffuse_loads + report.kernel_loads > 0.0);
         assert_each_matches(frames, std::slice::from_ref(&cpu), 0.003, within5);
     }
     // The same holes, entered by both; reconstructed again only by the fragment fill.
@@ -141,26 +154,61 @@ fn counters_count_each_lookup_and_leave_the_frame_unchanged() {
     assert!(s.loads + s.kernel_loads < f.loads);
 }
 
+/// The lookup kernel (`bevy_plenoptic::reconstruct::geometry::lookup_kernel`): with it the
+/// opaque fragments make no lookup (they load nothing on this pack without materials) and
+/// the kernel makes every pixel's, once; the frame is the one the fragments' own lookups
+/// give, and the CPU's.
+#[test]
+fn the_lookup_kernel_makes_every_pixels_lookups_for_the_same_frame() {
+    let (dir, path) = room_pack(Materials::Factors);
+    let (kernel, in_kernel, lookups) = counted_with(dir.path(), (true, true), |_| {});
+    let (fragments, in_fragments, _) = counted_with(dir.path(), (true, false), |_| {});
+    let m = |r: &CostReport, n: &str| r.mean_of(n).unwrap();
+    eprintln!(
+        "fetches per pixel: lookup kernel {:.1} + {:.1} in the kernels, fragments {:.1} + {:.1}",
+        in_kernel.loads, in_kernel.kernel_loads, in_fragments.loads, in_fragments.kernel_loads
+    );
+    // Every pixel's lookups, made once either way.
+    assert!((m(&in_kernel, "lookups") - m(&in_fragments, "lookups")).abs() < 1e-6 * lookups);
+    assert!(in_kernel.loads < 0.5 * in_fragments.loads, "{in_kernel:?}");
+    assert!(
+        in_kernel.kernel_loads > in_fragments.kernel_loads,
+        "{in_kernel:?}"
+    );
+    let (mean, f5, _) = compare(&kernel[0], &fragments[0]);
+    assert!(
+        mean < 1e-3 && f5 > 0.999,
+        "kernel against fragments: {mean} {f5}"
+    );
+    assert_each_matches(&kernel, &[cpu_frame(&path, eye())], 0.003, 0.995);
+}
+
 /// With a negative depth tolerance no lookup is accepted: every pixel is a hole and no ring holds
-/// an answered pixel. The hole list fills to its room (a quarter of the pixels) and the kernel
-/// takes its holes' later fallbacks from the keys (the object's nearby texels, else the
-/// heaviest key's texel); the holes past the room fill themselves in their fragments. The
-/// frame still equals the CPU's.
+/// an answered pixel. Without the lookup kernel the hole list fills to its room (a quarter of
+/// the pixels) and the fill kernel takes its holes' later fallbacks from the keys (the
+/// object's nearby texels, else the heaviest key's texel); the holes past the room fill
+/// themselves in their fragments. With the lookup kernel the list has a record per pixel and
+/// every hole is filled by the kernels. Both frames still equal the CPU's.
 #[test]
 fn every_pixel_a_hole_fills_as_on_the_cpu() {
     let (dir, path) = room_pack(Materials::None);
-    let (frames, report, _) = counted(dir.path(), true, |s| s.depth_tolerance = -1.0);
-    let m = |n: &str| report.mean_of(n).unwrap();
-    // Every fragment a hole, each taking the nearby texels: a quarter in the kernel, the
-    // rest after reconstructing its ring in the fragment.
-    assert!(m("fill") > 0.99 && m("neighbour") > 0.99, "{report:?}");
-    assert!(
-        report.kernel_loads > 0.0 && m("fill_lookups") > 1.0,
-        "{report:?}"
-    );
-
     let cpu = cpu_frame_with(&path, eye(), |s| s.depth_tolerance = -1.0);
-    assert_each_matches(&frames, &[cpu], 0.003, 0.995);
+    for lookup_kernel in [false, true] {
+        let (frames, report, _) = counted_with(dir.path(), (true, lookup_kernel), |s| {
+            s.depth_tolerance = -1.0
+        });
+        let m = |n: &str| report.mean_of(n).unwrap();
+        // Every fragment a hole, each taking the nearby texels: without the lookup kernel a
+        // quarter in the fill kernel, the rest after reconstructing its ring in the fragment.
+        assert!(m("fill") > 0.99 && m("neighbour") > 0.99, "{report:?}");
+        assert!(report.kernel_loads > 0.0, "{report:?}");
+        if lookup_kernel {
+            assert_eq!(m("fill_lookups"), 0.0, "{report:?}");
+        } else {
+            assert!(m("fill_lookups") > 1.0, "{report:?}");
+        }
+        assert_each_matches(&frames, std::slice::from_ref(&cpu), 0.003, 0.995);
+    }
 }
 
 /// A pack with materials: each view's two time keys are blended once per frame where they

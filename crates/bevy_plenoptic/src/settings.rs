@@ -36,6 +36,10 @@ pub struct PlenopticSettings {
     /// which reconstructs each ring pixel again. The same frame, for a fraction of the loads;
     /// off only to compare the two.
     pub screen_fill: bool,
+    /// On cameras with the screen fill, make the opaque pixels' lookups in a compute pass
+    /// over the fragments' records ([`crate::reconstruct::geometry::lookup_kernel`]) instead
+    /// of in the fragment shader. The same frame; off only to compare the two.
+    pub lookup_kernel: bool,
 }
 
 /// Where frames are reconstructed.
@@ -70,6 +74,7 @@ impl Default for PlenopticSettings {
             environment_light: true,
             cost_counters: false,
             screen_fill: true,
+            lookup_kernel: true,
         }
     }
 }

@@ -30,6 +30,8 @@ const VIEW_MARCHED: u32 = 8u;
 const VIEW_SCREEN_FILL: u32 = 16u;
 // The camera reads its relit keys (reconstruct/relight.rs): lookup k's key at layers 6k.
 const VIEW_RELIT: u32 = 32u;
+// The opaque fragments leave their lookups to the lookup kernel (screen_fill.wgsl).
+const VIEW_LOOKUP_KERNEL: u32 = 64u;
 
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
@@ -197,6 +199,11 @@ struct ObjectParams {
 @group(#{MATERIAL_BIND_GROUP}) @binding(23) var blended_terms: texture_2d_array<u32>;
 #endif
 
+// The point the lookups reconstruct: its object's motion slot (−1: static) and whether the
+// object is shaded from its material. Set from the material's uniform by a fragment
+// (geometry.wgsl), from a record by the lookup kernel (screen_fill.wgsl).
+var<private> point_slot: i32 = -1;
+var<private> point_material: bool = false;
 // The fragment's diffuse albedo (set once per fragment, before any lookup).
 var<private> pixel_albedo: vec3<f32>;
 // Its textured base colour, metalness and roughness (the runtime sun's BSDF).

@@ -18,11 +18,14 @@
 #import bevy_pbr::prepass_utils
 #import plenoptic::geometry::bindings::{
     cam, params, image_frame, image_mode, view_has, lit, pixel_albedo, face_normal, local_from_world,
-    non_diffuse_weight, VIEW_SCREEN_FILL, object_has, OBJECT_OPAQUE_PASS, glazing,
+    non_diffuse_weight, VIEW_SCREEN_FILL, VIEW_LOOKUP_KERNEL, object_has, OBJECT_OPAQUE_PASS,
+    glazing,
 }
 #ifdef PLENOPTIC_SCREEN_FILL
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
-#import plenoptic::fill_entry::{HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair}
+#import plenoptic::fill_entry::{
+    HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair, pack_normal, RECORD_HOLE, RECORD_LOOKUP,
+}
 #endif
 #import plenoptic::fill_entry::ring_step
 #import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, heaviest_texel, object_point, shade}
@@ -32,6 +35,8 @@
 const ENTRY_NONE: u32 = 0u;
 const ENTRY_ANSWERED: u32 = 1u;
 const ENTRY_HOLE: u32 = 2u;
+// Its lookups left to the lookup kernel (VIEW_LOOKUP_KERNEL).
+const ENTRY_LOOKUP: u32 = 3u;
 var<private> entry_kind: u32 = ENTRY_NONE;
 // The fragment's terms (lookup.wgsl's Weighted), with ENTRY_ANSWERED.
 var<private> entry_terms: mat2x3<f32>;
@@ -113,6 +118,8 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
     }
     fill_entries[i] = vec4<u32>(0u, 0u, 0u, object | HOLE);
     let r = &hole_list.records[hole_index];
+    (*r).state = select(RECORD_HOLE, RECORD_LOOKUP, entry_kind == ENTRY_LOOKUP);
+    (*r).normal = pack_normal(face_normal);
     (*r).pair = pack_pair(added * e, albedo);
     (*r).pixel = i;
     (*r).local = vec4<f32>(object_point(hole_point).xyz, f32(params.motion_slot));
@@ -202,8 +209,14 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     // facing the eye, in its lookups' frame (fragment_fill keeps it for ring points on the
     // fragment's plane).
     face_normal = lookup_frame(facing_eye(nrm, p, eye));
-    let own = reconstruct(p, eye, object);
     let deferred = screen_fill();
+    if deferred && view_has(VIEW_LOOKUP_KERNEL) && claim_hole(p) {
+        // The lookup kernel (screen_fill.wgsl) makes the point's lookups, then the fill
+        // kernel fills it if none answers.
+        entry_kind = ENTRY_LOOKUP;
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let own = reconstruct(p, eye, object);
     if own.w > 0.0 {
         if deferred {
             entry_kind = ENTRY_ANSWERED;

@@ -237,7 +237,7 @@ pub(super) fn composite_fill(
         &key.tonemap.unwrap_or(Tonemapping::None),
         &inputs.fallback,
     );
-    let mut uniform = UniformBuffer::from(FillParams::new(fill, camera));
+    let mut uniform = UniformBuffer::from(FillParams::new(fill, camera, Vec3::ZERO));
     uniform.write_buffer(&device, &queue);
     let Some(params) = uniform.binding() else {
         return;

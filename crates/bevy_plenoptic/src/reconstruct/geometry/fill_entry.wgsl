@@ -32,6 +32,45 @@ struct HoleRecord {
     tag: u32,
     // The samples its fragment covers (its sample mask; 1 without MSAA).
     coverage: u32,
+    // Its surface normal facing the eye in its lookups' frame (lookup.wgsl's face_normal),
+    // oct-encoded as two snorm16 (pack_normal).
+    normal: u32,
+    // RECORD_HOLE, RECORD_LOOKUP or RECORD_ANSWERED.
+    state: u32,
+}
+
+// A record's state: a hole the fill kernel fills; a point whose lookups the lookup kernel
+// makes (VIEW_LOOKUP_KERNEL); a point the lookup kernel answered (its colour in `pair`).
+const RECORD_HOLE: u32 = 0u;
+const RECORD_LOOKUP: u32 = 1u;
+const RECORD_ANSWERED: u32 = 2u;
+
+// The packed normal of no normal (the face test left out).
+const NO_NORMAL: u32 = 0xffffffffu;
+
+// Unit `n` oct-encoded into two snorm16 (zero: NO_NORMAL).
+fn pack_normal(n: vec3<f32>) -> u32 {
+    let l1 = abs(n.x) + abs(n.y) + abs(n.z);
+    if l1 == 0.0 {
+        return NO_NORMAL;
+    }
+    var e = n.xy / l1;
+    if n.z < 0.0 {
+        e = (1.0 - abs(e.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), e >= vec2<f32>(0.0));
+    }
+    return pack2x16snorm(e);
+}
+
+// The unit normal of `pack_normal` (NO_NORMAL: zero).
+fn unpack_normal(w: u32) -> vec3<f32> {
+    if w == NO_NORMAL {
+        return vec3<f32>(0.0);
+    }
+    let e = unpack2x16snorm(w);
+    var v = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
+    let t = max(-v.z, 0.0);
+    v = vec3<f32>(v.x + select(t, -t, v.x >= 0.0), v.y + select(t, -t, v.y >= 0.0), v.z);
+    return normalize(v);
 }
 
 // A record's tag bit: its object is shaded from its material.
@@ -59,6 +98,8 @@ struct FillParams {
     // The ring search's largest radius; the camera's exposure.
     radius: u32,
     exposure: f32,
+    // The camera's position (xyz), which the lookup kernel weighs views from.
+    eye: vec4<f32>,
 }
 
 // The step along row `dy` of the ring of radius `r` around a pixel (plenoptic_recon's ring

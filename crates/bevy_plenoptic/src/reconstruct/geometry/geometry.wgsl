@@ -28,6 +28,7 @@
 #import plenoptic::geometry::bindings::{
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
+    point_slot, point_material,
     glazing, object_has, OBJECT_RUNTIME_EMISSION,
 }
 #import plenoptic::geometry::fill::{radiance, write_fill_entry, note_fragment}
@@ -53,6 +54,8 @@ fn fragment(
     @builtin(sample_mask) coverage: u32,
 ) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(vertex.instance_index);
+    point_slot = params.motion_slot;
+    point_material = lit();
     note_fragment(vertex.position, coverage);
     let ng = cross(dpdx(vertex.world_position.xyz), dpdy(vertex.world_position.xyz));
     var pbr = pbr_input_from_standard_material(vertex, is_front);
@@ -76,6 +79,8 @@ fn fragment(
 @fragment
 fn fragment(in: VertexOutput, @builtin(sample_mask) coverage: u32) -> @location(0) vec4<f32> {
     local_from_world = get_local_from_world(in.instance_index);
+    point_slot = params.motion_slot;
+    point_material = lit();
     note_fragment(in.position, coverage);
     // The triangle's plane, before any non-uniform branch.
     let ng = cross(dpdx(in.world_position.xyz), dpdy(in.world_position.xyz));

@@ -14,6 +14,7 @@
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
     volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, face_normal, lit, view_has, VIEW_BILINEAR,
+    point_slot, point_material,
     blended_geometry, blended_terms, PAIR_CHANGING,
 }
 
@@ -21,7 +22,7 @@
 // for an animated object; `p` itself for a static one (in world space), which is not
 // carried. Computed once per point, before its lookups.
 fn object_point(p: vec3<f32>) -> vec4<f32> {
-    if params.motion_slot < 0 {
+    if point_slot < 0 {
         return vec4<f32>(p, 1.0);
     }
     return local_from_world * vec4<f32>(p, 1.0);
@@ -147,7 +148,7 @@ fn filtered(layer0: u32, n: u32, d: vec3<f32>, np: vec3<f32>, t: vec3<u32>, near
 // The terms of key texel `c` (in the key at `layer0`, whose key-texture texel is `texel`) for
 // this fragment's object.
 fn colour(c: vec3<u32>, layer0: u32, texel: vec4<u32>) -> mat2x3<f32> {
-    return texel_terms(c, layer0, texel, lit());
+    return texel_terms(c, layer0, texel, point_material);
 }
 
 // The terms of key texel `c`: its radiance, or its lighting and non-diffuse radiance for an
@@ -304,7 +305,7 @@ fn gathered_filter(l: Lookup, fp: Footprint, layer0: u32, n: u32, object: u32, t
     let g = gather_geometry(cubes, uv, layer, l, object, tol, normals);
     var c0 = vec4<u32>(0u);
     var c1 = vec4<u32>(0u);
-    if lit() {
+    if point_material {
         tally(C_GATHERS, 2u);
         c0 = textureGather(0, shading_cubes, cube_sampler, uv, layer);
         c1 = textureGather(1, shading_cubes, cube_sampler, uv, layer);
@@ -359,7 +360,7 @@ fn pair_lookup(l: Lookup, pair: u32, n: u32, object: u32, tol: f32, normals: boo
 // A gathered texel's terms: its lighting and non-diffuse radiance for an object shaded from
 // its material (`a`, `b`), else its radiance (`a`).
 fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
-    if lit() {
+    if point_material {
         return shaded(vec2<u32>(a, b));
     }
     return radiance_terms(a);
@@ -368,7 +369,7 @@ fn gathered_colour(a: u32, b: u32) -> mat2x3<f32> {
 // Whether this object stands still between the key times of lookups k and k + 1 (static, or
 // animated with the same transform at both): its point falls on the same texel of both keys.
 fn still_between(k: u32) -> bool {
-    let slot = f32(params.motion_slot);
+    let slot = f32(point_slot);
     if slot < 0.0 {
         return true;
     }
@@ -390,20 +391,24 @@ fn angular(l: Lookup, to_eye: vec3<f32>, power: f32) -> f32 {
 // bilinear filtering (always for lighting, plenoptic_recon's shading module) an accepted
 // lookup whose footprint lies on one face is gathered, one across a seam loaded tap by tap.
 fn direct_lookups(p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
+    return direct_lookups_at(object_point(p), p, eye, object);
+}
+
+// direct_lookups of the point whose object_point is `local`.
+fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32) -> Weighted {
     let count = cam.lookup_count;
     let n = cam.face;
     let tol = cam.depth_tolerance;
     let power = cam.angular_power;
-    let bilinear = view_has(VIEW_BILINEAR) || lit();
+    let bilinear = view_has(VIEW_BILINEAR) || point_material;
     let to_eye = normalize(eye - p);
-    let local = object_point(p);
     var sum = mat2x3<f32>();
     var ws = 0.0;
     // An object shaded from its material looks a view's two keys up once where it stands
     // still between their times and the keys agree (blend.rs).
-    let paired = lit();
+    let paired = point_material;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let l = lookup_of(local, k, n, f32(params.motion_slot));
+        let l = lookup_of(local, k, n, f32(point_slot));
         if !l.ok {
             continue;
         }
@@ -448,7 +453,7 @@ const NO_TEXEL: i32 = 1073741824;
 // texel on its face, `object`'s own first, then any surface's (the first in row order on
 // ties). Returns (Σ w·terms, Σ w).
 fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
-    return nearby_texels(object_point(p), object, f32(params.motion_slot), lit());
+    return nearby_texels(object_point(p), object, f32(point_slot), point_material);
 }
 
 // `neighbour_texels` of the point whose `object_point` is `local`, of `object` with motion

@@ -1,7 +1,9 @@
 //! GPU geometry-assisted reconstruction (thesis §8.2.3).
 //!
 //! Every proxy mesh is drawn with a [`PlenopticMaterial`] whose fragment shader
-//! (`geometry.wgsl`, beside this file) does the lookups of `plenoptic_recon`'s geometry mode:
+//! (`geometry.wgsl`, beside this file) shades it, and whose points are looked up as in
+//! `plenoptic_recon`'s geometry mode, by the fragment itself or, on a camera with the
+//! screen-space fill, by the lookup kernel ([`lookup_kernel`]) over the fragments' records:
 //! for each resident (base view, bracketing time key) the fragment's point is carried along
 //! its object's motion, `p_τ = M_o(τ) M_o(t)⁻¹ p`, looked up in that key's cube (the nearest
 //! texel, or seamlessly bilinear over the texels of the same object and distance with the
@@ -48,7 +50,7 @@
 //!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`]
 //!   and [`sun`]: the volume fallback's buffers, the ray-cast proxies, the reflection march
 //!   and the runtime sun; [`screen_fill`] (`screen_fill.wgsl`, `fill_entry.wgsl`): the
-//!   hole-fill kernel; [`blend`] (`blend.wgsl`): each view's two time keys blended once per
+//!   hole-fill kernel, and [`lookup_kernel`] the lookup kernel before it; [`blend`] (`blend.wgsl`): each view's two time keys blended once per
 //!   frame where they agree, which a lit object still between the keys' times looks up once.
 //!   The material is drawn by Bevy's own mesh passes; the key blend runs before its opaque
 //!   pass, the fill kernel between its opaque and transparent passes.
@@ -62,6 +64,7 @@ pub mod blend;
 pub mod fill_composite;
 pub mod frame;
 mod key_pass;
+pub mod lookup_kernel;
 pub mod prepare;
 pub mod rays;
 pub mod reflect;

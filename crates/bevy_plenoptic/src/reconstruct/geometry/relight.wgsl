@@ -5,7 +5,7 @@
 
 #import plenoptic::relight::{stored_terms, blend_base, blend_layer, blend_end, relit_radiance}
 #import plenoptic::counters::{tally, C_LOADS_16}
-#import plenoptic::geometry::bindings::{cam, volume_samples, lit, view_has, VIEW_RELIT}
+#import plenoptic::geometry::bindings::{cam, volume_samples, point_material, view_has, VIEW_RELIT}
 
 // Volume sample `s`'s terms at the camera's light groups: its (lighting, non-diffuse) for an
 // object shaded from its material, else (its radiance, 0). `terms` are its stored RGB9E5
@@ -14,7 +14,7 @@
 fn volume_terms(s: u32, terms: vec2<u32>, radiance: vec3<f32>) -> mat2x3<f32> {
     let stored = stored_terms(terms);
     if !view_has(VIEW_RELIT) {
-        if lit() {
+        if point_material {
             return stored;
         }
         return mat2x3<f32>(radiance, vec3<f32>(0.0));
@@ -27,7 +27,7 @@ fn volume_terms(s: u32, terms: vec2<u32>, radiance: vec3<f32>) -> mat2x3<f32> {
         acc = blend_layer(acc, cam.light_layers[k].xyz, select(v.xy, v.zw, (w & 2u) != 0u));
     }
     let relit = blend_end(acc);
-    if lit() {
+    if point_material {
         return relit;
     }
     let rad = relit_radiance(radiance, stored, relit, cam.light_base.xyz);

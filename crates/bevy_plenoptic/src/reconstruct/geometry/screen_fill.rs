@@ -20,6 +20,10 @@
 //! transparent pass) keep the fragment fill, as does a hole beyond the list's room
 //! ([`HOLE_SHARE`] of the viewport's pixels).
 //!
+//! With the lookup kernel ([`super::lookup_kernel`], on by default) the fragments make no
+//! lookups at all: every opaque fragment appends a record, the lookup kernel answers the
+//! records it can and writes their entries, and the fill kernel fills the rest.
+//!
 //! The fill needs the camera's [`DepthPrepass`] (every [`PlenopticCamera`] requires one), on a
 //! device that forces early depth tests ([`EarlyDepthSupport`]): a fragment writes its entry
 //! only where the prepass kept it. It takes HDR and 8-bit targets alike (the composite
@@ -50,9 +54,11 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::settings::WgpuFeatures;
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
 use bevy::render::texture::GpuImage;
+use bevy::render::view::ExtractedView;
 use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
+use super::lookup_kernel::{LookupPipelines, material_group};
 use super::view::ViewBuffer;
 use crate::camera::PlenopticCamera;
 use crate::reconstruct::counters::CounterBuffer;
@@ -107,6 +113,21 @@ pub struct ScreenFill {
     pub counters: Handle<ShaderBuffer>,
     /// Whether the shaders count their cost ([`PlenopticSettings::cost_counters`]).
     pub counting: bool,
+    /// Whether the opaque fragments leave their lookups to the lookup kernel
+    /// ([`PlenopticSettings::lookup_kernel`]).
+    pub kernel: bool,
+    /// What the lookup kernel reads beside the keys: the pack's volume samples and bins, and
+    /// the camera's blended keys.
+    pub lookups: Option<LookupBindings>,
+}
+
+/// The lookup kernel's buffers and textures besides the fill's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LookupBindings {
+    /// The pack's volume samples and bin offsets ([`super::volume::PackVolumes`]).
+    pub volumes: (Handle<ShaderBuffer>, Handle<ShaderBuffer>),
+    /// The camera's blended keys ([`super::blend::BlendedKeys`]).
+    pub blended: (Handle<Image>, Handle<Image>),
 }
 
 impl ScreenFill {
@@ -117,7 +138,7 @@ impl ScreenFill {
 
     /// The hole list's room: how many records it holds.
     pub(super) fn room(&self) -> u32 {
-        list_room(self.size) as u32
+        list_room(self.size, self.kernel) as u32
     }
 }
 
@@ -127,9 +148,16 @@ fn pixels_of(size: UVec2) -> u64 {
 }
 
 /// The records a viewport of `size` has room for in its hole list: a [`HOLE_SHARE`] of its
-/// pixels, at least one.
-fn list_room(size: UVec2) -> u64 {
-    (pixels_of(size) / HOLE_SHARE).max(1)
+/// pixels, or with the lookup `kernel` one per pixel and a [`HOLE_SHARE`] more (MSAA gives an
+/// edge pixel two fragments); at least one.
+fn list_room(size: UVec2, kernel: bool) -> u64 {
+    let share = pixels_of(size) / HOLE_SHARE;
+    if kernel {
+        pixels_of(size) + share
+    } else {
+        share
+    }
+    .max(1)
 }
 
 /// The fill passes' uniform (`fill_entry.wgsl`'s `FillParams`).
@@ -139,12 +167,14 @@ pub(super) struct FillParams {
     offset: UVec2,
     radius: u32,
     exposure: f32,
+    eye: Vec4,
 }
 
 impl FillParams {
-    /// The uniform of `fill` on `camera`'s view.
-    pub(super) fn new(fill: &ScreenFill, camera: &ExtractedCamera) -> Self {
+    /// The uniform of `fill` on `camera`'s view, seen from `eye`.
+    pub(super) fn new(fill: &ScreenFill, camera: &ExtractedCamera, eye: Vec3) -> Self {
         Self {
+            eye: eye.extend(1.0),
             size: fill.size,
             offset: camera
                 .viewport
@@ -168,7 +198,11 @@ pub(super) fn build(app: &mut App) {
     render_app
         .add_systems(
             RenderStartup,
-            (init_pipelines, super::fill_composite::init_composite),
+            (
+                init_pipelines,
+                super::lookup_kernel::init_pipelines,
+                super::fill_composite::init_composite,
+            ),
         )
         .add_systems(
             Core3d,
@@ -207,8 +241,10 @@ pub(super) fn prepare_screen_fill(
         Option<&mut ScreenFill>,
     )>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
+    volumes: Res<super::volume::VolumeBuffers>,
 ) {
     for (entity, camera, cam, (counters, view), prepass, fill) in &mut cameras {
+        let kernel = settings.lookup_kernel;
         let size = match camera.physical_viewport_size() {
             Some(s)
                 if settings.screen_fill
@@ -221,7 +257,7 @@ pub(super) fn prepare_screen_fill(
         };
         let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
             let pixels = pixels_of(size);
-            let list = LIST_HEADER_BYTES + list_room(size) * RECORD_BYTES;
+            let list = LIST_HEADER_BYTES + list_room(size, kernel) * RECORD_BYTES;
             let buffer = |bytes: u64| {
                 ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
             };
@@ -239,6 +275,15 @@ pub(super) fn prepare_screen_fill(
             view: view.buffer.clone(),
             counters: counters.buffer.clone(),
             counting: settings.cost_counters,
+            kernel,
+            lookups: volumes
+                .0
+                .get(&cam.pack.id())
+                .zip(view.blended.as_ref())
+                .map(|(v, b)| LookupBindings {
+                    volumes: (v.samples.clone(), v.bins.clone()),
+                    blended: b.clone(),
+                }),
         };
         match fill {
             None => {
@@ -247,7 +292,7 @@ pub(super) fn prepare_screen_fill(
                     .insert(wanted(new_buffers(&mut buffers)));
             }
             Some(mut f) => {
-                let handles = if f.size == size {
+                let handles = if f.size == size && f.kernel == kernel {
                     [f.entries.clone(), f.holes.clone()]
                 } else {
                     new_buffers(&mut buffers)
@@ -272,6 +317,8 @@ fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
         && a.view == b.view
         && a.counters == b.counters
         && a.counting == b.counting
+        && a.kernel == b.kernel
+        && a.lookups == b.lookups
 }
 
 /// The kernel's pipelines (without and with the cost counters) and their layouts: the fill's
@@ -283,23 +330,29 @@ struct FillPipelines {
     counting: CachedComputePipelineId,
 }
 
+/// The layout of the fill's own bindings (group 0 of its kernels): the entries (which the
+/// lookup kernel writes), the uniform and the hole list.
+pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
+    BindGroupLayoutDescriptor::new(
+        "plenoptic screen fill",
+        &BindGroupLayoutEntries::sequential(
+            ShaderStages::COMPUTE,
+            (
+                storage_buffer_sized(false, None),
+                uniform_buffer::<FillParams>(false),
+                storage_buffer_sized(false, None),
+            ),
+        ),
+    )
+}
+
 /// Queues the kernel's two pipelines.
 fn init_pipelines(
     mut commands: Commands,
     asset_server: Res<AssetServer>,
     pipeline_cache: Res<PipelineCache>,
 ) {
-    let own = BindGroupLayoutDescriptor::new(
-        "plenoptic screen fill",
-        &BindGroupLayoutEntries::sequential(
-            ShaderStages::COMPUTE,
-            (
-                storage_buffer_read_only_sized(false, None),
-                uniform_buffer::<FillParams>(false),
-                storage_buffer_sized(false, None),
-            ),
-        ),
-    );
+    let own = own_layout();
     // The material's binding numbers (bindings.wgsl, counters.wgsl).
     let material = BindGroupLayoutDescriptor::new(
         "plenoptic screen fill lookups",
@@ -400,8 +453,8 @@ fn bind_groups(
 /// list's room.
 #[expect(clippy::too_many_arguments, reason = "a Bevy system's parameters")]
 fn fill_holes(
-    view: ViewQuery<(&ScreenFill, &ExtractedCamera)>,
-    pipelines: Option<Res<FillPipelines>>,
+    view: ViewQuery<(&ScreenFill, &ExtractedCamera, &ExtractedView)>,
+    (pipelines, lookup): (Option<Res<FillPipelines>>, Option<Res<LookupPipelines>>),
     pipeline_cache: Res<PipelineCache>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
     images: Res<RenderAssets<GpuImage>>,
@@ -409,7 +462,7 @@ fn fill_holes(
     queue: Res<RenderQueue>,
     mut ctx: RenderContext,
 ) {
-    let (fill, camera) = view.into_inner();
+    let (fill, camera, extracted) = view.into_inner();
     let Some(pipelines) = pipelines else {
         return;
     };
@@ -423,7 +476,7 @@ fn fill_holes(
     };
     let Some(groups) = bind_groups(
         fill,
-        FillParams::new(fill, camera),
+        FillParams::new(fill, camera, extracted.world_from_view.translation()),
         (&pipelines, &pipeline_cache),
         (&buffers, &images),
         (&device, &queue),
@@ -440,10 +493,29 @@ fn fill_holes(
             ..default()
         });
     let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill");
+    let workgroups = fill.room().div_ceil(GROUP);
+    // The lookup kernel first: its answered records' entries are what the ring search reads.
+    if fill.kernel
+        && let Some(lookup) = lookup.as_deref()
+        && let (Some(kernel), Some(material)) = (
+            pipeline_cache.get_compute_pipeline(lookup.id(fill.counting)),
+            material_group(
+                fill,
+                (lookup, &pipeline_cache),
+                (&buffers, &images),
+                &device,
+            ),
+        )
+    {
+        pass.set_pipeline(kernel);
+        pass.set_bind_group(0, &groups[0], &[]);
+        pass.set_bind_group(1, &material, &[]);
+        pass.dispatch_workgroups(workgroups, 1, 1);
+    }
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &groups[0], &[]);
     pass.set_bind_group(1, &groups[1], &[]);
-    pass.dispatch_workgroups(fill.room().div_ceil(GROUP), 1, 1);
+    pass.dispatch_workgroups(workgroups, 1, 1);
     span.end(&mut pass);
 }
 

@@ -141,6 +141,9 @@ impl ViewFlags {
     /// The camera reads its relit keys ([`crate::reconstruct::relight`]): lookup `k`'s key at
     /// layers `6k..6k + 6`, volume samples blended with their group layers.
     pub const RELIT: u32 = 1 << 5;
+    /// The opaque fragments leave their lookups to the lookup kernel
+    /// ([`super::lookup_kernel`]).
+    pub const LOOKUP_KERNEL: u32 = 1 << 6;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
@@ -274,8 +277,11 @@ pub(super) fn update_view_buffers(
             relit: relit.map(|r| r.groups),
         };
         let mut params = ctx.view_params();
-        if fill.is_some_and(ScreenFill::on) && !ctx.image_mode {
+        if let Some(fill) = fill.filter(|f| f.on() && !ctx.image_mode) {
             params.flags |= ViewFlags::SCREEN_FILL;
+            if fill.kernel && fill.lookups.is_some() {
+                params.flags |= ViewFlags::LOOKUP_KERNEL;
+            }
         }
         let view = view.as_mut();
         if params.motion.len() != view.params.motion.len() {
