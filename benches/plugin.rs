@@ -15,9 +15,9 @@
 //!   plenoptic cameras (each reconstructs its own frame: its own proxies and passes);
 //! - `plugin/costs`: the same frames with the shaders' cost counters on
 //!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA (as the tests' frames),
-//!   each case with the lookup kernel and the screen-space hole fill (the defaults), with
-//!   the lookups in the fragments (`PlenopticSettings::lookup_kernel` off) and with the
-//!   fragment fill (`PlenopticSettings::screen_fill` off): each prints, per fragment, its lookups, loads by
+//!   each case with the screen-space hole fill (the default), with the lookup kernel too
+//!   (`PlenopticSettings::lookup_kernel`) and with the fragment fill
+//!   (`PlenopticSettings::screen_fill` off): each prints, per fragment, its lookups, loads by
 //!   width, samples, march steps and fallback entries, the screen-fill kernel's loads, the
 //!   loads of a diffuse fragment, and the mean over 32-pixel groups of the group's largest
 //!   loads and work against the mean (what divergence costs), then the two fills' ratio.
@@ -29,10 +29,11 @@
 //! `plugin/frame` also room A with its mirror in view, `tour_mirror_1280x720`, and the same
 //! with the baked specular instead of reflections marched for the camera,
 //! `tour_mirror_baked_specular_1280x720`). The `plugin/frame` cameras render to an 8-bit
-//! target with Bevy's default MSAA and take the lookup kernel and the screen-space hole fill;
-//! its `tour_hdr_screen_fill_1280x720`, `tour_hdr_fragment_lookups_1280x720` and
+//! target with Bevy's default MSAA and take the screen-space hole fill; its
+//! `tour_hdr_lookup_kernel_1280x720`, `tour_hdr_screen_fill_1280x720` and
 //! `tour_hdr_fragment_fill_1280x720` cases are the tour on an HDR camera without MSAA with
-//! the lookup kernel, with the lookups in the fragments, and with the fragment fill. With
+//! the lookup kernel, with the lookups in the fragments and the screen fill, and with the
+//! fragment fill. With
 //! `PLENOPTIC_BENCH_PASSES` set, each frame case also prints its passes' CPU and GPU times
 //! (Bevy's render diagnostics).
 //!
@@ -422,10 +423,11 @@ fn frame(c: &mut Criterion) {
             settled_frames(&mut g, case, || scene(assets, name, views, TOUR_SIZE));
         }
         // An HDR camera without MSAA: the lookup kernel with the screen-space fill, the
-        // lookups in the fragments with the screen-space fill, and the fragment fill.
+        // lookups in the fragments with the screen-space fill (the default), and the fragment
+        // fill.
         for (case, fill, kernel) in [
-            ("tour_hdr_screen_fill_1280x720", true, true),
-            ("tour_hdr_fragment_lookups_1280x720", true, false),
+            ("tour_hdr_lookup_kernel_1280x720", true, true),
+            ("tour_hdr_screen_fill_1280x720", true, false),
             ("tour_hdr_fragment_fill_1280x720", false, false),
         ] {
             settled_frames(&mut g, case, || {
@@ -584,12 +586,12 @@ fn compared_fills(
     case: &str,
     make: impl Fn() -> Scene,
 ) {
-    let screen = counted_frames(g, &format!("{case}_screen_fill"), true, &make);
-    let in_fragments = counted_frames(g, &format!("{case}_fragment_lookups"), true, || {
-        lookups_in(make(), false)
+    let kernel = counted_frames(g, &format!("{case}_lookup_kernel"), true, || {
+        lookups_in(make(), true)
     });
+    let screen = counted_frames(g, &format!("{case}_screen_fill"), true, &make);
     let fragment = counted_frames(g, &format!("{case}_fragment_fill"), false, &make);
-    if let (Some(s), Some(l), Some(f)) = (screen, in_fragments, fragment) {
+    if let (Some(s), Some(l), Some(f)) = (kernel, screen, fragment) {
         let total = |r: &CostReport| r.loads + r.kernel_loads;
         eprintln!(
             "costs {case}: fetches per pixel {:.1} (fragments {:.1}, kernels {:.1}) with the \

@@ -63,7 +63,7 @@ fn counted(
     screen_fill: bool,
     tweak: impl Fn(&mut ReconSettings),
 ) -> (Vec<Vec<Vec3>>, CostReport, f64) {
-    counted_with(dir, (screen_fill, true), tweak)
+    counted_with(dir, (screen_fill, false), tweak)
 }
 
 /// [`counted`], with the lookup kernel on or off (`fills.1`) where the screen fill is on

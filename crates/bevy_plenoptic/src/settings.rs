@@ -38,7 +38,9 @@ pub struct PlenopticSettings {
     pub screen_fill: bool,
     /// On cameras with the screen fill, make the opaque pixels' lookups in a compute pass
     /// over the fragments' records ([`crate::reconstruct::geometry::lookup_kernel`]) instead
-    /// of in the fragment shader. The same frame; off only to compare the two.
+    /// of in the fragment shader. The same frame. Off by default: on lavapipe it reads more
+    /// (the records) and takes longer (`docs/results/measurements.md`, "The plugin's work per
+    /// pixel"); whether a GPU's fragment occupancy repays that is for its timings to say.
     pub lookup_kernel: bool,
 }
 
@@ -74,7 +76,7 @@ impl Default for PlenopticSettings {
             environment_light: true,
             cost_counters: false,
             screen_fill: true,
-            lookup_kernel: true,
+            lookup_kernel: false,
         }
     }
 }

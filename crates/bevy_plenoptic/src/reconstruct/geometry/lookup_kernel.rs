@@ -13,6 +13,10 @@
 //! path, and a fragment's registers are the material's. A fragment past the list's room
 //! makes its own lookups, as a hole past it fills itself.
 //!
+//! Measured on lavapipe (`docs/results/measurements.md`, "The plugin's work per pixel"): the
+//! same frames, but more reads (each record is read back, 64 bytes) and a longer frame, so
+//! the setting is off by default until a GPU's timings decide.
+//!
 //! [`PlenopticSettings::lookup_kernel`]: crate::settings::PlenopticSettings::lookup_kernel
 
 use std::borrow::Cow;

@@ -20,7 +20,7 @@
 //! transparent pass) keep the fragment fill, as does a hole beyond the list's room
 //! ([`HOLE_SHARE`] of the viewport's pixels).
 //!
-//! With the lookup kernel ([`super::lookup_kernel`], on by default) the fragments make no
+//! With the lookup kernel ([`super::lookup_kernel`], off by default) the fragments make no
 //! lookups at all: every opaque fragment appends a record, the lookup kernel answers the
 //! records it can and writes their entries, and the fill kernel fills the rest.
 //!

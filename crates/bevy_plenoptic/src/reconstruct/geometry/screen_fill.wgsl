@@ -72,12 +72,11 @@ fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     if i >= listed() {
         return;
     }
-    tally(C_LOADS_4, 1u);
-    if holes.records[i].state != RECORD_LOOKUP {
-        return;
-    }
     tally(C_LOADS_16, 4u);
     let record = holes.records[i];
+    if record.state != RECORD_LOOKUP {
+        return;
+    }
     let object = (record.tag & OBJECT_BITS) - 1u;
     point_slot = i32(record.local.w);
     point_material = (record.tag & HOLE_MATERIAL) != 0u;
