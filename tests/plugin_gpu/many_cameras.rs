@@ -165,7 +165,13 @@ pub(crate) fn settled_frames(app: &mut App, targets: &[Handle<Image>]) -> Vec<Ve
         let all_shown = now
             .iter()
             .all(|d| shown(&rgba16f_pixels(d.as_deref().unwrap_or_default())));
-        stable = if same && all_shown { stable + 1 } else { 0 };
+        // Frames from before the last pipeline compiled can be stable and wrong.
+        let ready = crate::common::pipelines_ready(app);
+        stable = if same && all_shown && ready {
+            stable + 1
+        } else {
+            0
+        };
         previous = now;
         if stable >= 3 && frame >= 60 {
             return previous

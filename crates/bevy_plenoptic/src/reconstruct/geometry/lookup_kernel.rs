@@ -19,8 +19,6 @@
 //!
 //! [`PlenopticSettings::lookup_kernel`]: crate::settings::PlenopticSettings::lookup_kernel
 
-use std::borrow::Cow;
-
 use bevy::asset::load_embedded_asset;
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
@@ -29,15 +27,14 @@ use bevy::render::render_resource::binding_types::{
 };
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
-    CachedComputePipelineId, ComputePipelineDescriptor, PipelineCache, Sampler, SamplerBindingType,
-    SamplerDescriptor, ShaderStages, TextureSampleType,
+    CachedComputePipelineId, PipelineCache, Sampler, SamplerBindingType, SamplerDescriptor,
+    ShaderStages, TextureSampleType,
 };
 use bevy::render::renderer::RenderDevice;
 use bevy::render::storage::GpuShaderBuffer;
 use bevy::render::texture::GpuImage;
-use bevy::shader::ShaderDefVal;
 
-use super::screen_fill::{ScreenFill, own_layout};
+use super::screen_fill::{ScreenFill, own_layout, queue_kernel};
 
 /// The kernel's pipelines (without and with the cost counters), the layout of the materials'
 /// bindings it reads (group 1; group 0 is the fill's own) and the nearest sampler its gathers
@@ -83,19 +80,15 @@ pub(super) fn init_pipelines(
         ),
     );
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let pipeline = |label: &'static str, counting: bool| {
-        let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
-        if counting {
-            shader_defs.push("PLENOPTIC_COUNTERS".into());
-        }
-        pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
-            label: Some(label.into()),
-            layout: vec![own_layout(), layout.clone()],
-            shader: shader.clone(),
-            shader_defs,
-            entry_point: Some(Cow::from("lookup_records")),
-            ..default()
-        })
+    let layouts = [own_layout(), layout.clone()];
+    let pipeline = |label, counting| {
+        queue_kernel(
+            &pipeline_cache,
+            (&shader, "lookup_records"),
+            &layouts,
+            label,
+            counting,
+        )
     };
     let plain = pipeline("plenoptic lookup kernel", false);
     let counting = pipeline("plenoptic lookup kernel (counting)", true);

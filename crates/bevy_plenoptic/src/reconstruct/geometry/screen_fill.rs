@@ -346,6 +346,29 @@ pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
     )
 }
 
+/// Queues the pipeline of `screen_fill.wgsl`'s entry point `entry` with `layouts`, counting
+/// its cost or not.
+pub(super) fn queue_kernel(
+    pipeline_cache: &PipelineCache,
+    (shader, entry): (&Handle<Shader>, &'static str),
+    layouts: &[BindGroupLayoutDescriptor],
+    label: &'static str,
+    counting: bool,
+) -> CachedComputePipelineId {
+    let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
+    if counting {
+        shader_defs.push("PLENOPTIC_COUNTERS".into());
+    }
+    pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
+        label: Some(label.into()),
+        layout: layouts.to_vec(),
+        shader: shader.clone(),
+        shader_defs,
+        entry_point: Some(Cow::from(entry)),
+        ..default()
+    })
+}
+
 /// Queues the kernel's two pipelines.
 fn init_pipelines(
     mut commands: Commands,
@@ -368,19 +391,14 @@ fn init_pipelines(
     );
     let layouts = [own, material];
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let pipeline = |label: &'static str, counting: bool| {
-        let mut shader_defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 1)];
-        if counting {
-            shader_defs.push("PLENOPTIC_COUNTERS".into());
-        }
-        pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
-            label: Some(label.into()),
-            layout: layouts.to_vec(),
-            shader: shader.clone(),
-            shader_defs,
-            entry_point: Some(Cow::from("fill_holes")),
-            ..default()
-        })
+    let pipeline = |label, counting| {
+        queue_kernel(
+            &pipeline_cache,
+            (&shader, "fill_holes"),
+            &layouts,
+            label,
+            counting,
+        )
     };
     let plain = pipeline("plenoptic screen fill", false);
     let counting = pipeline("plenoptic screen fill (counting)", true);

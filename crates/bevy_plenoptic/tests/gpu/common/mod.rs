@@ -137,6 +137,11 @@ pub fn render_until(
 #[derive(Resource, Clone, Default)]
 pub struct ShaderErrors(Arc<Mutex<Option<String>>>);
 
+/// How many pipelines the render world's cache was still compiling at its last frame, shared
+/// with the main world as [`ShaderErrors`] is.
+#[derive(Resource, Clone, Default)]
+pub struct PipelinesWaiting(Arc<std::sync::atomic::AtomicUsize>);
+
 /// Records in [`ShaderErrors`] the first pipeline whose shader failed to compile.
 struct ShaderErrorsPlugin;
 
@@ -144,13 +149,27 @@ impl Plugin for ShaderErrorsPlugin {
     fn build(&self, app: &mut App) {
         use bevy::render::{Render, RenderApp, RenderSystems};
         let errors = ShaderErrors::default();
-        app.insert_resource(errors.clone());
+        let waiting = PipelinesWaiting::default();
+        app.insert_resource(errors.clone())
+            .insert_resource(waiting.clone());
         if let Some(render) = app.get_sub_app_mut(RenderApp) {
             render
                 .insert_resource(errors)
-                .add_systems(Render, record_shader_errors.in_set(RenderSystems::Cleanup));
+                .insert_resource(waiting)
+                .add_systems(
+                    Render,
+                    (record_shader_errors, record_waiting).in_set(RenderSystems::Cleanup),
+                );
         }
     }
+}
+
+fn record_waiting(
+    cache: Res<bevy::render::render_resource::PipelineCache>,
+    waiting: Res<PipelinesWaiting>,
+) {
+    let n = cache.waiting_pipelines().count();
+    waiting.0.store(n, std::sync::atomic::Ordering::Relaxed);
 }
 
 fn record_shader_errors(
@@ -190,6 +209,16 @@ pub fn assert_shaders_compile(app: &App) {
     }
 }
 
+/// Whether the render world's pipeline cache has compiled every pipeline queued so far:
+/// until then Bevy skips what a pipeline not ready yet would draw or dispatch, and the frames
+/// it shows meanwhile can be equal to each other and still wrong (a hole-fill kernel still
+/// compiling leaves its holes black).
+pub fn pipelines_ready(app: &App) -> bool {
+    app.world()
+        .get_resource::<PipelinesWaiting>()
+        .is_none_or(|w| w.0.load(std::sync::atomic::Ordering::Relaxed) == 0)
+}
+
 /// The RGBA8 pixel at (x, y).
 pub fn pixel(data: &[u8], x: u32, y: u32) -> [u8; 4] {
     let i = ((y * WIDTH + x) * 4) as usize;
@@ -225,6 +254,10 @@ pub fn settled_frame(app: &mut App, image: &Handle<Image>) -> Vec<u8> {
         })
     };
     let mut data = stable_frame(app);
+    // Frames from before the last pipeline compiled can be stable and wrong.
+    while !pipelines_ready(app) {
+        data = stable_frame(app);
+    }
     for _ in 0..20 {
         for _ in 0..15 {
             app.update();
