@@ -50,6 +50,20 @@ pub struct Relight {
     objects: HashMap<u32, Vec3>,
 }
 
+impl Default for Relight {
+    /// Every emitter as baked, for any pack.
+    fn default() -> Self {
+        Self {
+            weights: GroupWeights::identity(),
+            blend: GroupWeights::identity().blend(None),
+            sun: Vec3::ONE,
+            sky: Vec3::ONE,
+            lights: Vec::new(),
+            objects: HashMap::new(),
+        }
+    }
+}
+
 impl Relight {
     /// The multipliers of `manifest`'s emitters at `weights`. A pack without groups has one
     /// group, the default, whose weight scales everything.

@@ -11,6 +11,7 @@
 
 use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
+use plenoptic_recon::relight::Relight;
 use plenoptic_recon::temporal::bracketing;
 
 use super::view::{ViewFlags, ViewParams, motion_slot};
@@ -152,6 +153,8 @@ pub(crate) struct CameraFrame<'a> {
     pub(crate) image_mode: bool,
     /// With [`crate::reconstruct::relight::RelitKeys`]: the pack's stored light groups.
     pub(crate) relit: Option<u32>,
+    /// What the camera's light-group weights give each emitter of the pack.
+    pub(crate) relight: &'a Relight,
 }
 
 /// What an object's uniform is made for.
@@ -170,7 +173,12 @@ pub(crate) struct ObjectShading<'a> {
 impl ObjectShading<'_> {
     /// The object's uniform as camera `cam` shows it from `pack`: its id, motion slot,
     /// coverage and material. It changes only with the camera's settings.
-    pub(crate) fn params(&self, cam: &PlenopticCamera, pack: &RadiancePack) -> ObjectParams {
+    pub(crate) fn params(
+        &self,
+        cam: &PlenopticCamera,
+        pack: &RadiancePack,
+        relight: &Relight,
+    ) -> ObjectParams {
         let mut params = ObjectParams {
             id: self.id,
             motion_slot: motion_slot(pack, self.id).map_or(-1, |s| s as i32),
@@ -181,10 +189,7 @@ impl ObjectShading<'_> {
             && cam.settings.shading == plenoptic_recon::Shading::Materials
         {
             factors.fill(&mut params);
-            if !cam.lights.is_identity() {
-                let relight = cam.lights.relight(pack.reader.manifest());
-                params.emissive *= relight.object(self.id).extend(1.0);
-            }
+            params.emissive *= relight.object(self.id).extend(1.0);
             if let Some(t) = plenoptic_recon::specular::see_through_transmittance(
                 &cam.settings,
                 &factors.material,
@@ -225,7 +230,7 @@ pub(crate) fn rebind<M: Asset + BindsView>(
     let Some(m) = materials.get(handle) else {
         return;
     };
-    let params = m.shading(id).params(cam, pack);
+    let params = m.shading(id).params(cam, pack, &view.relight);
     let (bound, bindings, buffer) = m.bound();
     let stale = *bound != params || bindings != view.bindings || *buffer != view.buffer;
     if stale && let Some(mut m) = materials.get_mut(handle) {
@@ -237,8 +242,7 @@ impl CameraFrame<'_> {
     /// The camera's view buffer contents ([`super::view`]).
     pub(crate) fn view_params(&self) -> ViewParams {
         let (cam, pack, tex, f) = (self.cam, self.pack, self.tex, self.lookups);
-        let m = pack.reader.manifest();
-        let relight = cam.lights.relight(m);
+        let (m, relight) = (pack.reader.manifest(), self.relight);
         let mut params = ViewParams {
             lookup_count: f.lookups.len() as u32,
             face: tex.face,
@@ -286,11 +290,11 @@ impl CameraFrame<'_> {
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {
             sun::fill(&mut params, pack, cam.time, relight.sun);
-            reflect::fill(&mut params, pack, &cam.settings, &relight);
+            reflect::fill(&mut params, pack, &cam.settings, relight);
         }
         if let Some(groups) = self.relit {
             params.flags |= ViewFlags::RELIT;
-            super::relight::fill(&mut params, &relight, groups);
+            super::relight::fill(&mut params, relight, groups);
         }
         params
     }

@@ -42,6 +42,7 @@ use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
 use plenoptic_pack::MAX_LIGHT_GROUPS;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
+use plenoptic_recon::relight::Relight;
 
 /// One camera's lookups and settings, as the geometry-assisted shader reads them (`ViewParams`
 /// in `bindings.wgsl`).
@@ -168,6 +169,9 @@ pub struct ViewBuffer {
     /// The key and shading textures its lookups read: its [`RelitKeys`] when it has them,
     /// else its pack's.
     pub keys: Option<(Handle<Image>, Handle<Image>)>,
+    /// What the camera's light-group weights give each emitter of its pack this frame (its
+    /// materials' emission reads it).
+    pub relight: Relight,
 }
 
 impl ViewBuffer {
@@ -220,6 +224,7 @@ pub(super) fn add_view_buffers(
                 hole_list: Handle::default(),
                 blended: None,
                 keys: None,
+                relight: Relight::default(),
             },
             ViewDisplay::default(),
         ));
@@ -267,6 +272,7 @@ pub(super) fn update_view_buffers(
             cam.time,
         );
         let pack_volumes = volumes.0.get(&id);
+        let relight = cam.lights.relight(pack.reader.manifest());
         let ctx = CameraFrame {
             cam,
             pack,
@@ -275,6 +281,7 @@ pub(super) fn update_view_buffers(
             lookups: &lookups,
             image_mode: warped(cam.mode) && frame.active,
             relit: relit.map(|r| r.groups),
+            relight: &relight,
         };
         let mut params = ctx.view_params();
         if let Some(fill) = fill.filter(|f| f.on() && !ctx.image_mode) {
@@ -284,6 +291,9 @@ pub(super) fn update_view_buffers(
             }
         }
         let view = view.as_mut();
+        if view.relight != relight {
+            view.relight = relight;
+        }
         if params.motion.len() != view.params.motion.len() {
             // Another size: a new buffer, which the materials must bind again.
             view.buffer = buffers.add(shader_buffer(&params));
