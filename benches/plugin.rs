@@ -16,7 +16,8 @@
 //! - `plugin/costs`: the same frames with the shaders' cost counters on
 //!   (`PlenopticSettings::cost_counters`), on HDR cameras without MSAA (as the tests' frames),
 //!   each case with the screen-space hole fill (the default), with the lookup kernel too
-//!   (`PlenopticSettings::lookup_kernel`) and with the fragment fill
+//!   (`PlenopticSettings::lookup_kernel`; with the sparse lighting, the cameras' default,
+//!   and `_dense` without it, `ReconSettings::sparse_lighting`) and with the fragment fill
 //!   (`PlenopticSettings::screen_fill` off): each prints, per fragment, its lookups, loads by
 //!   width, samples, march steps and fallback entries, the screen-fill kernel's loads, the
 //!   loads of a diffuse fragment, and the mean over 32-pixel groups of the group's largest
@@ -30,10 +31,11 @@
 //! with the baked specular instead of reflections marched for the camera,
 //! `tour_mirror_baked_specular_1280x720`). The `plugin/frame` cameras render to an 8-bit
 //! target with Bevy's default MSAA and take the screen-space hole fill; its
-//! `tour_hdr_lookup_kernel_1280x720`, `tour_hdr_screen_fill_1280x720` and
-//! `tour_hdr_fragment_fill_1280x720` cases are the tour on an HDR camera without MSAA with
-//! the lookup kernel, with the lookups in the fragments and the screen fill, and with the
-//! fragment fill. With
+//! `tour_hdr_lookup_kernel_1280x720`, `tour_hdr_lookup_kernel_dense_1280x720`,
+//! `tour_hdr_screen_fill_1280x720` and `tour_hdr_fragment_fill_1280x720` cases are the tour
+//! on an HDR camera without MSAA with the lookup kernel (with and without the sparse
+//! lighting), with the lookups in the fragments and the screen fill, and with the fragment
+//! fill. With
 //! `PLENOPTIC_BENCH_PASSES` set, each frame case also prints its passes' CPU and GPU times
 //! (Bevy's render diagnostics).
 //!
@@ -425,16 +427,18 @@ fn frame(c: &mut Criterion) {
         // An HDR camera without MSAA: the lookup kernel with the screen-space fill, the
         // lookups in the fragments with the screen-space fill (the default), and the fragment
         // fill.
-        for (case, fill, kernel) in [
-            ("tour_hdr_lookup_kernel_1280x720", true, true),
-            ("tour_hdr_screen_fill_1280x720", true, false),
-            ("tour_hdr_fragment_fill_1280x720", false, false),
+        for (case, fill, kernel, sparse) in [
+            ("tour_hdr_lookup_kernel_1280x720", true, true, true),
+            ("tour_hdr_lookup_kernel_dense_1280x720", true, true, false),
+            ("tour_hdr_screen_fill_1280x720", true, false, true),
+            ("tour_hdr_fragment_fill_1280x720", false, false, true),
         ] {
             settled_frames(&mut g, case, || {
-                lookups_in(
+                let s = lookups_in(
                     hdr_scene(scene(assets, name, &views, TOUR_SIZE), fill),
                     kernel,
-                )
+                );
+                if sparse { s } else { dense_lighting(s) }
             });
         }
     }
@@ -447,6 +451,17 @@ fn lookups_in(mut s: Scene, kernel: bool) -> Scene {
         .world_mut()
         .resource_mut::<PlenopticSettings>()
         .lookup_kernel = kernel;
+    s
+}
+
+/// `s` with every camera's lighting looked up at every pixel
+/// (`ReconSettings::sparse_lighting` off).
+fn dense_lighting(mut s: Scene) -> Scene {
+    for &camera in &s.cameras {
+        if let Some(mut c) = s.app.world_mut().get_mut::<PlenopticCamera>(camera) {
+            c.settings.sparse_lighting = false;
+        }
+    }
     s
 }
 
@@ -589,18 +604,23 @@ fn compared_fills(
     let kernel = counted_frames(g, &format!("{case}_lookup_kernel"), true, || {
         lookups_in(make(), true)
     });
+    let dense = counted_frames(g, &format!("{case}_lookup_kernel_dense"), true, || {
+        dense_lighting(lookups_in(make(), true))
+    });
     let screen = counted_frames(g, &format!("{case}_screen_fill"), true, &make);
     let fragment = counted_frames(g, &format!("{case}_fragment_fill"), false, &make);
-    if let (Some(s), Some(l), Some(f)) = (kernel, screen, fragment) {
+    if let (Some(s), Some(d), Some(l), Some(f)) = (kernel, dense, screen, fragment) {
         let total = |r: &CostReport| r.loads + r.kernel_loads;
         eprintln!(
             "costs {case}: fetches per pixel {:.1} (fragments {:.1}, kernels {:.1}) with the \
-             lookup kernel and the screen fill, {:.1} ({:.1} + {:.1}) with the lookups in the \
+             lookup kernel and the screen fill, {:.1} without the sparse lighting, \
+             {:.1} ({:.1} + {:.1}) with the lookups in the \
              fragments, {:.1} with the fragment fill; a fragment's largest in 32 {:.1}, {:.1} \
              and {:.1}",
             total(&s),
             s.loads,
             s.kernel_loads,
+            total(&d),
             total(&l),
             l.loads,
             l.kernel_loads,

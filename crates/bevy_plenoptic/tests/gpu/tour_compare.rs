@@ -4,7 +4,10 @@
 //! --ignored --nocapture`; the pack is `target/architectural_tour/tour.pack` or
 //! `$PLENOPTIC_TOUR_PACK`. On a pack baked with light groups, `PLENOPTIC_TOUR_LIGHTS` (as
 //! `lamp=0 sun=0.2 sky=0.2`: a group's name and its intensity or colour) relights both
-//! frames.
+//! frames. `PLENOPTIC_TOUR_KERNEL=1` makes the GPU's lookups in the lookup kernel
+//! (`PlenopticSettings::lookup_kernel`); `PLENOPTIC_TOUR_DENSE` set to `gpu`, `cpu` or `both`
+//! looks the lighting up at every pixel there (`ReconSettings::sparse_lighting` off), so
+//! that the sparse lighting's error against the dense frame can be read off.
 
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -52,6 +55,10 @@ fn tour_gpu_against_cpu() {
     // As the GPU path reconstructs: a mirror's ray shows the base views' radiance where it
     // meets a surface (the GPU does not shade that surface as a pixel yet).
     rec.settings.shaded_reflections = false;
+    let dense = std::env::var("PLENOPTIC_TOUR_DENSE").unwrap_or_default();
+    rec.settings.sparse_lighting = !matches!(dense.as_str(), "cpu" | "both");
+    let gpu_sparse = !matches!(dense.as_str(), "gpu" | "both");
+    let kernel = std::env::var_os("PLENOPTIC_TOUR_KERNEL").is_some_and(|v| v == "1");
     let (t0, t1) = path.time_range();
     for s in [0.1f32, 0.35, 0.6, 0.85] {
         let sample = path.sample(t0 + (t1 - t0) * s);
@@ -62,6 +69,9 @@ fn tour_gpu_against_cpu() {
             .render(&cam, sample.scene_time, Mode::GeometryAssisted)
             .unwrap();
         let mut app = crate::common::headless_app_in(pack.parent().unwrap());
+        app.world_mut()
+            .resource_mut::<PlenopticSettings>()
+            .lookup_kernel = kernel;
         let handle: Handle<RadiancePack> = app
             .world()
             .resource::<AssetServer>()
@@ -95,6 +105,10 @@ fn tour_gpu_against_cpu() {
                     playback: Playback::Manual,
                     time: sample.scene_time,
                     lights: lights.clone(),
+                    settings: ReconSettings {
+                        sparse_lighting: gpu_sparse,
+                        ..default()
+                    },
                     ..PlenopticCamera::new(handle)
                 },
             ))

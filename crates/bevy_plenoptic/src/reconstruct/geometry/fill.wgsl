@@ -28,7 +28,8 @@
 }
 #endif
 #import plenoptic::fill_entry::ring_step
-#import plenoptic::geometry::lookup::{reconstruct, neighbour_texels, heaviest_texel, object_point, shade}
+#import plenoptic::geometry::lookup::{reconstruct, object_point, shade}
+#import plenoptic::geometry::fallback::{neighbour_texels, heaviest_texel}
 #import plenoptic::counters::{tally, C_LOADS_16, C_LOADS_4, C_FILL, C_FILL_LOOKUPS}
 
 // What the fragment leaves in the fill entries: nothing, its terms, or its hole.
@@ -227,7 +228,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     tally(C_FILL, 1u);
     if deferred && claim_hole(p) {
         // The fill kernel fills the pixel: its ring search, else the fallbacks below
-        // (lookup.wgsl's nearby_texels and heaviest_texel, as here).
+        // (fallback.wgsl's nearby_texels and heaviest_texel, as here).
         entry_kind = ENTRY_HOLE;
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }

@@ -35,15 +35,17 @@ struct HoleRecord {
     // Its surface normal facing the eye in its lookups' frame (lookup.wgsl's face_normal),
     // oct-encoded as two snorm16 (pack_normal).
     normal: u32,
-    // RECORD_HOLE, RECORD_LOOKUP or RECORD_ANSWERED.
+    // RECORD_HOLE, RECORD_LOOKUP, RECORD_SPARSE or RECORD_ANSWERED.
     state: u32,
 }
 
 // A record's state: a hole the fill kernel fills; a point whose lookups the lookup kernel
-// makes (VIEW_LOOKUP_KERNEL); a point the lookup kernel answered (its colour in `pair`).
+// makes (VIEW_LOOKUP_KERNEL); a point the lookup kernel answered (its colour in `pair`); a
+// point the sparse lighting interpolates from its anchors or looks up after them.
 const RECORD_HOLE: u32 = 0u;
 const RECORD_LOOKUP: u32 = 1u;
 const RECORD_ANSWERED: u32 = 2u;
+const RECORD_SPARSE: u32 = 3u;
 
 // The packed normal of no normal (the face test left out).
 const NO_NORMAL: u32 = 0xffffffffu;
@@ -98,6 +100,9 @@ struct FillParams {
     // The ring search's largest radius; the camera's exposure.
     radius: u32,
     exposure: f32,
+    // Whether the lookup kernel looks materials' lighting up at the anchors only and
+    // interpolates between them (ReconSettings::sparse_lighting): 1, else 0.
+    sparse: u32,
     // The camera's position (xyz), which the lookup kernel weighs views from.
     eye: vec4<f32>,
 }

@@ -4,19 +4,27 @@
 // key's cube (the nearest texel, or seamlessly bilinear over the taps of the same surface),
 // accepted if the cube saw the same object at the same distance, and blended with
 // w_view · w_time · ((1 + cos θ)/2)^p; the temporal-volume fallback (thesis §7.4) where no
-// lookup is accepted, and the nearby texels tried after the hole fill (fill.wgsl).
+// lookup is accepted (the fallbacks after the hole fill are fallback.wgsl's).
 #define_import_path plenoptic::geometry::lookup
 
 #import plenoptic::cube::{rgb9e5_decode, cube_texel, texel_direction, bilinear_tap, Footprint, footprint, tap_weight}
 #import plenoptic::fill_entry::unpack_pair
 #import plenoptic::geometry::relight::volume_terms
-#import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME, C_NEIGHBOUR}
+#import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
     volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, face_normal, lit, view_has, VIEW_BILINEAR,
     point_slot, point_material,
     blended_geometry, blended_terms, PAIR_CHANGING,
 }
+
+// Whether the last filtered lookup kept all four of its bilinear taps (the nearest texel's
+// alone: true; across a face seam: false), as plenoptic_recon's lookup records it.
+var<private> taps_whole: bool;
+// The keys that answered the last direct_lookups_at: bit 2k for lookup k, bit 2k + 1 where
+// it kept all four taps (plenoptic_recon's Scratch::accepted; the sparse lighting's
+// signature, screen_fill.wgsl).
+var<private> lookup_accepted: u32;
 
 // Point `p` of this object in the object's own frame (homogeneous): local_from_world · p
 // for an animated object; `p` itself for a static one (in world space), which is not
@@ -119,6 +127,7 @@ fn same_surface(c: vec3<u32>, n: u32, texel: vec4<u32>, object: u32, d: vec3<f32
 // lookup::filtered). Each tap is loaded on its own: the path of a footprint across a face
 // seam (gathered_filter takes the others).
 fn filtered(layer0: u32, n: u32, d: vec3<f32>, np: vec3<f32>, t: vec3<u32>, nearest: vec4<u32>, object: u32, l: f32, tol: f32, normals: bool) -> mat2x3<f32> {
+    taps_whole = false;
     var acc = mat2x3<f32>();
     var aw = 0.0;
     for (var k = 0u; k < 4u; k++) {
@@ -227,6 +236,7 @@ fn key_lookup(l: Lookup, layer0: u32, n: u32, object: u32, tol: f32, normals: bo
         return Weighted(mat2x3<f32>(), 0.0);
     }
     if !bilinear {
+        taps_whole = true;
         return Weighted(colour(l.t, layer0, texel), 1.0);
     }
     let fp = footprint(l.d, n);
@@ -280,6 +290,7 @@ fn filter_taps(l: Lookup, fp: Footprint, n: u32, object: u32, tol: f32, normals:
     let kn = kt.x + 2u * kt.y;
     var acc = mat2x3<f32>();
     var aw = 0.0;
+    var kept = 0u;
     for (var k = 0u; k < 4u; k++) {
         let w = tap_weight(fp.f, k);
         let c = vec3<u32>(corner + vec2<u32>(k & 1u, k >> 1u), fp.face);
@@ -287,8 +298,10 @@ fn filter_taps(l: Lookup, fp: Footprint, n: u32, object: u32, tol: f32, normals:
         if k == kn || same_surface(c, n, texel, object, l.d, l.np, l.dist, tol, normals) {
             acc += terms[k] * w;
             aw += w;
+            kept += 1u;
         }
     }
+    taps_whole = kept == 4u;
     if aw > 0.0 {
         return acc * (1.0 / aw);
     }
@@ -378,6 +391,11 @@ fn still_between(k: u32) -> bool {
     return all(a[0] == b[0]) && all(a[1] == b[1]) && all(a[2] == b[2]) && all(a[3] == b[3]);
 }
 
+// Lookup k's bits of lookup_accepted, after its lookup was accepted.
+fn accepted_bits(k: u32) -> u32 {
+    return (1u | select(0u, 2u, taps_whole)) << (2u * k);
+}
+
 // The angular weight ((1 + cos θ)/2)^p of lookup `l` seen from the direction `to_eye`.
 fn angular(l: Lookup, to_eye: vec3<f32>, power: f32) -> f32 {
     if power <= 0.0 {
@@ -407,6 +425,7 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
     // An object shaded from its material looks a view's two keys up once where it stands
     // still between their times and the keys agree (blend.rs).
     let paired = point_material;
+    lookup_accepted = 0u;
     for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
         let l = lookup_of(local, k, n, f32(point_slot));
         if !l.ok {
@@ -419,6 +438,7 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
             if got.w >= 0.0 {
                 tally(C_LOOKUPS, 2u);
                 if got.w > 0.0 {
+                    lookup_accepted |= accepted_bits(k) | accepted_bits(k + 1u);
                     let w = (cam.weight[k].x + cam.weight[k + 1u].x) * angular(l, to_eye, power);
                     sum += got.terms * w;
                     ws += w;
@@ -433,73 +453,10 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
         if got.w == 0.0 {
             continue;
         }
+        lookup_accepted |= accepted_bits(k);
         let w = cam.weight[k].x * angular(l, to_eye, power);
         sum += got.terms * w;
         ws += w;
-    }
-    return Weighted(sum, ws);
-}
-
-// plenoptic_recon's NEIGHBOUR_TEXELS and NEIGHBOUR_TOLERANCE.
-const NEIGHBOUR_TEXELS: i32 = 8;
-const NEIGHBOUR_TOLERANCE: f32 = 0.25;
-// Ranks another object's texel behind every texel of the object itself.
-const OTHER_OBJECT: i32 = 2 * NEIGHBOUR_TEXELS * NEIGHBOUR_TEXELS + 1;
-// Above every score.
-const NO_TEXEL: i32 = 1073741824;
-
-// The fallback after the hole fill (plenoptic_recon's neighbour_texel): in each lookup's key,
-// the nearest texel at about the distance of `p` within NEIGHBOUR_TEXELS of the lookup's
-// texel on its face, `object`'s own first, then any surface's (the first in row order on
-// ties). Returns (Σ w·terms, Σ w).
-fn neighbour_texels(p: vec3<f32>, object: u32) -> Weighted {
-    return nearby_texels(object_point(p), object, f32(point_slot), point_material);
-}
-
-// `neighbour_texels` of the point whose `object_point` is `local`, of `object` with motion
-// slot `slot`, shaded from its material or not (`material`): the screen-space fill kernel's
-// entry, which has no material bound.
-fn nearby_texels(local: vec4<f32>, object: u32, slot: f32, material: bool) -> Weighted {
-    tally(C_NEIGHBOUR, 1u);
-    var sum = mat2x3<f32>();
-    var ws = 0.0;
-    let count = cam.lookup_count;
-    let n = cam.face;
-    for (var k = 0u; k < min(count, MAX_LOOKUPS); k++) {
-        let l = lookup_of(local, k, n, slot);
-        if !l.ok {
-            continue;
-        }
-        let dist = l.dist;
-        let t = l.t;
-        let layer0 = u32(cam.base[k].w);
-        var best = NO_TEXEL;
-        var best_c = t;
-        for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
-            for (var di = -NEIGHBOUR_TEXELS; di <= NEIGHBOUR_TEXELS; di++) {
-                let x = i32(t.x) + di;
-                let y = i32(t.y) + dj;
-                if x < 0 || y < 0 || x >= i32(n) || y >= i32(n) {
-                    continue;
-                }
-                let c = vec3<u32>(u32(x), u32(y), t.z);
-                tally(C_LOADS_16, 1u);
-                let texel = textureLoad(cubes, c.xy, layer0 + c.z, 0);
-                // The object's own texels first, then any surface at the point's distance.
-                let score = di * di + dj * dj + select(OTHER_OBJECT, 0, texel.z == object);
-                if texel.z != 0u && abs(bitcast<f32>(texel.y) - dist) <= NEIGHBOUR_TOLERANCE * dist
-                    && score < best {
-                    best = score;
-                    best_c = c;
-                }
-            }
-        }
-        if best < NO_TEXEL {
-            tally(C_LOADS_16, 1u);
-            let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
-            sum += texel_terms(best_c, layer0, texel, material) * cam.weight[k].x;
-            ws += cam.weight[k].x;
-        }
     }
     return Weighted(sum, ws);
 }
@@ -558,21 +515,6 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
         }
     }
     return Weighted(sum, ws);
-}
-
-// The last fallback: the heaviest key's texel in the direction of world point `p`
-// ("background"), the terms of an object shaded from its material or not (`material`);
-// w = 0 without lookups.
-fn heaviest_texel(p: vec3<f32>, material: bool) -> Weighted {
-    let h = cam.heaviest;
-    if h >= min(cam.lookup_count, MAX_LOOKUPS) {
-        return Weighted(mat2x3<f32>(), 0.0);
-    }
-    let t = cube_texel(p - cam.base[h].xyz, cam.face);
-    let layer0 = u32(cam.base[h].w);
-    tally(C_LOADS_16, 1u);
-    let texel = textureLoad(cubes, t.xy, layer0 + t.z, 0);
-    return Weighted(texel_terms(t, layer0, texel, material), 1.0);
 }
 
 // Direct lookups, else the temporal-volume fallback: (terms, 1), or w = 0 for a hole.

@@ -13,11 +13,22 @@
 //! path, and a fragment's registers are the material's. A fragment past the list's room
 //! makes its own lookups, as a hole past it fills itself.
 //!
+//! With [`ReconSettings::sparse_lighting`] (`plenoptic_recon`'s `geometry::sparse`, the
+//! CPU's rule) a record shaded from its material is looked up only on an *anchor* (even row
+//! and column), which leaves a cell for its neighbours: the keys that answered it with their
+//! taps, its distance, normal and object. A second pass (`interpolate_records`) gives every
+//! other such record its two or four anchors' mean where they stand for its own lookups
+//! (the same object answered by the same keys with all their taps, no crease, no depth
+//! step), a joint bilateral upsampling guided by object id, keys, normal and depth; the rest
+//! (object edges, creases, occlusion edges in a base view) look themselves up at full
+//! resolution. Albedo, the sun and reflections stay per pixel in the fragments.
+//!
 //! Measured on lavapipe (`docs/results/measurements.md`, "The plugin's work per pixel"): the
 //! same frames, but more reads (each record is read back, 64 bytes) and a longer frame, so
 //! the setting is off by default until a GPU's timings decide.
 //!
 //! [`PlenopticSettings::lookup_kernel`]: crate::settings::PlenopticSettings::lookup_kernel
+//! [`ReconSettings::sparse_lighting`]: plenoptic_recon::ReconSettings::sparse_lighting
 
 use bevy::asset::load_embedded_asset;
 use bevy::prelude::*;
@@ -27,8 +38,8 @@ use bevy::render::render_resource::binding_types::{
 };
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
-    CachedComputePipelineId, PipelineCache, Sampler, SamplerBindingType, SamplerDescriptor,
-    ShaderStages, TextureSampleType,
+    CachedComputePipelineId, ComputePass, PipelineCache, Sampler, SamplerBindingType,
+    SamplerDescriptor, ShaderStages, TextureSampleType,
 };
 use bevy::render::renderer::RenderDevice;
 use bevy::render::storage::GpuShaderBuffer;
@@ -36,22 +47,20 @@ use bevy::render::texture::GpuImage;
 
 use super::screen_fill::{ScreenFill, own_layout, queue_kernel};
 
-/// The kernel's pipelines (without and with the cost counters), the layout of the materials'
-/// bindings it reads (group 1; group 0 is the fill's own) and the nearest sampler its gathers
-/// take.
+/// The kernel's pipelines, without and with the cost counters: its lookups' and the sparse
+/// lighting's interpolation.
+struct Kernels {
+    lookups: [CachedComputePipelineId; 2],
+    interpolate: [CachedComputePipelineId; 2],
+}
+
+/// The kernel's pipelines, the layout of the materials' bindings it reads (group 1; group 0
+/// is the fill's own) and the nearest sampler its gathers take.
 #[derive(Resource)]
 pub(super) struct LookupPipelines {
     layout: BindGroupLayoutDescriptor,
-    plain: CachedComputePipelineId,
-    counting: CachedComputePipelineId,
+    kernels: Kernels,
     sampler: Sampler,
-}
-
-impl LookupPipelines {
-    /// The pipeline for a fill counting its cost or not.
-    pub(super) fn id(&self, counting: bool) -> CachedComputePipelineId {
-        if counting { self.counting } else { self.plain }
-    }
 }
 
 /// Queues the kernel's pipelines.
@@ -81,32 +90,66 @@ pub(super) fn init_pipelines(
     );
     let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
     let layouts = [own_layout(), layout.clone()];
-    let pipeline = |label, counting| {
-        queue_kernel(
-            &pipeline_cache,
-            (&shader, "lookup_records"),
-            &layouts,
-            label,
-            counting,
-        )
+    let pipeline = |entry, label, counting| {
+        queue_kernel(&pipeline_cache, (&shader, entry), &layouts, label, counting)
     };
-    let plain = pipeline("plenoptic lookup kernel", false);
-    let counting = pipeline("plenoptic lookup kernel (counting)", true);
+    let kernels = Kernels {
+        lookups: [
+            pipeline("lookup_records", "plenoptic lookup kernel", false),
+            pipeline("lookup_records", "plenoptic lookup kernel (counting)", true),
+        ],
+        interpolate: [
+            pipeline("interpolate_records", "plenoptic sparse lighting", false),
+            pipeline(
+                "interpolate_records",
+                "plenoptic sparse lighting (counting)",
+                true,
+            ),
+        ],
+    };
     let sampler = device.create_sampler(&SamplerDescriptor {
         label: Some("plenoptic lookup kernel gathers"),
         ..default()
     });
     commands.insert_resource(LookupPipelines {
         layout,
-        plain,
-        counting,
+        kernels,
         sampler,
     });
 }
 
+/// Records the lookup kernel's dispatches for `fill` into `pass` (the sparse lighting's second
+/// pass after the first where the fill has it), with the fill's own bind group `own` and
+/// `workgroups` groups; nothing until its pipelines are compiled and its bindings on the GPU.
+pub(super) fn dispatch_lookups(
+    pass: &mut ComputePass,
+    (fill, own, workgroups): (&ScreenFill, &BindGroup, u32),
+    (pipelines, pipeline_cache): (&LookupPipelines, &PipelineCache),
+    assets: (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
+    device: &RenderDevice,
+) {
+    let counting = usize::from(fill.counting);
+    let get = |id: CachedComputePipelineId| pipeline_cache.get_compute_pipeline(id);
+    let (Some(lookups), Some(interpolate), Some(material)) = (
+        get(pipelines.kernels.lookups[counting]),
+        get(pipelines.kernels.interpolate[counting]),
+        material_group(fill, (pipelines, pipeline_cache), assets, device),
+    ) else {
+        return;
+    };
+    pass.set_bind_group(0, own, &[]);
+    pass.set_bind_group(1, &material, &[]);
+    pass.set_pipeline(lookups);
+    pass.dispatch_workgroups(workgroups, 1, 1);
+    if fill.sparse {
+        pass.set_pipeline(interpolate);
+        pass.dispatch_workgroups(workgroups, 1, 1);
+    }
+}
+
 /// The kernel's group 1 for `fill`: the keys, volumes, view buffer, counters and blended keys
 /// the camera's materials bind; `None` until all are on the GPU.
-pub(super) fn material_group(
+fn material_group(
     fill: &ScreenFill,
     (pipelines, pipeline_cache): (&LookupPipelines, &PipelineCache),
     (buffers, images): (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),

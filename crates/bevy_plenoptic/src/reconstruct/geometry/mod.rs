@@ -104,6 +104,7 @@ impl Plugin for GeometryAssistedPlugin {
         bevy::shader::load_shader_library!(app, "bindings.wgsl");
         bevy::shader::load_shader_library!(app, "material.wgsl");
         bevy::shader::load_shader_library!(app, "lookup.wgsl");
+        bevy::shader::load_shader_library!(app, "fallback.wgsl");
         bevy::shader::load_shader_library!(app, "fill.wgsl");
         bevy::shader::load_shader_library!(app, "bsdf.wgsl");
         bevy::shader::load_shader_library!(app, "sun.wgsl");

@@ -75,7 +75,7 @@ mod tests {
         let specular = include_str!("specular.wgsl");
         let line = format!("const RAY_OFFSET: f32 = {RAY_OFFSET:?};");
         assert!(specular.contains(&line), "specular.wgsl lacks `{line}`");
-        let lookup = include_str!("lookup.wgsl");
+        let fallback = include_str!("fallback.wgsl");
         for line in [
             format!(
                 "const NEIGHBOUR_TEXELS: i32 = {};",
@@ -86,7 +86,7 @@ mod tests {
                 plenoptic_recon::NEIGHBOUR_TOLERANCE
             ),
         ] {
-            assert!(lookup.contains(&line), "lookup.wgsl lacks `{line}`");
+            assert!(fallback.contains(&line), "fallback.wgsl lacks `{line}`");
         }
         let line = format!(
             "lamps: array<vec4<f32>, {}>,",

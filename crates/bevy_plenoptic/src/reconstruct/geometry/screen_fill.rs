@@ -22,7 +22,8 @@
 //!
 //! With the lookup kernel ([`super::lookup_kernel`], off by default) the fragments make no
 //! lookups at all: every opaque fragment appends a record, the lookup kernel answers the
-//! records it can and writes their entries, and the fill kernel fills the rest.
+//! records it can and writes their entries (with the sparse lighting in two passes, the
+//! anchors' then the pixels between them), and the fill kernel fills the rest.
 //!
 //! The fill needs the camera's [`DepthPrepass`] (every [`PlenopticCamera`] requires one), on a
 //! device that forces early depth tests ([`EarlyDepthSupport`]): a fragment writes its entry
@@ -58,7 +59,7 @@ use bevy::render::view::ExtractedView;
 use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
-use super::lookup_kernel::{LookupPipelines, material_group};
+use super::lookup_kernel::{LookupPipelines, dispatch_lookups};
 use super::view::ViewBuffer;
 use crate::camera::PlenopticCamera;
 use crate::reconstruct::counters::CounterBuffer;
@@ -100,6 +101,9 @@ pub struct ScreenFill {
     pub entries: Handle<ShaderBuffer>,
     /// The hole list: a header and room for a [`HOLE_SHARE`] of the pixels' records.
     pub holes: Handle<ShaderBuffer>,
+    /// The sparse lighting's anchor cells, one per 2 × 2 pixels (16 bytes each; a
+    /// placeholder without the lookup kernel).
+    pub anchors: Handle<ShaderBuffer>,
     /// The viewport's size in pixels; zero while the camera uses the fragment fill.
     pub size: UVec2,
     /// The ring search's largest radius (`ReconSettings::hole_fill_radius`).
@@ -116,6 +120,11 @@ pub struct ScreenFill {
     /// Whether the opaque fragments leave their lookups to the lookup kernel
     /// ([`PlenopticSettings::lookup_kernel`]).
     pub kernel: bool,
+    /// Whether the lookup kernel looks materials' lighting up at a quarter of the pixels and
+    /// interpolates the rest ([`ReconSettings::sparse_lighting`]; only with `kernel`).
+    ///
+    /// [`ReconSettings::sparse_lighting`]: plenoptic_recon::ReconSettings::sparse_lighting
+    pub sparse: bool,
     /// What the lookup kernel reads beside the keys: the pack's volume samples and bins, and
     /// the camera's blended keys.
     pub lookups: Option<LookupBindings>,
@@ -147,6 +156,11 @@ fn pixels_of(size: UVec2) -> u64 {
     u64::from(size.x) * u64::from(size.y)
 }
 
+/// The sparse lighting's anchor cells of a viewport of `size`: one per 2 × 2 pixels.
+fn anchors_of(size: UVec2) -> u64 {
+    pixels_of((size + 1) / 2)
+}
+
 /// The records a viewport of `size` has room for in its hole list: a [`HOLE_SHARE`] of its
 /// pixels, or with the lookup `kernel` one per pixel and a [`HOLE_SHARE`] more (MSAA gives an
 /// edge pixel two fragments); at least one.
@@ -167,6 +181,7 @@ pub(super) struct FillParams {
     offset: UVec2,
     radius: u32,
     exposure: f32,
+    sparse: u32,
     eye: Vec4,
 }
 
@@ -182,6 +197,7 @@ impl FillParams {
                 .map_or(UVec2::ZERO, |v| v.physical_position),
             radius: fill.radius,
             exposure: camera.exposure,
+            sparse: u32::from(fill.sparse),
         }
     }
 }
@@ -258,17 +274,24 @@ pub(super) fn prepare_screen_fill(
         let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
             let pixels = pixels_of(size);
             let list = LIST_HEADER_BYTES + list_room(size, kernel) * RECORD_BYTES;
-            let buffer = |bytes: u64| {
-                ShaderBuffer::with_size(bytes as usize, RenderAssetUsages::RENDER_WORLD)
+            let anchors = if kernel { anchors_of(size) } else { 0 };
+            let mut buffer = |bytes: u64| {
+                let bytes = bytes.max(ENTRY_BYTES) as usize;
+                buffers.add(ShaderBuffer::with_size(
+                    bytes,
+                    RenderAssetUsages::RENDER_WORLD,
+                ))
             };
             [
-                buffers.add(buffer((pixels * ENTRY_BYTES).max(ENTRY_BYTES))),
-                buffers.add(buffer(list)),
+                buffer(pixels * ENTRY_BYTES),
+                buffer(list),
+                buffer(anchors * ENTRY_BYTES),
             ]
         };
-        let wanted = |[entries, holes]: [Handle<ShaderBuffer>; 2]| ScreenFill {
+        let wanted = |[entries, holes, anchors]: [Handle<ShaderBuffer>; 3]| ScreenFill {
             entries,
             holes,
+            anchors,
             size,
             radius: cam.settings.hole_fill_radius,
             keys: view.keys.clone(),
@@ -276,6 +299,7 @@ pub(super) fn prepare_screen_fill(
             counters: counters.buffer.clone(),
             counting: settings.cost_counters,
             kernel,
+            sparse: kernel && cam.settings.sparse_lighting,
             lookups: volumes
                 .0
                 .get(&cam.pack.id())
@@ -293,7 +317,7 @@ pub(super) fn prepare_screen_fill(
             }
             Some(mut f) => {
                 let handles = if f.size == size && f.kernel == kernel {
-                    [f.entries.clone(), f.holes.clone()]
+                    [f.entries.clone(), f.holes.clone(), f.anchors.clone()]
                 } else {
                     new_buffers(&mut buffers)
                 };
@@ -311,6 +335,8 @@ pub(super) fn prepare_screen_fill(
 fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
     a.entries == b.entries
         && a.holes == b.holes
+        && a.anchors == b.anchors
+        && a.sparse == b.sparse
         && a.size == b.size
         && a.radius == b.radius
         && a.keys == b.keys
@@ -331,7 +357,7 @@ struct FillPipelines {
 }
 
 /// The layout of the fill's own bindings (group 0 of its kernels): the entries (which the
-/// lookup kernel writes), the uniform and the hole list.
+/// lookup kernel writes), the uniform, the hole list and the sparse lighting's anchors.
 pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
     BindGroupLayoutDescriptor::new(
         "plenoptic screen fill",
@@ -340,6 +366,7 @@ pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
             (
                 storage_buffer_sized(false, None),
                 uniform_buffer::<FillParams>(false),
+                storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
             ),
         ),
@@ -427,6 +454,11 @@ fn clear_entries(
     let encoder = ctx.command_encoder();
     encoder.clear_buffer(&entries.buffer, 0, None);
     encoder.clear_buffer(&holes.buffer, 0, Some(LIST_HEADER_BYTES));
+    if fill.sparse
+        && let Some(anchors) = buffers.get(&fill.anchors)
+    {
+        encoder.clear_buffer(&anchors.buffer, 0, None);
+    }
 }
 
 /// A view's bind groups for the kernel (its own, the lookups'); `None` until
@@ -452,6 +484,7 @@ fn bind_groups(
             entries.buffer.as_entire_binding(),
             uniform.binding()?,
             buffers.get(&fill.holes)?.buffer.as_entire_binding(),
+            buffers.get(&fill.anchors)?.buffer.as_entire_binding(),
         )),
     );
     let material = device.create_bind_group(
@@ -515,20 +548,14 @@ fn fill_holes(
     // The lookup kernel first: its answered records' entries are what the ring search reads.
     if fill.kernel
         && let Some(lookup) = lookup.as_deref()
-        && let (Some(kernel), Some(material)) = (
-            pipeline_cache.get_compute_pipeline(lookup.id(fill.counting)),
-            material_group(
-                fill,
-                (lookup, &pipeline_cache),
-                (&buffers, &images),
-                &device,
-            ),
-        )
     {
-        pass.set_pipeline(kernel);
-        pass.set_bind_group(0, &groups[0], &[]);
-        pass.set_bind_group(1, &material, &[]);
-        pass.dispatch_workgroups(workgroups, 1, 1);
+        dispatch_lookups(
+            &mut pass,
+            (fill, &groups[0], workgroups),
+            (lookup, &pipeline_cache),
+            (&buffers, &images),
+            &device,
+        );
     }
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &groups[0], &[]);

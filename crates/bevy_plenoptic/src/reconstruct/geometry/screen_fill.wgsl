@@ -4,26 +4,32 @@
 // at once. A hole takes the nearest ring of pixels (radius 1 to `radius`) holding answered
 // pixels of its own object, averages their terms and shades them with its own albedo and
 // non-diffuse weight; where no ring has one, its object's nearby
-// texels around its lookups, else the heaviest key's texel (lookup.wgsl's fallbacks, as its
+// texels around its lookups, else the heaviest key's texel (fallback.wgsl's, as its
 // fragment would take them). What its fragment added comes on top, and the colour is written
 // over the hole's record, which the composite pass (fill_composite.wgsl) draws into the
 // view's target. No pixel's lookups are computed again: a ring pixel costs one 16-byte load.
+//
+// Before it, with the lookup kernel, the records' lookups (lookup_records) and the sparse
+// lighting's interpolation between them (interpolate_records).
 //
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
 #import plenoptic::fill_entry::{
     HoleList, FillParams, HOLE_NON_DIFFUSE, HOLE_MATERIAL, OBJECT_BITS, unpack_pair, pack_pair,
-    ring_step, unpack_normal, RECORD_HOLE, RECORD_LOOKUP, RECORD_ANSWERED,
+    ring_step, unpack_normal, HoleRecord, RECORD_HOLE, RECORD_LOOKUP, RECORD_ANSWERED, RECORD_SPARSE,
 }
-#import plenoptic::geometry::lookup::{
-    Weighted, nearby_texels, heaviest_texel, direct_lookups_at, volume_lookups,
-}
-#import plenoptic::geometry::bindings::{point_slot, point_material, face_normal}
+#import plenoptic::geometry::lookup::{Weighted, direct_lookups_at, volume_lookups, lookup_accepted}
+#import plenoptic::geometry::fallback::{nearby_texels, heaviest_texel}
+#import plenoptic::geometry::bindings::{cam, point_slot, point_material, face_normal}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16, C_LOADS_4, C_FILL}
 
 @group(0) @binding(0) var<storage, read_write> entries: array<vec4<u32>>;
 @group(0) @binding(1) var<uniform> fill: FillParams;
 @group(0) @binding(2) var<storage, read_write> holes: HoleList;
+// The sparse lighting's anchors (the pixels of even row and column), one cell each: the keys
+// its direct lookups accepted (lookup.wgsl's lookup_accepted; 0: none), its distance from
+// the eye, its packed face normal and its object + 1. Cleared each frame.
+@group(0) @binding(3) var<storage, read_write> anchors: array<vec4<u32>>;
 // Threads per workgroup of fill_holes.
 const GROUP: u32 = 64u;
 
@@ -60,47 +66,189 @@ fn ring_mean(c: vec2<i32>, tag: u32) -> Weighted {
     return Weighted(mat2x3<f32>(), 0.0);
 }
 
+// The pixel of `record`, in the viewport.
+fn record_pixel(record: HoleRecord) -> vec2<u32> {
+    return vec2<u32>(record.pixel % fill.size.x, record.pixel / fill.size.x);
+}
+
+// The lookups' private state for `record`: its motion slot, material and face normal.
+fn begin_record(record: HoleRecord) {
+    point_slot = i32(record.local.w);
+    point_material = (record.tag & HOLE_MATERIAL) != 0u;
+    face_normal = unpack_normal(record.normal);
+}
+
+// The lookups of `record` (begin_record's): its direct lookups, else the temporal volumes,
+// normalized and times the exposure; w = 0 where none answers. An `anchor` of the sparse
+// lighting also leaves its cell for its neighbours (what its direct lookups accepted).
+fn record_lookups(record: HoleRecord, anchor: bool) -> Weighted {
+    let object = record.tag & OBJECT_BITS;
+    let p = record.world.xyz;
+    var got = direct_lookups_at(vec4<f32>(record.local.xyz, 1.0), p, fill.eye.xyz, object - 1u);
+    if anchor {
+        let signature = select(0u, lookup_accepted, got.w > 0.0);
+        let dist = distance(p, fill.eye.xyz);
+        let a = record_pixel(record) / 2u;
+        anchors[a.y * anchor_size().x + a.x] = vec4<u32>(signature, bitcast<u32>(dist), record.normal, object);
+    }
+    if got.w <= 0.0 {
+        got = volume_lookups(p, object - 1u);
+    }
+    if got.w <= 0.0 {
+        return Weighted(mat2x3<f32>(), 0.0);
+    }
+    return Weighted(got.terms * (fill.exposure / got.w), 1.0);
+}
+
+// Record i's answer `got` (terms times the exposure) for its `pixel`, `tag` and `pair`: its
+// terms into its pixel's entry, where the fill kernel's ring search reads them, and its
+// colour (shaded with the record's albedo and non-diffuse weight, plus what its fragment
+// added) over its record; with w = 0 the record becomes a hole (RECORD_HOLE) for fill_holes.
+fn answer(i: u32, pixel: u32, tag: u32, pair: vec3<u32>, got: Weighted) {
+    if got.w <= 0.0 {
+        tally(C_FILL, 1u);
+        holes.records[i].state = RECORD_HOLE;
+        return;
+    }
+    entries[pixel] = vec4<u32>(pack_pair(got.terms[0], got.terms[1]), tag & OBJECT_BITS);
+    let own = unpack_pair(pair);
+    let nd = select(0.0, 1.0, (tag & HOLE_NON_DIFFUSE) != 0u);
+    let colour = own[1] * got.terms[0] + got.terms[1] * nd + own[0];
+    holes.records[i].pair = pack_pair(colour, vec3<f32>(0.0));
+    holes.records[i].state = RECORD_ANSWERED;
+}
+
+// Whether pixel `p` of a record shaded from its `material` is left to interpolate_records.
+fn sparse_pixel(p: vec2<u32>, material: bool) -> bool {
+    return fill.sparse != 0u && material && any((p & vec2<u32>(1u)) != vec2<u32>(0u));
+}
+
 // The lookups of the records the opaque fragments left to it (RECORD_LOOKUP; thesis
 // §8.2.3's direct lookups, else the temporal volumes, lookup.wgsl's as a fragment makes
-// them), one thread per record: an answered point's terms go into its pixel's entry, where
-// the fill kernel's ring search reads them, and its colour (shaded with the record's albedo
-// and non-diffuse weight, plus what its fragment added) over its record; a point nothing
-// answers becomes a hole (RECORD_HOLE) for fill_holes.
+// them), one thread per record. With the sparse lighting, a record shaded from its material
+// off the anchors (even row and column) is left to interpolate_records (RECORD_SPARSE),
+// having read its state, tag and pixel only. A record's 64 bytes count as four 16-byte loads.
 @compute @workgroup_size(GROUP, 1, 1)
 fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     if i >= listed() {
         return;
     }
-    tally(C_LOADS_16, 4u);
-    let record = holes.records[i];
-    if record.state != RECORD_LOOKUP {
+    tally(C_LOADS_16, 1u);
+    if holes.records[i].state != RECORD_LOOKUP {
         return;
     }
-    let object = (record.tag & OBJECT_BITS) - 1u;
-    point_slot = i32(record.local.w);
-    point_material = (record.tag & HOLE_MATERIAL) != 0u;
-    face_normal = unpack_normal(record.normal);
-    let p = record.world.xyz;
-    var got = direct_lookups_at(vec4<f32>(record.local.xyz, 1.0), p, fill.eye.xyz, object);
-    if got.w <= 0.0 {
-        got = volume_lookups(p, object);
+    let tag = holes.records[i].tag;
+    tally(C_LOADS_16, 1u);
+    let p = vec2<u32>(holes.records[i].pixel % fill.size.x, holes.records[i].pixel / fill.size.x);
+    let px = vec2<f32>(fill.offset + p);
+    let material = (tag & HOLE_MATERIAL) != 0u;
+    if sparse_pixel(p, material) {
+        holes.records[i].state = RECORD_SPARSE;
+    } else {
+        tally(C_LOADS_16, 2u);
+        let record = holes.records[i];
+        begin_record(record);
+        let anchor = fill.sparse != 0u && material;
+        answer(i, record.pixel, record.tag, record.pair, record_lookups(record, anchor));
     }
-    let px = vec2<f32>(fill.offset + vec2<u32>(record.pixel % fill.size.x, record.pixel / fill.size.x));
-    if got.w <= 0.0 {
-        tally(C_FILL, 1u);
-        holes.records[i].state = RECORD_HOLE;
-        flush_kernel_counters(px);
-        return;
-    }
-    let terms = got.terms * (fill.exposure / got.w);
-    entries[record.pixel] = vec4<u32>(pack_pair(terms[0], terms[1]), object + 1u);
-    let own = unpack_pair(record.pair);
-    let nd = select(0.0, 1.0, (record.tag & HOLE_NON_DIFFUSE) != 0u);
-    let colour = own[1] * terms[0] + terms[1] * nd + own[0];
-    holes.records[i].pair = pack_pair(colour, vec3<f32>(0.0));
-    holes.records[i].state = RECORD_ANSWERED;
     flush_kernel_counters(px);
+}
+
+// plenoptic_recon's sparse CREASE: anchors whose triangles' normals differ by more than about
+// 6° lie on both sides of a crease.
+const CREASE: f32 = 0.995;
+
+// The anchors' grid: one per 2 × 2 pixels, rounded up.
+fn anchor_size() -> vec2<u32> {
+    return (fill.size + 1u) / 2u;
+}
+
+// Whether every key of signature `s` that answered kept all four of its bilinear taps.
+fn whole(s: u32) -> bool {
+    let even = 0x55555555u;
+    return (s & even) == ((s >> 1u) & even);
+}
+
+// The terms of pixel `p` (of `object` + 1, at `dist` from the eye) from the two or four
+// anchors around it (plenoptic_recon's Anchors::interpolate, the same rules): their mean where
+// each shows the object, answered by the same keys with all their taps, their triangles
+// facing the same way and the pixel within half the depth tolerance of their mean distance;
+// w = 0 where the pixel must be looked up itself. Two loads per anchor: its cell and entry.
+fn interpolated(p: vec2<u32>, object: u32, dist: f32) -> Weighted {
+    let none = Weighted(mat2x3<f32>(), 0.0);
+    let a = p / 2u;
+    let span = 1u + p % 2u;
+    let size = anchor_size();
+    if any(a + span > size) {
+        return none;
+    }
+    var signature = 0u;
+    var normal = vec3<f32>(0.0);
+    var sum = mat2x3<f32>();
+    var d = 0.0;
+    for (var j = 0u; j < span.y; j++) {
+        for (var i = 0u; i < span.x; i++) {
+            let q = a + vec2<u32>(i, j);
+            tally(C_LOADS_16, 1u);
+            let c = anchors[q.y * size.x + q.x];
+            let n = unpack_normal(c.z);
+            if i + j == 0u {
+                signature = c.x;
+                normal = n;
+                if signature == 0u || !whole(signature) {
+                    return none;
+                }
+            }
+            if c.x != signature || c.w != object || abs(dot(n, normal)) < CREASE {
+                return none;
+            }
+            tally(C_LOADS_16, 1u);
+            let e = entries[2u * q.y * fill.size.x + 2u * q.x];
+            if e.w != object {
+                return none;
+            }
+            sum += unpack_pair(e.xyz);
+            d += bitcast<f32>(c.y);
+        }
+    }
+    let k = 1.0 / f32(span.x * span.y);
+    if abs(d * k - dist) > 0.5 * cam.depth_tolerance * dist {
+        return none;
+    }
+    return Weighted(sum * k, 1.0);
+}
+
+// The sparse lighting's second pass (ReconSettings::sparse_lighting, plenoptic_recon's
+// geometry::sparse), after lookup_records: each record it left (RECORD_SPARSE) takes its
+// anchors' mean where they stand for its own lookups (reading its pixel, tag, colours and
+// world point), else reads the rest of its record and makes its own lookups, so that object
+// edges, creases and depth steps stay at full resolution.
+@compute @workgroup_size(GROUP, 1, 1)
+fn interpolate_records(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= listed() {
+        return;
+    }
+    tally(C_LOADS_16, 1u);
+    if holes.records[i].state != RECORD_SPARSE {
+        return;
+    }
+    let tag = holes.records[i].tag;
+    tally(C_LOADS_16, 2u);
+    let pixel = holes.records[i].pixel;
+    let pair = holes.records[i].pair;
+    let world = holes.records[i].world.xyz;
+    let p = vec2<u32>(pixel % fill.size.x, pixel / fill.size.x);
+    var got = interpolated(p, tag & OBJECT_BITS, distance(world, fill.eye.xyz));
+    if got.w <= 0.0 {
+        tally(C_LOADS_16, 1u);
+        let record = holes.records[i];
+        begin_record(record);
+        got = record_lookups(record, false);
+    }
+    answer(i, pixel, tag, pair, got);
+    flush_kernel_counters(vec2<f32>(fill.offset + p));
 }
 
 @compute @workgroup_size(GROUP, 1, 1)
