@@ -79,7 +79,9 @@ pub struct ReconSettings {
     /// (`geometry/sparse.rs`); every other pixel is looked up itself. The lighting is at cube
     /// resolution, so this changes the test room's lighting by 0.04 % on average; the textured
     /// frame of benches/recon.rs takes 0.84× the time at 640 × 360 (`geometry_textured`
-    /// against `geometry_textured_dense`). The plugin's GPU path looks up every fragment.
+    /// against `geometry_textured_dense`). The plugin's lookup kernel follows the same rule
+    /// (`bevy_plenoptic`'s `lookup_kernel.rs`); fragments that make their own lookups make
+    /// them at every pixel.
     pub sparse_lighting: bool,
     /// With [`Specular::Marched`] on a pack with proxies: a reflected ray that meets a proxy
     /// is answered at that point ([`crate::specular`]), and on a pack with materials the

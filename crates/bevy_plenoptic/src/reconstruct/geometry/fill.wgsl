@@ -117,7 +117,7 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
             tag |= HOLE_NON_DIFFUSE;
         }
     }
-    fill_entries[i] = vec4<u32>(0u, 0u, 0u, object | HOLE);
+    fill_entries[i] = vec4<u32>(hole_index, 0u, 0u, object | HOLE);
     let r = &hole_list.records[hole_index];
     (*r).state = select(RECORD_HOLE, RECORD_LOOKUP, entry_kind == ENTRY_LOOKUP);
     (*r).normal = pack_normal(face_normal);

@@ -3,7 +3,8 @@
 // kernel (screen_fill.wgsl). Per pixel an entry of 16 bytes:
 // - a pixel its lookups answered: its terms (lighting and non-diffuse, or radiance and 0;
 //   lookup.wgsl's Weighted) times the camera's exposure (xyz), its object + 1 (w);
-// - a hole: its object + 1 with HOLE (w);
+// - a hole, or a point left to the lookup kernel: its record's index in the hole list (x),
+//   its object + 1 with HOLE (w);
 // - nothing drawn there: 0.
 // Per hole fragment a record in the camera's hole list (HoleRecord), appended by the fragment.
 // With MSAA two fragments may share a pixel and its entry (the last write stays); a record is

@@ -32,26 +32,77 @@
 
 use bevy::asset::load_embedded_asset;
 use bevy::prelude::*;
+use bevy::render::diagnostic::{DiagnosticsRecorder, RecordDiagnostics};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
     sampler, storage_buffer_read_only_sized, storage_buffer_sized, texture_2d_array,
 };
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
-    CachedComputePipelineId, ComputePass, PipelineCache, Sampler, SamplerBindingType,
-    SamplerDescriptor, ShaderStages, TextureSampleType,
+    CachedComputePipelineId, CommandEncoder, ComputePassDescriptor, ComputePipeline, PipelineCache,
+    Sampler, SamplerBindingType, SamplerDescriptor, ShaderStages, TextureSampleType,
 };
 use bevy::render::renderer::RenderDevice;
-use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
 use bevy::render::texture::GpuImage;
 
 use super::screen_fill::{ScreenFill, own_layout, queue_kernel};
 
-/// The kernel's pipelines, without and with the cost counters: its lookups' and the sparse
-/// lighting's interpolation.
+/// The kernel's pipelines, without and with the cost counters: its lookups', the sparse
+/// lighting's anchors' and its interpolation's.
 struct Kernels {
     lookups: [CachedComputePipelineId; 2],
+    anchors: [CachedComputePipelineId; 2],
     interpolate: [CachedComputePipelineId; 2],
+    listed: [CachedComputePipelineId; 2],
+}
+
+/// Threads per workgroup side of `anchor_lookups` (`screen_fill.wgsl`'s `ANCHOR_GROUP`).
+const ANCHOR_GROUP: u32 = 8;
+
+/// Bytes of an anchor's cell (`screen_fill.wgsl`'s `anchors`) and of the work list's header.
+const CELL_BYTES: u64 = 16;
+const WORK_HEADER_BYTES: u64 = 16;
+
+/// A camera's buffers for the sparse lighting, beside the screen fill's: the anchors' cells
+/// (one per 2 × 2 pixels) and the work list, the indices of the records whose lookups are
+/// made in a pass of their own (`screen_fill.wgsl`'s `WorkList`, room for every record).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SparseBuffers {
+    /// The anchors' cells, 16 bytes each.
+    pub anchors: Handle<ShaderBuffer>,
+    /// The work list: a count, then one record index per entry.
+    pub work: Handle<ShaderBuffer>,
+}
+
+impl SparseBuffers {
+    /// The buffers of a viewport of `size` whose hole list has `room` records, made by
+    /// `buffer` (from a size in bytes); placeholders where the lookup `kernel` is off.
+    pub(super) fn new(
+        size: UVec2,
+        room: u64,
+        kernel: bool,
+        mut buffer: impl FnMut(u64) -> Handle<ShaderBuffer>,
+    ) -> Self {
+        let cells = u64::from(size.x.div_ceil(2)) * u64::from(size.y.div_ceil(2));
+        let (cells, room) = if kernel { (cells, room) } else { (0, 0) };
+        SparseBuffers {
+            anchors: buffer(cells * CELL_BYTES),
+            work: buffer(WORK_HEADER_BYTES + room * 4),
+        }
+    }
+
+    /// Clears the anchors' cells and the work list's count, before a frame's opaque pass.
+    pub(super) fn clear(
+        &self,
+        encoder: &mut CommandEncoder,
+        buffers: &RenderAssets<GpuShaderBuffer>,
+    ) {
+        if let (Some(anchors), Some(work)) = (buffers.get(&self.anchors), buffers.get(&self.work)) {
+            encoder.clear_buffer(&anchors.buffer, 0, None);
+            encoder.clear_buffer(&work.buffer, 0, Some(WORK_HEADER_BYTES));
+        }
+    }
 }
 
 /// The kernel's pipelines, the layout of the materials' bindings it reads (group 1; group 0
@@ -98,11 +149,27 @@ pub(super) fn init_pipelines(
             pipeline("lookup_records", "plenoptic lookup kernel", false),
             pipeline("lookup_records", "plenoptic lookup kernel (counting)", true),
         ],
+        anchors: [
+            pipeline("anchor_lookups", "plenoptic sparse lighting anchors", false),
+            pipeline(
+                "anchor_lookups",
+                "plenoptic sparse lighting anchors (counting)",
+                true,
+            ),
+        ],
         interpolate: [
             pipeline("interpolate_records", "plenoptic sparse lighting", false),
             pipeline(
                 "interpolate_records",
                 "plenoptic sparse lighting (counting)",
+                true,
+            ),
+        ],
+        listed: [
+            pipeline("listed_lookups", "plenoptic listed lookups", false),
+            pipeline(
+                "listed_lookups",
+                "plenoptic listed lookups (counting)",
                 true,
             ),
         ],
@@ -118,11 +185,14 @@ pub(super) fn init_pipelines(
     });
 }
 
-/// Records the lookup kernel's dispatches for `fill` into `pass` (the sparse lighting's second
-/// pass after the first where the fill has it), with the fill's own bind group `own` and
-/// `workgroups` groups; nothing until its pipelines are compiled and its bindings on the GPU.
+/// Records the lookup kernel's compute passes for `fill` into `encoder`, each with a span of
+/// the render `diagnostics` (`plenoptic/lookups`; where the fill has the sparse lighting,
+/// `plenoptic/sparse_anchors`, `plenoptic/sparse_interpolate` and `plenoptic/sparse_lookups`
+/// after it), with the fill's
+/// own bind group `own` and `workgroups` groups over the records; nothing until its pipelines
+/// are compiled and its bindings on the GPU.
 pub(super) fn dispatch_lookups(
-    pass: &mut ComputePass,
+    (encoder, diagnostics): (&mut CommandEncoder, Option<&DiagnosticsRecorder>),
     (fill, own, workgroups): (&ScreenFill, &BindGroup, u32),
     (pipelines, pipeline_cache): (&LookupPipelines, &PipelineCache),
     assets: (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
@@ -130,20 +200,40 @@ pub(super) fn dispatch_lookups(
 ) {
     let counting = usize::from(fill.counting);
     let get = |id: CachedComputePipelineId| pipeline_cache.get_compute_pipeline(id);
-    let (Some(lookups), Some(interpolate), Some(material)) = (
-        get(pipelines.kernels.lookups[counting]),
-        get(pipelines.kernels.interpolate[counting]),
+    let k = &pipelines.kernels;
+    let (Some(lookups), Some(anchors), Some(interpolate), Some(listed), Some(material)) = (
+        get(k.lookups[counting]),
+        get(k.anchors[counting]),
+        get(k.interpolate[counting]),
+        get(k.listed[counting]),
         material_group(fill, (pipelines, pipeline_cache), assets, device),
     ) else {
         return;
     };
-    pass.set_bind_group(0, own, &[]);
-    pass.set_bind_group(1, &material, &[]);
-    pass.set_pipeline(lookups);
-    pass.dispatch_workgroups(workgroups, 1, 1);
+    let mut stage = |name: &'static str, pipeline: &ComputePipeline, grid: UVec2| {
+        let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
+            label: Some(name),
+            ..default()
+        });
+        let span = diagnostics.pass_span(&mut pass, name);
+        pass.set_bind_group(0, own, &[]);
+        pass.set_bind_group(1, &material, &[]);
+        pass.set_pipeline(pipeline);
+        pass.dispatch_workgroups(grid.x, grid.y, 1);
+        span.end(&mut pass);
+    };
+    let records = UVec2::new(workgroups, 1);
+    stage("plenoptic/lookups", lookups, records);
     if fill.sparse {
-        pass.set_pipeline(interpolate);
-        pass.dispatch_workgroups(workgroups, 1, 1);
+        // One thread per anchor, the pixels of even row and column.
+        let side = 2 * ANCHOR_GROUP;
+        stage(
+            "plenoptic/sparse_anchors",
+            anchors,
+            (fill.size + (side - 1)) / side,
+        );
+        stage("plenoptic/sparse_interpolate", interpolate, records);
+        stage("plenoptic/sparse_lookups", listed, records);
     }
 }
 

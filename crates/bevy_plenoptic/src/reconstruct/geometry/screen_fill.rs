@@ -59,7 +59,7 @@ use bevy::render::view::ExtractedView;
 use bevy::render::{RenderApp, RenderStartup};
 use bevy::shader::ShaderDefVal;
 
-use super::lookup_kernel::{LookupPipelines, dispatch_lookups};
+use super::lookup_kernel::{LookupPipelines, SparseBuffers, dispatch_lookups};
 use super::view::ViewBuffer;
 use crate::camera::PlenopticCamera;
 use crate::reconstruct::counters::CounterBuffer;
@@ -101,9 +101,9 @@ pub struct ScreenFill {
     pub entries: Handle<ShaderBuffer>,
     /// The hole list: a header and room for a [`HOLE_SHARE`] of the pixels' records.
     pub holes: Handle<ShaderBuffer>,
-    /// The sparse lighting's anchor cells, one per 2 × 2 pixels (16 bytes each; a
-    /// placeholder without the lookup kernel).
-    pub anchors: Handle<ShaderBuffer>,
+    /// The sparse lighting's anchor cells and work list (placeholders without the lookup
+    /// kernel).
+    pub sparse_buffers: SparseBuffers,
     /// The viewport's size in pixels; zero while the camera uses the fragment fill.
     pub size: UVec2,
     /// The ring search's largest radius (`ReconSettings::hole_fill_radius`).
@@ -154,11 +154,6 @@ impl ScreenFill {
 /// The pixels of a viewport of `size`.
 fn pixels_of(size: UVec2) -> u64 {
     u64::from(size.x) * u64::from(size.y)
-}
-
-/// The sparse lighting's anchor cells of a viewport of `size`: one per 2 × 2 pixels.
-fn anchors_of(size: UVec2) -> u64 {
-    pixels_of((size + 1) / 2)
 }
 
 /// The records a viewport of `size` has room for in its hole list: a [`HOLE_SHARE`] of its
@@ -272,9 +267,7 @@ pub(super) fn prepare_screen_fill(
             _ => UVec2::ZERO,
         };
         let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
-            let pixels = pixels_of(size);
             let list = LIST_HEADER_BYTES + list_room(size, kernel) * RECORD_BYTES;
-            let anchors = if kernel { anchors_of(size) } else { 0 };
             let mut buffer = |bytes: u64| {
                 let bytes = bytes.max(ENTRY_BYTES) as usize;
                 buffers.add(ShaderBuffer::with_size(
@@ -282,16 +275,18 @@ pub(super) fn prepare_screen_fill(
                     RenderAssetUsages::RENDER_WORLD,
                 ))
             };
-            [
-                buffer(pixels * ENTRY_BYTES),
-                buffer(list),
-                buffer(anchors * ENTRY_BYTES),
-            ]
+            let (entries, holes) = (buffer(pixels_of(size) * ENTRY_BYTES), buffer(list));
+            let room = list_room(size, kernel);
+            (
+                entries,
+                holes,
+                SparseBuffers::new(size, room, kernel, buffer),
+            )
         };
-        let wanted = |[entries, holes, anchors]: [Handle<ShaderBuffer>; 3]| ScreenFill {
+        let wanted = |(entries, holes, sparse_buffers)| ScreenFill {
             entries,
             holes,
-            anchors,
+            sparse_buffers,
             size,
             radius: cam.settings.hole_fill_radius,
             keys: view.keys.clone(),
@@ -317,7 +312,7 @@ pub(super) fn prepare_screen_fill(
             }
             Some(mut f) => {
                 let handles = if f.size == size && f.kernel == kernel {
-                    [f.entries.clone(), f.holes.clone(), f.anchors.clone()]
+                    (f.entries.clone(), f.holes.clone(), f.sparse_buffers.clone())
                 } else {
                     new_buffers(&mut buffers)
                 };
@@ -335,7 +330,7 @@ pub(super) fn prepare_screen_fill(
 fn same_fill(a: &ScreenFill, b: &ScreenFill) -> bool {
     a.entries == b.entries
         && a.holes == b.holes
-        && a.anchors == b.anchors
+        && a.sparse_buffers == b.sparse_buffers
         && a.sparse == b.sparse
         && a.size == b.size
         && a.radius == b.radius
@@ -357,7 +352,8 @@ struct FillPipelines {
 }
 
 /// The layout of the fill's own bindings (group 0 of its kernels): the entries (which the
-/// lookup kernel writes), the uniform, the hole list and the sparse lighting's anchors.
+/// lookup kernel writes), the uniform, the hole list and the sparse lighting's anchors and
+/// work list.
 pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
     BindGroupLayoutDescriptor::new(
         "plenoptic screen fill",
@@ -366,6 +362,7 @@ pub(super) fn own_layout() -> BindGroupLayoutDescriptor {
             (
                 storage_buffer_sized(false, None),
                 uniform_buffer::<FillParams>(false),
+                storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
             ),
@@ -454,10 +451,8 @@ fn clear_entries(
     let encoder = ctx.command_encoder();
     encoder.clear_buffer(&entries.buffer, 0, None);
     encoder.clear_buffer(&holes.buffer, 0, Some(LIST_HEADER_BYTES));
-    if fill.sparse
-        && let Some(anchors) = buffers.get(&fill.anchors)
-    {
-        encoder.clear_buffer(&anchors.buffer, 0, None);
+    if fill.sparse {
+        fill.sparse_buffers.clear(encoder, &buffers);
     }
 }
 
@@ -484,7 +479,14 @@ fn bind_groups(
             entries.buffer.as_entire_binding(),
             uniform.binding()?,
             buffers.get(&fill.holes)?.buffer.as_entire_binding(),
-            buffers.get(&fill.anchors)?.buffer.as_entire_binding(),
+            buffers
+                .get(&fill.sparse_buffers.anchors)?
+                .buffer
+                .as_entire_binding(),
+            buffers
+                .get(&fill.sparse_buffers.work)?
+                .buffer
+                .as_entire_binding(),
         )),
     );
     let material = device.create_bind_group(
@@ -535,8 +537,21 @@ fn fill_holes(
         return;
     };
     // One thread per record of the list's room; those past the holes listed return at once.
-    let diagnostics = ctx.diagnostic_recorder();
-    let diagnostics = diagnostics.as_deref();
+    let recorder = ctx.diagnostic_recorder();
+    let diagnostics = recorder.as_deref();
+    let workgroups = fill.room().div_ceil(GROUP);
+    // The lookup kernel first: its answered records' entries are what the ring search reads.
+    if fill.kernel
+        && let Some(lookup) = lookup.as_deref()
+    {
+        dispatch_lookups(
+            (ctx.command_encoder(), diagnostics),
+            (fill, &groups[0], workgroups),
+            (lookup, &pipeline_cache),
+            (&buffers, &images),
+            &device,
+        );
+    }
     let mut pass = ctx
         .command_encoder()
         .begin_compute_pass(&ComputePassDescriptor {
@@ -544,19 +559,6 @@ fn fill_holes(
             ..default()
         });
     let span = diagnostics.pass_span(&mut pass, "plenoptic/screen_fill");
-    let workgroups = fill.room().div_ceil(GROUP);
-    // The lookup kernel first: its answered records' entries are what the ring search reads.
-    if fill.kernel
-        && let Some(lookup) = lookup.as_deref()
-    {
-        dispatch_lookups(
-            &mut pass,
-            (fill, &groups[0], workgroups),
-            (lookup, &pipeline_cache),
-            (&buffers, &images),
-            &device,
-        );
-    }
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &groups[0], &[]);
     pass.set_bind_group(1, &groups[1], &[]);

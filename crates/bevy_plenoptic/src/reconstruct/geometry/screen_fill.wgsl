@@ -15,7 +15,7 @@
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
 #import plenoptic::fill_entry::{
-    HoleList, FillParams, HOLE_NON_DIFFUSE, HOLE_MATERIAL, OBJECT_BITS, unpack_pair, pack_pair,
+    HoleList, FillParams, HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, OBJECT_BITS, unpack_pair, pack_pair,
     ring_step, unpack_normal, HoleRecord, RECORD_HOLE, RECORD_LOOKUP, RECORD_ANSWERED, RECORD_SPARSE,
 }
 #import plenoptic::geometry::lookup::{Weighted, direct_lookups_at, volume_lookups, lookup_accepted}
@@ -30,6 +30,13 @@
 // its direct lookups accepted (lookup.wgsl's lookup_accepted; 0: none), its distance from
 // the eye, its packed face normal and its object + 1. Cleared each frame.
 @group(0) @binding(3) var<storage, read_write> anchors: array<vec4<u32>>;
+// The sparse lighting's work list: the records whose lookups listed_lookups makes, so that
+// the threads of a group all look up (lookup_kernel.rs's SparseBuffers).
+struct WorkList {
+    count: atomic<u32>,
+    items: array<u32>,
+}
+@group(0) @binding(4) var<storage, read_write> work: WorkList;
 // Threads per workgroup of fill_holes.
 const GROUP: u32 = 64u;
 
@@ -118,16 +125,12 @@ fn answer(i: u32, pixel: u32, tag: u32, pair: vec3<u32>, got: Weighted) {
     holes.records[i].state = RECORD_ANSWERED;
 }
 
-// Whether pixel `p` of a record shaded from its `material` is left to interpolate_records.
-fn sparse_pixel(p: vec2<u32>, material: bool) -> bool {
-    return fill.sparse != 0u && material && any((p & vec2<u32>(1u)) != vec2<u32>(0u));
-}
-
 // The lookups of the records the opaque fragments left to it (RECORD_LOOKUP; thesis
 // §8.2.3's direct lookups, else the temporal volumes, lookup.wgsl's as a fragment makes
-// them), one thread per record. With the sparse lighting, a record shaded from its material
-// off the anchors (even row and column) is left to interpolate_records (RECORD_SPARSE),
-// having read its state, tag and pixel only. A record's 64 bytes count as four 16-byte loads.
+// them), one thread per record. With the sparse lighting this pass only sorts the records,
+// having read their state and tag: one shaded from its material is left to anchor_lookups
+// and interpolate_records (RECORD_SPARSE), any other goes to the work list. A record's 64
+// bytes count as four 16-byte loads.
 @compute @workgroup_size(GROUP, 1, 1)
 fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -138,21 +141,50 @@ fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     if holes.records[i].state != RECORD_LOOKUP {
         return;
     }
-    let tag = holes.records[i].tag;
-    tally(C_LOADS_16, 1u);
-    let p = vec2<u32>(holes.records[i].pixel % fill.size.x, holes.records[i].pixel / fill.size.x);
-    let px = vec2<f32>(fill.offset + p);
-    let material = (tag & HOLE_MATERIAL) != 0u;
-    if sparse_pixel(p, material) {
-        holes.records[i].state = RECORD_SPARSE;
-    } else {
-        tally(C_LOADS_16, 2u);
-        let record = holes.records[i];
-        begin_record(record);
-        let anchor = fill.sparse != 0u && material;
-        answer(i, record.pixel, record.tag, record.pair, record_lookups(record, anchor));
+    if fill.sparse != 0u {
+        if (holes.records[i].tag & HOLE_MATERIAL) != 0u {
+            holes.records[i].state = RECORD_SPARSE;
+        } else {
+            to_work_list(i);
+        }
+        return;
     }
-    flush_kernel_counters(px);
+    tally(C_LOADS_16, 3u);
+    let record = holes.records[i];
+    begin_record(record);
+    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, false));
+    flush_kernel_counters(vec2<f32>(fill.offset + record_pixel(record)));
+}
+
+// Threads per workgroup side of anchor_lookups.
+const ANCHOR_GROUP: u32 = 8u;
+
+// The sparse lighting's anchors (ReconSettings::sparse_lighting; plenoptic_recon's
+// geometry::sparse): one thread per anchor, the pixel of even row and column (2x, 2y), in
+// 8 × 8 groups of neighbouring anchors. Where the pixel's entry names a record left to it
+// (RECORD_SPARSE), the record's lookups are made and its cell written for its neighbours.
+// The records are found through the entries, not in the list's order, so that the threads
+// of a group are anchors side by side, all looking up, and none waits on another's work.
+@compute @workgroup_size(ANCHOR_GROUP, ANCHOR_GROUP, 1)
+fn anchor_lookups(@builtin(global_invocation_id) id: vec3<u32>) {
+    let p = 2u * id.xy;
+    if any(p >= fill.size) {
+        return;
+    }
+    tally(C_LOADS_16, 1u);
+    let e = entries[p.y * fill.size.x + p.x];
+    let i = e.x;
+    if (e.w & HOLE) == 0u || i >= listed() {
+        return;
+    }
+    tally(C_LOADS_16, 4u);
+    let record = holes.records[i];
+    if record.state != RECORD_SPARSE || record.pixel != p.y * fill.size.x + p.x {
+        return;
+    }
+    begin_record(record);
+    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, true));
+    flush_kernel_counters(vec2<f32>(fill.offset + p));
 }
 
 // plenoptic_recon's sparse CREASE: anchors whose triangles' normals differ by more than about
@@ -219,11 +251,12 @@ fn interpolated(p: vec2<u32>, object: u32, dist: f32) -> Weighted {
     return Weighted(sum * k, 1.0);
 }
 
-// The sparse lighting's second pass (ReconSettings::sparse_lighting, plenoptic_recon's
-// geometry::sparse), after lookup_records: each record it left (RECORD_SPARSE) takes its
-// anchors' mean where they stand for its own lookups (reading its pixel, tag, colours and
-// world point), else reads the rest of its record and makes its own lookups, so that object
-// edges, creases and depth steps stay at full resolution.
+// The sparse lighting's second pass, after anchor_lookups: each record left (RECORD_SPARSE:
+// off the anchors, or a second fragment of an anchor's pixel with MSAA, which takes that
+// anchor's lookups as its own where they stand for them) takes its anchors' mean where they
+// stand for its own lookups (reading its pixel, tag, colours and world point), else goes to
+// the work list for its own lookups, so that object edges, creases and depth steps stay at
+// full resolution and a group's threads here never wait on one that looks up.
 @compute @workgroup_size(GROUP, 1, 1)
 fn interpolate_records(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -240,15 +273,37 @@ fn interpolate_records(@builtin(global_invocation_id) id: vec3<u32>) {
     let pair = holes.records[i].pair;
     let world = holes.records[i].world.xyz;
     let p = vec2<u32>(pixel % fill.size.x, pixel / fill.size.x);
-    var got = interpolated(p, tag & OBJECT_BITS, distance(world, fill.eye.xyz));
-    if got.w <= 0.0 {
-        tally(C_LOADS_16, 1u);
-        let record = holes.records[i];
-        begin_record(record);
-        got = record_lookups(record, false);
+    let got = interpolated(p, tag & OBJECT_BITS, distance(world, fill.eye.xyz));
+    if got.w > 0.0 {
+        answer(i, pixel, tag, pair, got);
+    } else {
+        to_work_list(i);
     }
-    answer(i, pixel, tag, pair, got);
     flush_kernel_counters(vec2<f32>(fill.offset + p));
+}
+
+// Appends record `i` to the work list (room for every record, so never past it).
+fn to_work_list(i: u32) {
+    let k = atomicAdd(&work.count, 1u);
+    if k < arrayLength(&work.items) {
+        work.items[k] = i;
+    }
+}
+
+// The sparse lighting's last pass: the lookups of the records on the work list (those
+// without a material, and those their anchors did not stand for), one thread per item.
+@compute @workgroup_size(GROUP, 1, 1)
+fn listed_lookups(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= min(atomicLoad(&work.count), arrayLength(&work.items)) {
+        return;
+    }
+    tally(C_LOADS_4, 1u);
+    let i = work.items[id.x];
+    tally(C_LOADS_16, 4u);
+    let record = holes.records[i];
+    begin_record(record);
+    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, false));
+    flush_kernel_counters(vec2<f32>(fill.offset + record_pixel(record)));
 }
 
 @compute @workgroup_size(GROUP, 1, 1)
