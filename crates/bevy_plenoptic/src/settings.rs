@@ -38,9 +38,13 @@ pub struct PlenopticSettings {
     pub screen_fill: bool,
     /// On cameras with the screen fill, make the opaque pixels' lookups in a compute pass
     /// over the fragments' records ([`crate::reconstruct::geometry::lookup_kernel`]) instead
-    /// of in the fragment shader. The same frame. Off by default: on lavapipe it reads more
-    /// (the records) and takes longer (`docs/results/measurements.md`, "The plugin's work per
-    /// pixel"); whether a GPU's fragment occupancy repays that is for its timings to say.
+    /// of in the fragment shader. The same frame; with [`ReconSettings::sparse_lighting`] a
+    /// material's lighting is looked up at a quarter of the pixels, as on the CPU. Off by
+    /// default: on lavapipe it takes longer (`docs/results/measurements.md`, "The plugin's
+    /// work per pixel"); whether a GPU's fragment occupancy repays that is for its timings to
+    /// say.
+    ///
+    /// [`ReconSettings::sparse_lighting`]: plenoptic_recon::ReconSettings::sparse_lighting
     pub lookup_kernel: bool,
 }
 
