@@ -57,13 +57,32 @@ use bevy::render::texture::GpuImage;
 
 use super::screen_fill::{ScreenFill, own_layout, queue_kernel};
 
-/// The kernel's pipelines, without and with the cost counters: its lookups', the sparse
-/// lighting's anchors' and its interpolation's.
+/// The kernel's pipelines of one variant (with the cost counters or without): its lookups',
+/// the sparse lighting's anchors', its interpolation's and its work list's.
 struct Kernels {
-    lookups: [CachedComputePipelineId; 2],
-    anchors: [CachedComputePipelineId; 2],
-    interpolate: [CachedComputePipelineId; 2],
-    listed: [CachedComputePipelineId; 2],
+    lookups: CachedComputePipelineId,
+    anchors: CachedComputePipelineId,
+    interpolate: CachedComputePipelineId,
+    listed: CachedComputePipelineId,
+}
+
+impl Kernels {
+    /// Queues the four pipelines of `shader` with `layouts`, counting their cost or not.
+    fn queue(
+        cache: &PipelineCache,
+        shader: &Handle<Shader>,
+        layouts: &[BindGroupLayoutDescriptor],
+        counting: bool,
+    ) -> Self {
+        let pipeline =
+            |entry, label| queue_kernel(cache, (shader, entry), layouts, label, counting);
+        Kernels {
+            lookups: pipeline("lookup_records", "plenoptic lookup kernel"),
+            anchors: pipeline("anchor_lookups", "plenoptic sparse lighting anchors"),
+            interpolate: pipeline("interpolate_records", "plenoptic sparse lighting"),
+            listed: pipeline("listed_lookups", "plenoptic listed lookups"),
+        }
+    }
 }
 
 /// Threads per workgroup side of `anchor_lookups` (`screen_fill.wgsl`'s `ANCHOR_GROUP`).
@@ -114,20 +133,22 @@ impl SparseBuffers {
     }
 }
 
-/// The kernel's pipelines, the layout of the materials' bindings it reads (group 1; group 0
-/// is the fill's own) and the nearest sampler its gathers take.
+/// The kernel's pipelines (queued when a camera first wants them: an app that never turns
+/// the lookup kernel on compiles none), the layout of the materials' bindings it reads (group
+/// 1; group 0 is the fill's own), its shader and the nearest sampler its gathers take.
 #[derive(Resource)]
 pub(super) struct LookupPipelines {
     layout: BindGroupLayoutDescriptor,
-    kernels: Kernels,
+    shader: Handle<Shader>,
+    /// Without and with the cost counters.
+    kernels: [Option<Kernels>; 2],
     sampler: Sampler,
 }
 
-/// Queues the kernel's pipelines.
+/// Makes the kernel's layout and sampler; its pipelines wait for [`queue_wanted`].
 pub(super) fn init_pipelines(
     mut commands: Commands,
     asset_server: Res<AssetServer>,
-    pipeline_cache: Res<PipelineCache>,
     device: Res<RenderDevice>,
 ) {
     // The material's binding numbers (bindings.wgsl, counters.wgsl).
@@ -148,50 +169,36 @@ pub(super) fn init_pipelines(
             ),
         ),
     );
-    let shader = load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl");
-    let layouts = [own_layout(), layout.clone()];
-    let pipeline = |entry, label, counting| {
-        queue_kernel(&pipeline_cache, (&shader, entry), &layouts, label, counting)
-    };
-    let kernels = Kernels {
-        lookups: [
-            pipeline("lookup_records", "plenoptic lookup kernel", false),
-            pipeline("lookup_records", "plenoptic lookup kernel (counting)", true),
-        ],
-        anchors: [
-            pipeline("anchor_lookups", "plenoptic sparse lighting anchors", false),
-            pipeline(
-                "anchor_lookups",
-                "plenoptic sparse lighting anchors (counting)",
-                true,
-            ),
-        ],
-        interpolate: [
-            pipeline("interpolate_records", "plenoptic sparse lighting", false),
-            pipeline(
-                "interpolate_records",
-                "plenoptic sparse lighting (counting)",
-                true,
-            ),
-        ],
-        listed: [
-            pipeline("listed_lookups", "plenoptic listed lookups", false),
-            pipeline(
-                "listed_lookups",
-                "plenoptic listed lookups (counting)",
-                true,
-            ),
-        ],
-    };
     let sampler = device.create_sampler(&SamplerDescriptor {
         label: Some("plenoptic lookup kernel gathers"),
         ..default()
     });
     commands.insert_resource(LookupPipelines {
         layout,
-        kernels,
+        shader: load_embedded_asset!(asset_server.as_ref(), "screen_fill.wgsl"),
+        kernels: [None, None],
         sampler,
     });
+}
+
+/// Queues the kernel's pipelines of a variant (counting or not) the first time a view's fill
+/// takes the lookup kernel with it.
+pub(super) fn queue_wanted(
+    pipelines: Option<ResMut<LookupPipelines>>,
+    cache: Res<PipelineCache>,
+    fills: Query<&ScreenFill>,
+) {
+    let Some(mut pipelines) = pipelines else {
+        return;
+    };
+    for fill in fills.iter().filter(|f| f.kernel) {
+        let counting = usize::from(fill.counting);
+        if pipelines.kernels[counting].is_none() {
+            let layouts = [own_layout(), pipelines.layout.clone()];
+            let kernels = Kernels::queue(&cache, &pipelines.shader, &layouts, fill.counting);
+            pipelines.kernels[counting] = Some(kernels);
+        }
+    }
 }
 
 /// Records the lookup kernel's compute passes for `fill` into `encoder`, each with a span of
@@ -207,14 +214,15 @@ pub(super) fn dispatch_lookups(
     assets: (&RenderAssets<GpuShaderBuffer>, &RenderAssets<GpuImage>),
     device: &RenderDevice,
 ) {
-    let counting = usize::from(fill.counting);
+    let Some(k) = &pipelines.kernels[usize::from(fill.counting)] else {
+        return;
+    };
     let get = |id: CachedComputePipelineId| pipeline_cache.get_compute_pipeline(id);
-    let k = &pipelines.kernels;
     let (Some(lookups), Some(anchors), Some(interpolate), Some(listed), Some(material)) = (
-        get(k.lookups[counting]),
-        get(k.anchors[counting]),
-        get(k.interpolate[counting]),
-        get(k.listed[counting]),
+        get(k.lookups),
+        get(k.anchors),
+        get(k.interpolate),
+        get(k.listed),
         material_group(fill, (pipelines, pipeline_cache), assets, device),
     ) else {
         return;

@@ -56,7 +56,7 @@ use bevy::render::settings::WgpuFeatures;
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
 use bevy::render::texture::GpuImage;
 use bevy::render::view::ExtractedView;
-use bevy::render::{RenderApp, RenderStartup};
+use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::ShaderDefVal;
 
 use super::lookup_kernel::{LookupPipelines, SparseBuffers, dispatch_lookups};
@@ -214,6 +214,10 @@ pub(super) fn build(app: &mut App) {
                 super::lookup_kernel::init_pipelines,
                 super::fill_composite::init_composite,
             ),
+        )
+        .add_systems(
+            Render,
+            super::lookup_kernel::queue_wanted.in_set(RenderSystems::Queue),
         )
         .add_systems(
             Core3d,
