@@ -32,6 +32,8 @@ const VIEW_SCREEN_FILL: u32 = 16u;
 const VIEW_RELIT: u32 = 32u;
 // The opaque fragments leave their lookups to the lookup kernel (screen_fill.wgsl).
 const VIEW_LOOKUP_KERNEL: u32 = 64u;
+// With it, materials' lighting is looked up at the anchors and interpolated (screen_fill.wgsl).
+const VIEW_SPARSE_LIGHTING: u32 = 128u;
 
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {

@@ -18,13 +18,13 @@
 #import bevy_pbr::prepass_utils
 #import plenoptic::geometry::bindings::{
     cam, params, image_frame, image_mode, view_has, lit, pixel_albedo, face_normal, local_from_world,
-    non_diffuse_weight, VIEW_SCREEN_FILL, VIEW_LOOKUP_KERNEL, object_has, OBJECT_OPAQUE_PASS,
+    non_diffuse_weight, VIEW_SCREEN_FILL, VIEW_LOOKUP_KERNEL, VIEW_SPARSE_LIGHTING, object_has, OBJECT_OPAQUE_PASS,
     glazing,
 }
 #ifdef PLENOPTIC_SCREEN_FILL
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
 #import plenoptic::fill_entry::{
-    HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair, pack_normal, RECORD_HOLE, RECORD_LOOKUP,
+    HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair, pack_normal, RECORD_HOLE, RECORD_LOOKUP, RECORD_SPARSE,
 }
 #endif
 #import plenoptic::fill_entry::ring_step
@@ -119,7 +119,11 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
     }
     fill_entries[i] = vec4<u32>(hole_index, 0u, 0u, object | HOLE);
     let r = &hole_list.records[hole_index];
-    (*r).state = select(RECORD_HOLE, RECORD_LOOKUP, entry_kind == ENTRY_LOOKUP);
+    var state = select(RECORD_HOLE, RECORD_LOOKUP, entry_kind == ENTRY_LOOKUP);
+    if state == RECORD_LOOKUP && lit() && view_has(VIEW_SPARSE_LIGHTING) {
+        state = RECORD_SPARSE;
+    }
+    (*r).state = state;
     (*r).normal = pack_normal(face_normal);
     (*r).pair = pack_pair(added * e, albedo);
     (*r).pixel = i;

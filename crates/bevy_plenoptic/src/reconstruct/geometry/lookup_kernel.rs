@@ -24,17 +24,17 @@
 //! resolution. Albedo, the sun and reflections stay per pixel in the fragments.
 //!
 //! The records are appended in no spatial order, so the sparse lighting's work is sorted into
-//! passes whose threads all do the same: `lookup_records` only sorts (a material's records
-//! to the sparse passes, any other to a work list), `anchor_lookups` runs one thread per
-//! anchor pixel in 8 × 8 groups and finds its record through the pixel's entry,
-//! `interpolate_records` interpolates or puts the record on the work list, and
-//! `listed_lookups` looks the work list up. Each is a compute pass with its own time span.
+//! passes whose threads all do the same: a material's fragment leaves its record to the
+//! sparse passes, `anchor_lookups` runs one thread per anchor pixel in 8 × 8 groups and
+//! finds its record through the pixel's entry, `interpolate_records` interpolates or puts the
+//! record on the work list (as every record without a material), and `listed_lookups` looks
+//! the work list up. Each is a compute pass with its own time span.
 //!
 //! Measured on lavapipe (`docs/results/measurements.md`, "The plugin's work per pixel"): the
 //! same frames, but more reads (each record is read back, 64 bytes) and a longer frame
-//! (the tour: 1.43× the fragments' lookups with the sparse lighting, 1.32× without, although
-//! the sparse lighting reads 23.0 texels and records per pixel against 28.4), so the setting
-//! is off by default until a GPU's timings decide.
+//! (the tour: 1.19× the fragments' lookups with the sparse lighting, which reads 23.0 texels
+//! and records per pixel, 1.36× without it, 28.4), so the setting is off by default until a
+//! GPU's timings decide.
 //!
 //! [`PlenopticSettings::lookup_kernel`]: crate::settings::PlenopticSettings::lookup_kernel
 //! [`ReconSettings::sparse_lighting`]: plenoptic_recon::ReconSettings::sparse_lighting
@@ -204,7 +204,7 @@ pub(super) fn queue_wanted(
 /// Records the lookup kernel's compute passes for `fill` into `encoder`, each with a span of
 /// the render `diagnostics` (`plenoptic/lookups`; where the fill has the sparse lighting,
 /// `plenoptic/sparse_anchors`, `plenoptic/sparse_interpolate` and `plenoptic/sparse_lookups`
-/// after it), with the fill's
+/// instead), with the fill's
 /// own bind group `own` and `workgroups` groups over the records; nothing until its pipelines
 /// are compiled and its bindings on the GPU.
 pub(super) fn dispatch_lookups(
@@ -240,8 +240,9 @@ pub(super) fn dispatch_lookups(
         span.end(&mut pass);
     };
     let records = UVec2::new(workgroups, 1);
-    stage("plenoptic/lookups", lookups, records);
-    if fill.sparse {
+    if !fill.sparse {
+        stage("plenoptic/lookups", lookups, records);
+    } else {
         // One thread per anchor, the pixels of even row and column.
         let side = 2 * ANCHOR_GROUP;
         stage(

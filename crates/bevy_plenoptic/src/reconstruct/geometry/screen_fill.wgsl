@@ -127,10 +127,10 @@ fn answer(i: u32, pixel: u32, tag: u32, pair: vec3<u32>, got: Weighted) {
 
 // The lookups of the records the opaque fragments left to it (RECORD_LOOKUP; thesis
 // §8.2.3's direct lookups, else the temporal volumes, lookup.wgsl's as a fragment makes
-// them), one thread per record. With the sparse lighting this pass only sorts the records,
-// having read their state and tag: one shaded from its material is left to anchor_lookups
-// and interpolate_records (RECORD_SPARSE), any other goes to the work list. A record's 64
-// bytes count as four 16-byte loads.
+// them), one thread per record, on a camera without the sparse lighting (with it, a
+// material's fragment leaves its record RECORD_SPARSE for anchor_lookups and
+// interpolate_records, and the rest go to the work list there). A record's 64 bytes count as
+// four 16-byte loads.
 @compute @workgroup_size(GROUP, 1, 1)
 fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -138,15 +138,10 @@ fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     tally(C_LOADS_16, 1u);
-    if holes.records[i].state != RECORD_LOOKUP {
-        return;
-    }
-    if fill.sparse != 0u {
-        if (holes.records[i].tag & HOLE_MATERIAL) != 0u {
-            holes.records[i].state = RECORD_SPARSE;
-        } else {
-            to_work_list(i);
-        }
+    // A record left RECORD_SPARSE in a frame whose fill turned the sparse lighting off is
+    // looked up too.
+    let state = holes.records[i].state;
+    if state != RECORD_LOOKUP && state != RECORD_SPARSE {
         return;
     }
     tally(C_LOADS_16, 3u);
@@ -251,7 +246,8 @@ fn interpolated(p: vec2<u32>, object: u32, dist: f32) -> Weighted {
     return Weighted(sum * k, 1.0);
 }
 
-// The sparse lighting's second pass, after anchor_lookups: each record left (RECORD_SPARSE:
+// The sparse lighting's second pass, after anchor_lookups: a record without a material goes
+// to the work list; each record left (RECORD_SPARSE:
 // off the anchors, or a second fragment of an anchor's pixel with MSAA, which takes that
 // anchor's lookups as its own where they stand for them) takes its anchors' mean where they
 // stand for its own lookups (reading its pixel, tag, colours and world point), else goes to
@@ -264,7 +260,13 @@ fn interpolate_records(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     tally(C_LOADS_16, 1u);
-    if holes.records[i].state != RECORD_SPARSE {
+    let state = holes.records[i].state;
+    if state == RECORD_LOOKUP {
+        // Without a material (or left by a fragment before the sparse lighting was on).
+        to_work_list(i);
+        return;
+    }
+    if state != RECORD_SPARSE {
         return;
     }
     let tag = holes.records[i].tag;

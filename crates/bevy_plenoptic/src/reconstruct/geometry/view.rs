@@ -145,6 +145,9 @@ impl ViewFlags {
     /// The opaque fragments leave their lookups to the lookup kernel
     /// ([`super::lookup_kernel`]).
     pub const LOOKUP_KERNEL: u32 = 1 << 6;
+    /// The lookup kernel looks materials' lighting up at the anchors and interpolates the
+    /// rest (`ReconSettings::sparse_lighting`): a material's record is left to its passes.
+    pub const SPARSE_LIGHTING: u32 = 1 << 7;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
@@ -288,6 +291,9 @@ pub(super) fn update_view_buffers(
             params.flags |= ViewFlags::SCREEN_FILL;
             if fill.kernel && fill.lookups.is_some() {
                 params.flags |= ViewFlags::LOOKUP_KERNEL;
+                if fill.sparse {
+                    params.flags |= ViewFlags::SPARSE_LIGHTING;
+                }
             }
         }
         let view = view.as_mut();
