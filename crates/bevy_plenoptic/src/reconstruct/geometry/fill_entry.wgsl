@@ -101,9 +101,6 @@ struct FillParams {
     // The ring search's largest radius; the camera's exposure.
     radius: u32,
     exposure: f32,
-    // Whether the lookup kernel looks materials' lighting up at the anchors only and
-    // interpolates between them (ReconSettings::sparse_lighting): 1, else 0.
-    sparse: u32,
     // The camera's position (xyz), which the lookup kernel weighs views from.
     eye: vec4<f32>,
 }

@@ -22,8 +22,9 @@
 //!
 //! With the lookup kernel ([`super::lookup_kernel`], off by default) the fragments make no
 //! lookups at all: every opaque fragment appends a record, the lookup kernel answers the
-//! records it can and writes their entries (with the sparse lighting in two passes, the
-//! anchors' then the pixels between them), and the fill kernel fills the rest.
+//! records it can and writes their entries (with the sparse lighting in three passes: the
+//! anchors', the pixels between them, the pixels they refused), and the fill kernel fills
+//! the rest.
 //!
 //! The fill needs the camera's [`DepthPrepass`] (every [`PlenopticCamera`] requires one), on a
 //! device that forces early depth tests ([`EarlyDepthSupport`]): a fragment writes its entry
@@ -176,7 +177,6 @@ pub(super) struct FillParams {
     offset: UVec2,
     radius: u32,
     exposure: f32,
-    sparse: u32,
     eye: Vec4,
 }
 
@@ -192,7 +192,6 @@ impl FillParams {
                 .map_or(UVec2::ZERO, |v| v.physical_position),
             radius: fill.radius,
             exposure: camera.exposure,
-            sparse: u32::from(fill.sparse),
         }
     }
 }
@@ -271,7 +270,8 @@ pub(super) fn prepare_screen_fill(
             _ => UVec2::ZERO,
         };
         let new_buffers = |buffers: &mut Assets<ShaderBuffer>| {
-            let list = LIST_HEADER_BYTES + list_room(size, kernel) * RECORD_BYTES;
+            let room = list_room(size, kernel);
+            let list = LIST_HEADER_BYTES + room * RECORD_BYTES;
             let mut buffer = |bytes: u64| {
                 let bytes = bytes.max(ENTRY_BYTES) as usize;
                 buffers.add(ShaderBuffer::with_size(
@@ -280,7 +280,6 @@ pub(super) fn prepare_screen_fill(
                 ))
             };
             let (entries, holes) = (buffer(pixels_of(size) * ENTRY_BYTES), buffer(list));
-            let room = list_room(size, kernel);
             (
                 entries,
                 holes,

@@ -9,8 +9,8 @@
 // over the hole's record, which the composite pass (fill_composite.wgsl) draws into the
 // view's target. No pixel's lookups are computed again: a ring pixel costs one 16-byte load.
 //
-// Before it, with the lookup kernel, the records' lookups (lookup_records) and the sparse
-// lighting's interpolation between them (interpolate_records).
+// Before it, with the lookup kernel, the records' lookups: lookup_records, or with the
+// sparse lighting anchor_lookups, interpolate_records and listed_lookups.
 //
 // The lookups' bindings (the keys, their shading texels, the camera's view buffer, the
 // counters) are the material's, bound here as group 1 (MATERIAL_BIND_GROUP).
@@ -85,26 +85,34 @@ fn begin_record(record: HoleRecord) {
     face_normal = unpack_normal(record.normal);
 }
 
-// The lookups of `record` (begin_record's): its direct lookups, else the temporal volumes,
-// normalized and times the exposure; w = 0 where none answers. An `anchor` of the sparse
-// lighting also leaves its cell for its neighbours (what its direct lookups accepted).
-fn record_lookups(record: HoleRecord, anchor: bool) -> Weighted {
-    let object = record.tag & OBJECT_BITS;
-    let p = record.world.xyz;
-    var got = direct_lookups_at(vec4<f32>(record.local.xyz, 1.0), p, fill.eye.xyz, object - 1u);
-    if anchor {
-        let signature = select(0u, lookup_accepted, got.w > 0.0);
-        let dist = distance(p, fill.eye.xyz);
-        let a = record_pixel(record) / 2u;
-        anchors[a.y * anchor_size().x + a.x] = vec4<u32>(signature, bitcast<u32>(dist), record.normal, object);
-    }
+// The direct lookups of `record` (begin_record's): (Σ w·terms, Σ w); lookup_accepted says
+// which keys answered.
+fn direct_of(record: HoleRecord) -> Weighted {
+    let local = vec4<f32>(record.local.xyz, 1.0);
+    return direct_lookups_at(local, record.world.xyz, fill.eye.xyz, (record.tag & OBJECT_BITS) - 1u);
+}
+
+// The answer of `record` from its `direct` lookups, else the temporal volumes, normalized and
+// times the exposure; w = 0 where none answers.
+fn with_volumes(record: HoleRecord, direct: Weighted) -> Weighted {
+    var got = direct;
     if got.w <= 0.0 {
-        got = volume_lookups(p, object - 1u);
+        got = volume_lookups(record.world.xyz, (record.tag & OBJECT_BITS) - 1u);
     }
     if got.w <= 0.0 {
         return Weighted(mat2x3<f32>(), 0.0);
     }
     return Weighted(got.terms * (fill.exposure / got.w), 1.0);
+}
+
+// Record i's own lookups, its answer written (answer): lookup_records' and listed_lookups'
+// thread.
+fn look_up(i: u32) {
+    tally(C_LOADS_16, 4u);
+    let record = holes.records[i];
+    begin_record(record);
+    answer(i, record.pixel, record.tag, record.pair, with_volumes(record, direct_of(record)));
+    flush_kernel_counters(vec2<f32>(fill.offset + record_pixel(record)));
 }
 
 // Record i's answer `got` (terms times the exposure) for its `pixel`, `tag` and `pair`: its
@@ -137,18 +145,13 @@ fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     if i >= listed() {
         return;
     }
-    tally(C_LOADS_16, 1u);
     // A record left RECORD_SPARSE in a frame whose fill turned the sparse lighting off is
-    // looked up too.
+    // looked up too. (Its state is counted with the record's four loads.)
     let state = holes.records[i].state;
     if state != RECORD_LOOKUP && state != RECORD_SPARSE {
         return;
     }
-    tally(C_LOADS_16, 3u);
-    let record = holes.records[i];
-    begin_record(record);
-    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, false));
-    flush_kernel_counters(vec2<f32>(fill.offset + record_pixel(record)));
+    look_up(i);
 }
 
 // Threads per workgroup side of anchor_lookups.
@@ -178,7 +181,13 @@ fn anchor_lookups(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     begin_record(record);
-    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, true));
+    let direct = direct_of(record);
+    // The anchor's cell: what answered it directly (0: nothing did), its distance, face
+    // normal and object.
+    let signature = select(0u, lookup_accepted, direct.w > 0.0);
+    let dist = bitcast<u32>(distance(record.world.xyz, fill.eye.xyz));
+    anchors[id.y * anchor_size().x + id.x] = vec4<u32>(signature, dist, record.normal, record.tag & OBJECT_BITS);
+    answer(i, record.pixel, record.tag, record.pair, with_volumes(record, direct));
     flush_kernel_counters(vec2<f32>(fill.offset + p));
 }
 
@@ -300,12 +309,7 @@ fn listed_lookups(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     tally(C_LOADS_4, 1u);
-    let i = work.items[id.x];
-    tally(C_LOADS_16, 4u);
-    let record = holes.records[i];
-    begin_record(record);
-    answer(i, record.pixel, record.tag, record.pair, record_lookups(record, false));
-    flush_kernel_counters(vec2<f32>(fill.offset + record_pixel(record)));
+    look_up(work.items[id.x]);
 }
 
 @compute @workgroup_size(GROUP, 1, 1)
