@@ -240,7 +240,19 @@ pub(crate) fn render_pair(
         tol,
         second: pass.second,
     };
-    fallback.run(&point, &mut frame, &mut plane2, &mut class);
+    // A pixel's surface normal facing the eye, in the world as the volume samples' normals are,
+    // for their face test (zero: none).
+    let normal = |j: usize| -> Vec3 {
+        let n = match &source {
+            MaskSource::Mask(m) => m.normal.get(j).copied().unwrap_or_default(),
+            MaskSource::Raster(tris) => prims
+                .get(j)
+                .map_or(Vec3::ZERO, |&p| tris.world_normal(&basis, p)),
+        };
+        let to_eye = basis.position - point(j);
+        if n.dot(to_eye) < 0.0 { -n } else { n }
+    };
+    fallback.run(&point, &normal, &mut frame, &mut plane2, &mut class);
     report.stage_ms.push(("volume".into(), ms(start)));
     let start = Instant::now();
     let slot = |o: u32| slot_of.get(o);
@@ -687,10 +699,12 @@ struct VolumeFallback<'a> {
 
 impl VolumeFallback<'_> {
     /// Fills the pixels of `class` [`HOLE`] that the volumes' samples of the same object near
-    /// their `point` answer, both colours with the same samples and weights.
+    /// their `point`, facing as their surface `normal` does, answer, both colours with the
+    /// same samples and weights.
     fn run(
         &self,
         point: &(impl Fn(usize) -> Vec3 + Sync),
+        normal: &(impl Fn(usize) -> Vec3 + Sync),
         frame: &mut Frame,
         plane2: &mut [Vec3],
         class: &mut [u8],
@@ -705,7 +719,8 @@ impl VolumeFallback<'_> {
                 let (p, o) = (point(j), frame.object[j]);
                 let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
                 for (base, w, index) in self.volumes {
-                    let near = index.lookup_pair(p - *base, o, self.tol * 3.0, self.second);
+                    let near =
+                        index.lookup_pair(p - *base, o, self.tol * 3.0, self.second, normal(j));
                     if let Some((c, c2, wt)) = near {
                         vs += c * wt * *w;
                         vs2 += c2 * wt * *w;

@@ -241,9 +241,13 @@ impl<'r> ShadedHits<'r> {
         }
         if total <= 0.0 {
             for (base, w, index) in &self.volumes {
-                if let Some((l, second, wv)) =
-                    index.lookup_pair(p - *base, object, tol, Some(Channel::NonDiffuse))
-                {
+                if let Some((l, second, wv)) = index.lookup_pair(
+                    p - *base,
+                    object,
+                    tol,
+                    Some(Channel::NonDiffuse),
+                    Vec3::ZERO,
+                ) {
                     let w = w * angular(*base) * wv;
                     sum += l * w;
                     sum2 += second * w;

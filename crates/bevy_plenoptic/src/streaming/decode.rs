@@ -3,6 +3,7 @@
 //! temporal-volume block binned by direction; and the bytes each will occupy, known from the
 //! pack's directory before the read (see the [module doc](super)).
 
+use bevy::math::Vec3;
 use plenoptic_pack::{ChunkKind, PackReader, cube, ktx, range_image};
 use plenoptic_recon::streamed::{CUBE_KINDS, StreamedCube, read_cube};
 
@@ -187,9 +188,10 @@ pub const VOLUME_SAMPLE_WORDS: usize = 12;
 
 /// A temporal-volume block ready for the GPU: its samples sorted by direction bin (a cube of
 /// [`VOLUME_BIN_FACE`]² texels per face, bin = `cube::direction_to_texel`), each as
-/// [`VOLUME_SAMPLE_WORDS`] words `(direction.xyz, radius, radiance.rgb, distance, t, object
-/// id, lighting, non-diffuse)` (floats as their bits, the last two RGB9E5), and the offset of
-/// each bin's first sample.
+/// [`VOLUME_SAMPLE_WORDS`] words `(direction.xyz, radius, radiance, normal, 0, distance, t,
+/// object id, lighting, non-diffuse)` (floats as their bits; radiance, lighting and
+/// non-diffuse RGB9E5, as the pack stores them; the normal octahedral as two snorm16, as the
+/// key textures' normals), and the offset of each bin's first sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BinnedVolume {
     /// Sample words, bin by bin.
@@ -216,6 +218,13 @@ impl BinnedVolume {
     pub fn is_empty(&self) -> bool {
         self.words.is_empty()
     }
+}
+
+/// Unit `n` as one word: octahedral, two snorm16 (x in the low half), as a key texture's
+/// RG16Snorm normal texel and WGSL's `unpack2x16snorm` read it.
+fn oct_snorm16(n: Vec3) -> u32 {
+    let e = cube::oct_encode(n);
+    u32::from(cube::snorm16(e.x) as u16) | (u32::from(cube::snorm16(e.y) as u16) << 16)
 }
 
 /// Reads, decodes and bins one temporal-volume block. The error names the chunk.
@@ -266,20 +275,14 @@ pub fn decode_volume(
         }
         let o = at * VOLUME_SAMPLE_WORDS;
         fill[b] += 1;
-        let f = [
-            s.direction.x,
-            s.direction.y,
-            s.direction.z,
-            s.radius,
-            s.radiance.x,
-            s.radiance.y,
-            s.radiance.z,
-            s.distance,
-            s.t,
-        ];
-        for (w, x) in words[o..o + 9].iter_mut().zip(f) {
+        let f = [s.direction.x, s.direction.y, s.direction.z, s.radius];
+        for (w, x) in words[o..o + 4].iter_mut().zip(f) {
             *w = x.to_bits();
         }
+        words[o + 4] = cube::rgb9e5_pack(s.radiance);
+        words[o + 5] = oct_snorm16(s.normal);
+        words[o + 7] = s.distance.to_bits();
+        words[o + 8] = s.t.to_bits();
         words[o + 9] = s.object_id;
         words[o + 10] = cube::rgb9e5_pack(s.lighting);
         words[o + 11] = cube::rgb9e5_pack(s.non_diffuse);

@@ -223,6 +223,9 @@ var<private> local_from_world: mat4x4<f32>;
 // (the object's own for an animated one, as object_point): the lookups' face test
 // (lookup.wgsl's same_face). Zero: no face test.
 var<private> face_normal: vec3<f32>;
+// The same normal in the world, where the temporal volume's samples keep theirs: their face
+// test (lookup.wgsl's volume_lookups). Zero: no face test.
+var<private> world_face_normal: vec3<f32>;
 
 // Whether the camera's flags have `bit` (VIEW_*).
 fn view_has(bit: u32) -> bool {

@@ -17,7 +17,8 @@
 #import bevy_pbr::mesh_view_bindings::view
 #import bevy_pbr::prepass_utils
 #import plenoptic::geometry::bindings::{
-    cam, params, image_frame, image_mode, view_has, lit, pixel_albedo, face_normal, local_from_world,
+    cam, params, image_frame, image_mode, view_has, lit, pixel_albedo, face_normal, world_face_normal,
+    local_from_world,
     non_diffuse_weight, VIEW_SCREEN_FILL, VIEW_LOOKUP_KERNEL, VIEW_SPARSE_LIGHTING, object_has, OBJECT_OPAQUE_PASS,
     glazing,
 }
@@ -25,6 +26,7 @@
 #import plenoptic::geometry::bindings::{fill_entries, hole_list}
 #import plenoptic::fill_entry::{
     HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, pack_pair, pack_normal, RECORD_HOLE, RECORD_LOOKUP, RECORD_SPARSE,
+    COVERAGE_SHIFT,
 }
 #endif
 #import plenoptic::fill_entry::ring_step
@@ -123,14 +125,14 @@ fn write_fill_entry(frag: vec4<f32>, added: vec3<f32>) {
     if state == RECORD_LOOKUP && lit() && view_has(VIEW_SPARSE_LIGHTING) {
         state = RECORD_SPARSE;
     }
-    (*r).state = state;
+    (*r).state = state | (fragment_coverage << COVERAGE_SHIFT);
     (*r).normal = pack_normal(face_normal);
+    (*r).world_normal = pack_normal(world_face_normal);
     (*r).pair = pack_pair(added * e, albedo);
     (*r).pixel = i;
     (*r).local = vec4<f32>(object_point(hole_point).xyz, f32(params.motion_slot));
     (*r).world = vec4<f32>(hole_point, fragment_near_depth);
     (*r).tag = tag;
-    (*r).coverage = fragment_coverage;
 #endif
 }
 
@@ -213,7 +215,8 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
     // The face test of the lookups (lookup.wgsl's same_face): the fragment's surface normal
     // facing the eye, in its lookups' frame (fragment_fill keeps it for ring points on the
     // fragment's plane).
-    face_normal = lookup_frame(facing_eye(nrm, p, eye));
+    world_face_normal = facing_eye(nrm, p, eye);
+    face_normal = lookup_frame(world_face_normal);
     let deferred = screen_fill();
     if deferred && view_has(VIEW_LOOKUP_KERNEL) && claim_hole(p) {
         // The lookup kernel (screen_fill.wgsl) makes the point's lookups, then the fill
@@ -256,6 +259,7 @@ fn radiance(in: VertexOutput, ng_raw: vec3<f32>) -> vec4<f32> {
 fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>, object: u32) -> vec4<f32> {
     let radius = i32(cam.fill_radius);
     let own_face = face_normal;
+    let own_world_face = world_face_normal;
     for (var r = 1; r <= radius; r++) {
         var sum = mat2x3<f32>();
         var count = 0.0;
@@ -282,6 +286,7 @@ fn fragment_fill(centre: vec2<f32>, p: vec3<f32>, nrm: vec3<f32>, eye: vec3<f32>
                 // measured the same frame at four more loads per ring point).
                 let on_plane = abs(dot(q.xyz - p, nrm)) <= 0.01 * distance(q.xyz, eye);
                 face_normal = select(vec3<f32>(0.0), own_face, on_plane);
+                world_face_normal = select(vec3<f32>(0.0), own_world_face, on_plane);
                 tally(C_FILL_LOOKUPS, 1u);
                 let got = reconstruct(q.xyz, eye, object);
                 if got.w > 0.0 {

@@ -6,7 +6,7 @@
 // each keeps its own samples. Points past the holes listed fall outside the view and are not
 // drawn. On a camera without an HDR target (TONEMAP_IN_SHADER) the colour is tonemapped with
 // the view's tonemapping and colour grading, as geometry.wgsl's fragments are.
-#import plenoptic::fill_entry::{HoleRecords, FillParams, unpack_pair}
+#import plenoptic::fill_entry::{HoleRecords, FillParams, unpack_pair, COVERAGE_SHIFT}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16}
 #ifdef TONEMAP_IN_SHADER
 #import bevy_render::view::View
@@ -53,5 +53,5 @@ fn composite(in: HolePoint) -> Filled {
 #ifdef TONEMAP_IN_SHADER
     colour = tone_mapping(colour, view.color_grading);
 #endif
-    return Filled(colour, r.world.w, r.coverage);
+    return Filled(colour, r.world.w, r.state >> COVERAGE_SHIFT);
 }

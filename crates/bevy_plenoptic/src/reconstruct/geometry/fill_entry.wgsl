@@ -31,12 +31,13 @@ struct HoleRecord {
     world: vec4<f32>,
     // Its object + 1, with HOLE_NON_DIFFUSE and HOLE_MATERIAL.
     tag: u32,
-    // The samples its fragment covers (its sample mask; 1 without MSAA).
-    coverage: u32,
+    // The same in the world (lookup.wgsl's world_face_normal), packed alike.
+    world_normal: u32,
     // Its surface normal facing the eye in its lookups' frame (lookup.wgsl's face_normal),
     // oct-encoded as two snorm16 (pack_normal).
     normal: u32,
-    // RECORD_HOLE, RECORD_LOOKUP, RECORD_SPARSE or RECORD_ANSWERED.
+    // RECORD_HOLE, RECORD_LOOKUP, RECORD_SPARSE or RECORD_ANSWERED (RECORD_STATE's bits),
+    // and above them the samples its fragment covers (its sample mask; 1 without MSAA).
     state: u32,
 }
 
@@ -47,6 +48,19 @@ const RECORD_HOLE: u32 = 0u;
 const RECORD_LOOKUP: u32 = 1u;
 const RECORD_ANSWERED: u32 = 2u;
 const RECORD_SPARSE: u32 = 3u;
+// The bits of a record's state word that hold its state; its coverage is above them.
+const RECORD_STATE: u32 = 0xffu;
+const COVERAGE_SHIFT: u32 = 8u;
+
+// The state of a record's state word.
+fn record_state(word: u32) -> u32 {
+    return word & RECORD_STATE;
+}
+
+// A record's state word with its state set to `state`, its coverage kept.
+fn with_state(word: u32, state: u32) -> u32 {
+    return (word & ~RECORD_STATE) | state;
+}
 
 // The packed normal of no normal (the face test left out).
 const NO_NORMAL: u32 = 0xffffffffu;

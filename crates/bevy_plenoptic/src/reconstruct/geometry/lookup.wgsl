@@ -13,7 +13,7 @@
 #import plenoptic::counters::{tally, C_LOOKUPS, C_LOADS_16, C_LOADS_8, C_LOADS_4, C_GATHERS, C_VOLUME}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, MAX_VOLUMES, BIN_FACE, cam, params, cubes, shading_cubes, cube_sampler, volume_samples,
-    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, face_normal, lit, view_has, VIEW_BILINEAR,
+    volume_bins, pixel_albedo, non_diffuse_weight, local_from_world, face_normal, world_face_normal, lit, view_has, VIEW_BILINEAR,
     point_slot, point_material,
     blended_geometry, blended_terms, PAIR_CHANGING,
 }
@@ -461,11 +461,12 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
     return Weighted(sum, ws);
 }
 
-// The temporal-volume fallback (plenoptic_recon's VolumeIndex::lookup, summed over the views
-// with their weights): samples of `object` in the direction bin of `p` from each base view,
-// whose cone contains that direction, whose distance agrees within 3× the depth tolerance and
-// whose time is within t ± tε, weighted by the tent filter and the angular falloff.
-// Returns (Σ w·terms, Σ w).
+// The temporal-volume fallback (plenoptic_recon's VolumeIndex::lookup_pair, summed over the
+// views with their weights): samples of `object` in the direction bin of `p` from each base
+// view, whose cone contains that direction, whose distance agrees within 3× the depth
+// tolerance, whose time is within t ± tε and that face as the point's surface does
+// (world_face_normal; the lookups' same_face), weighted by the tent filter and the angular
+// falloff. Returns (Σ w·terms, Σ w).
 fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
     tally(C_VOLUME, 1u);
     let count = min(cam.volume_count, MAX_VOLUMES);
@@ -499,8 +500,8 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
                 continue;
             }
             tally(C_LOADS_16, 1u);
-            let b = bitcast<vec4<f32>>(volume_samples[s + 1u]);
-            if abs(b.w - dist) > tol * dist {
+            let b = volume_samples[s + 1u];
+            if abs(bitcast<f32>(b.w) - dist) > tol * dist || !same_face(b.y, world_face_normal, true) {
                 continue;
             }
             tally(C_LOADS_16, 1u);
@@ -509,7 +510,7 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
             let r = max(a.w, half_bin);
             if angle < r {
                 let w = (1.0 - dt / eps) * max(1.0 - angle / r, 1e-3) * view_w;
-                sum += volume_terms(first + j, c.zw, b.rgb) * w;
+                sum += volume_terms(first + j, c.zw, rgb9e5_decode(b.x)) * w;
                 ws += w;
             }
         }

@@ -17,10 +17,11 @@
 #import plenoptic::fill_entry::{
     HoleList, FillParams, HOLE, HOLE_NON_DIFFUSE, HOLE_MATERIAL, OBJECT_BITS, unpack_pair, pack_pair,
     ring_step, unpack_normal, HoleRecord, RECORD_HOLE, RECORD_LOOKUP, RECORD_ANSWERED, RECORD_SPARSE,
+    record_state, with_state,
 }
 #import plenoptic::geometry::lookup::{Weighted, direct_lookups_at, volume_lookups, lookup_accepted}
 #import plenoptic::geometry::fallback::{nearby_texels, heaviest_texel}
-#import plenoptic::geometry::bindings::{cam, point_slot, point_material, face_normal}
+#import plenoptic::geometry::bindings::{cam, point_slot, point_material, face_normal, world_face_normal}
 #import plenoptic::counters::{tally, flush_kernel_counters, C_LOADS_16, C_LOADS_4, C_FILL}
 
 @group(0) @binding(0) var<storage, read_write> entries: array<vec4<u32>>;
@@ -83,6 +84,7 @@ fn begin_record(record: HoleRecord) {
     point_slot = i32(record.local.w);
     point_material = (record.tag & HOLE_MATERIAL) != 0u;
     face_normal = unpack_normal(record.normal);
+    world_face_normal = unpack_normal(record.world_normal);
 }
 
 // The direct lookups of `record` (begin_record's): (Σ w·terms, Σ w); lookup_accepted says
@@ -122,7 +124,7 @@ fn look_up(i: u32) {
 fn answer(i: u32, pixel: u32, tag: u32, pair: vec3<u32>, got: Weighted) {
     if got.w <= 0.0 {
         tally(C_FILL, 1u);
-        holes.records[i].state = RECORD_HOLE;
+        holes.records[i].state = with_state(holes.records[i].state, RECORD_HOLE);
         return;
     }
     entries[pixel] = vec4<u32>(pack_pair(got.terms[0], got.terms[1]), tag & OBJECT_BITS);
@@ -130,7 +132,7 @@ fn answer(i: u32, pixel: u32, tag: u32, pair: vec3<u32>, got: Weighted) {
     let nd = select(0.0, 1.0, (tag & HOLE_NON_DIFFUSE) != 0u);
     let colour = own[1] * got.terms[0] + got.terms[1] * nd + own[0];
     holes.records[i].pair = pack_pair(colour, vec3<f32>(0.0));
-    holes.records[i].state = RECORD_ANSWERED;
+    holes.records[i].state = with_state(holes.records[i].state, RECORD_ANSWERED);
 }
 
 // The lookups of the records the opaque fragments left to it (RECORD_LOOKUP; thesis
@@ -147,7 +149,7 @@ fn lookup_records(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     // A record left RECORD_SPARSE in a frame whose fill turned the sparse lighting off is
     // looked up too. (Its state is counted with the record's four loads.)
-    let state = holes.records[i].state;
+    let state = record_state(holes.records[i].state);
     if state != RECORD_LOOKUP && state != RECORD_SPARSE {
         return;
     }
@@ -177,7 +179,7 @@ fn anchor_lookups(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     tally(C_LOADS_16, 4u);
     let record = holes.records[i];
-    if record.state != RECORD_SPARSE || record.pixel != p.y * fill.size.x + p.x {
+    if record_state(record.state) != RECORD_SPARSE || record.pixel != p.y * fill.size.x + p.x {
         return;
     }
     begin_record(record);
@@ -269,7 +271,7 @@ fn interpolate_records(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     tally(C_LOADS_16, 1u);
-    let state = holes.records[i].state;
+    let state = record_state(holes.records[i].state);
     if state == RECORD_LOOKUP {
         // Without a material (or left by a fragment before the sparse lighting was on).
         to_work_list(i);
@@ -319,7 +321,7 @@ fn fill_holes(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     tally(C_LOADS_4, 1u);
-    if holes.records[i].state != RECORD_HOLE {
+    if record_state(holes.records[i].state) != RECORD_HOLE {
         return;
     }
     tally(C_LOADS_16, 4u);

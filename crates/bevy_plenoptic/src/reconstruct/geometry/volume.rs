@@ -1,7 +1,8 @@
 //! The temporal-volume fallback of the GPU reconstruction (`plenoptic_recon`'s
 //! `VolumeIndex`): where no time key has an accepted lookup, the fragment blends the volume
 //! samples of its object whose cone contains its direction from a base view, whose distance
-//! agrees (3× the depth tolerance) and whose time is within `t ± tε` (tent filter).
+//! agrees (3× the depth tolerance), whose time is within `t ± tε` (tent filter) and whose
+//! normal is within 60° of the point's surface normal in the world (the lookups' face test).
 //!
 //! Every resident volume block of a pack ([`crate::streaming::BinnedVolume`]: samples sorted
 //! by direction bin, and the bins' offsets) is packed into two storage buffers per pack,
