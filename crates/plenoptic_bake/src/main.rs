@@ -11,7 +11,7 @@
 //!     [--shading materials|radiance] [--reflections shaded|marched] [--supersampling N]
 //!     [--frames N] [--exposure E] [--light NAME=I]... --out DIR
 //! plenoptic compare --reference DIR [--reference-b DIR_B] [LABEL=]DIR... [--csv OUT.csv]
-//!                   [--plot OUT.svg]
+//!                   [--plot OUT.svg] [--maps DIR]
 //! ```
 //!
 //! Variance-corrected comparison: `plenoptic reference … --out ref --halves` renders two
@@ -181,6 +181,11 @@ enum Command {
         /// The plot to write: `<stem>.svg` (with text) and `<stem>.png` (curves only).
         #[arg(long, default_value = "compare.svg")]
         plot: PathBuf,
+        /// Also write each candidate frame's low-frequency difference from the reference as
+        /// `DIR/<label>_frame_NNNNN.png`: red where the candidate is brighter, blue where it
+        /// is darker, full colour at 20 % of the frame's mean (blotches, halos, dim patches).
+        #[arg(long, value_name = "DIR")]
+        maps: Option<PathBuf>,
     },
     /// Render reference frames along a camera path with the path tracer (EXR + PNG).
     Reference {
@@ -305,7 +310,14 @@ fn run(command: Command) -> Result<()> {
             candidates,
             csv,
             plot,
-        } => cmd_compare(&reference, reference_b.as_deref(), &candidates, &csv, &plot),
+            maps,
+        } => cmd_compare(
+            &reference,
+            reference_b.as_deref(),
+            &candidates,
+            (&csv, &plot),
+            maps.as_deref(),
+        ),
         Command::Reference {
             recipe,
             path,
@@ -440,8 +452,8 @@ fn cmd_compare(
     reference: &Path,
     reference_b: Option<&Path>,
     candidates: &[String],
-    csv: &Path,
-    plot: &Path,
+    (csv, plot): (&Path, &Path),
+    maps: Option<&Path>,
 ) -> Result<()> {
     let candidates: Vec<(String, PathBuf)> = candidates
         .iter()
@@ -466,6 +478,16 @@ fn cmd_compare(
         .map(|p| p.display().to_string())
         .collect();
     out!("wrote {} and {}", csv.display(), plots.join(", "));
+    if let Some(dir) = maps {
+        let n = plenoptic_eval::maps::write_low_frequency_maps(
+            reference,
+            reference_b,
+            &candidates,
+            dir,
+        )
+        .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
+        out!("wrote {n} low-frequency maps into {}", dir.display());
+    }
     Ok(())
 }
 

@@ -11,6 +11,7 @@
 //!   LRMS against a noisy two-half reference;
 //! - [`frame_io`]: frame files: OpenEXR through the `exr` crate (any compression, half or
 //!   float channels) and tonemapped PNG;
+//! - [`maps`]: pictures of where a candidate's low-frequency error lies;
 //! - [`plot`]: error-along-path plots (thesis figures 6.29 and 6.31) as SVG and PNG;
 //! - [`mask`]: the geometry mask by ray casting through the tracer's BVH, the reference the
 //!   runtime's rasterized mask is tested against;
@@ -19,6 +20,7 @@
 pub mod camera;
 pub mod frame_io;
 pub mod low_frequency;
+pub mod maps;
 pub mod mask;
 pub mod metrics;
 pub mod plot;

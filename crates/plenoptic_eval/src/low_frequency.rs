@@ -22,28 +22,48 @@ pub const SIGMA_OF_WIDTH: f64 = 0.02;
 /// The low-frequency relative error of `test` against `reference` (see the module docs).
 /// NaN when the sizes differ or the reference is black.
 pub fn low_frequency_error(test: &Image<Vec3>, reference: &Image<Vec3>) -> f64 {
+    match low_frequency_difference(test, reference) {
+        Some(d) => (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt(),
+        None => f64::NAN,
+    }
+}
+
+/// The signed low-frequency difference of `test` from `reference` per pixel (row-major):
+/// (G∗x − G∗m) / mean(G∗m), positive where `test` is brighter; its RMS is
+/// [`low_frequency_error`]. `None` when the sizes differ or the reference is black.
+pub fn low_frequency_difference(test: &Image<Vec3>, reference: &Image<Vec3>) -> Option<Vec<f64>> {
     let (w, h) = (reference.width as usize, reference.height as usize);
     if (test.width, test.height) != (reference.width, reference.height)
         || test.pixels.len() != w * h
         || reference.pixels.len() != w * h
         || w == 0
     {
-        return f64::NAN;
+        return None;
     }
     let sigma = SIGMA_OF_WIDTH * w as f64;
     let x = blur(&luminance_of(test), w, h, sigma);
     let m = blur(&luminance_of(reference), w, h, sigma);
     let mean = m.iter().sum::<f64>() / m.len() as f64;
-    if mean <= 0.0 {
-        return f64::NAN;
+    if mean <= 0.0 || mean.is_nan() {
+        return None;
     }
-    let mse = x
-        .iter()
-        .zip(&m)
-        .map(|(a, b)| (a - b) * (a - b))
-        .sum::<f64>()
-        / m.len() as f64;
-    mse.sqrt() / mean
+    Some(x.iter().zip(&m).map(|(a, b)| (a - b) / mean).collect())
+}
+
+/// The colour [`crate::maps`] shows a signed difference `v` in: white at 0, towards red where
+/// the candidate is brighter and blue where it is darker, saturated at ±`full`.
+pub fn difference_colour(v: f64, full: f64) -> [u8; 3] {
+    let t = if full > 0.0 && v.is_finite() {
+        (v / full).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let fade = |x: f64| (255.0 * (1.0 - x) + 0.5) as u8;
+    if t >= 0.0 {
+        [255, fade(t), fade(t)]
+    } else {
+        [fade(-t), fade(-t), 255]
+    }
 }
 
 fn luminance_of(image: &Image<Vec3>) -> Vec<f64> {
@@ -174,5 +194,26 @@ mod tests {
             ..r.clone()
         };
         assert!(low_frequency_error(&r, &black).is_nan());
+    }
+
+    #[test]
+    fn the_difference_map_is_signed_and_its_rms_is_the_error() {
+        let r = reference(160, 90);
+        // The left half 10 % brighter, the right half as the reference.
+        let x = map_pixels(&r, |x, _, c| if x < 80 { c * 1.1 } else { c });
+        let d = low_frequency_difference(&x, &r).unwrap();
+        let at = |x: usize, y: usize| d[y * 160 + x];
+        assert!(
+            at(20, 45) > 0.03 && at(140, 45).abs() < 0.01,
+            "{} {}",
+            at(20, 45),
+            at(140, 45)
+        );
+        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
+        assert!((rms - low_frequency_error(&x, &r)).abs() < 1e-12);
+        assert_eq!(difference_colour(0.0, 0.2), [255, 255, 255]);
+        assert_eq!(difference_colour(0.4, 0.2), [255, 0, 0]);
+        assert_eq!(difference_colour(-0.2, 0.2), [0, 0, 255]);
+        assert_eq!(difference_colour(f64::NAN, 0.2), [255, 255, 255]);
     }
 }

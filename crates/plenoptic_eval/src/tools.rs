@@ -353,7 +353,7 @@ impl Comparison {
     }
 }
 
-fn exr_frames(dir: &Path) -> Result<Vec<(usize, PathBuf)>> {
+pub(crate) fn exr_frames(dir: &Path) -> Result<Vec<(usize, PathBuf)>> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(dir).map_err(|e| EvalError::io(dir, e))? {
         let p = e.map_err(|e| EvalError::io(dir, e))?.path();
@@ -370,7 +370,7 @@ fn exr_frames(dir: &Path) -> Result<Vec<(usize, PathBuf)>> {
     Ok(out)
 }
 
-fn read_image(path: &Path) -> Result<Image<Vec3>> {
+pub(crate) fn read_image(path: &Path) -> Result<Image<Vec3>> {
     let (width, height, pixels) = read_exr(path)?;
     Ok(Image {
         width,
