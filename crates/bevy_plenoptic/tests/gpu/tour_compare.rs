@@ -8,6 +8,7 @@
 //! (`PlenopticSettings::lookup_kernel`); `PLENOPTIC_TOUR_DENSE` set to `gpu`, `cpu` or `both`
 //! looks the lighting up at every pixel there (`ReconSettings::sparse_lighting` off), so
 //! that the sparse lighting's error against the dense frame can be read off.
+//! `PLENOPTIC_TOUR_AT` (as `0.4,0.9`: fractions of the path's time) compares other points.
 
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -60,7 +61,12 @@ fn tour_gpu_against_cpu() {
     let gpu_sparse = !matches!(dense.as_str(), "gpu" | "both");
     let kernel = std::env::var_os("PLENOPTIC_TOUR_KERNEL").is_some_and(|v| v == "1");
     let (t0, t1) = path.time_range();
-    for s in [0.1f32, 0.35, 0.6, 0.85] {
+    // The points of the path (fractions of its time), or `PLENOPTIC_TOUR_AT`'s (as `0.4,0.9`).
+    let points: Vec<f32> = std::env::var("PLENOPTIC_TOUR_AT")
+        .ok()
+        .map(|v| v.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![0.1, 0.35, 0.6, 0.85]);
+    for s in points {
         let sample = path.sample(t0 + (t1 - t0) * s);
         let mut cam = sample.camera;
         cam.width = W;
