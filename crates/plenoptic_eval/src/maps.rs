@@ -17,7 +17,8 @@ pub const MAP_FULL_SCALE: f64 = 0.2;
 
 /// Writes `out/<label>_frame_NNNNN.png`, the low-frequency difference map of each candidate's
 /// frame from the reference's (`reference_a`, or the mean of it and `reference_b`). Frames a
-/// candidate lacks are skipped. Returns the number of maps written.
+/// candidate lacks are skipped; one that cannot be read, or whose size differs from the
+/// reference's, is an error naming its file. Returns the number of maps written.
 pub fn write_low_frequency_maps(
     reference_a: &Path,
     reference_b: Option<&Path>,
@@ -37,12 +38,20 @@ pub fn write_low_frequency_maps(
             None => a,
         };
         for (label, dir) in candidates {
-            let Ok(c) = read_image(&dir.join(frame_name(idx, "exr"))) else {
+            let cpath = dir.join(frame_name(idx, "exr"));
+            if !cpath.exists() {
                 continue;
-            };
-            let Some(d) = low_frequency_difference(&c, &reference) else {
-                continue;
-            };
+            }
+            let c = read_image(&cpath)?;
+            let d = low_frequency_difference(&c, &reference).ok_or_else(|| {
+                EvalError::invalid(
+                    &cpath,
+                    format!(
+                        "{}×{}, the reference {}×{} (or the reference is black)",
+                        c.width, c.height, reference.width, reference.height
+                    ),
+                )
+            })?;
             let bytes: Vec<u8> = d
                 .iter()
                 .flat_map(|&v| difference_colour(v, MAP_FULL_SCALE))

@@ -42,6 +42,17 @@ fn a_brighter_patch_is_red_a_darker_one_blue_and_the_rest_white() {
     assert_eq!(pixel("dark", 4), [0, 0, 255]);
     // Far from it, the blur (σ = 2 % of the width) leaves no difference.
     assert_eq!(pixel("bright", W - 4), [255, 255, 255]);
+    // A candidate frame of another size names its file.
+    let small = dir.path().join("small");
+    std::fs::create_dir_all(&small).unwrap();
+    let half = &frame(0.5, 1.0)[..(W * H / 2) as usize];
+    write_frame_files(&small, 0, W, H / 2, half, None, 1.0).unwrap();
+    let e =
+        write_low_frequency_maps(&a, Some(&b), &[("small".to_string(), small)], &out).unwrap_err();
+    assert!(
+        e.to_string().contains("small") && e.to_string().contains("64×18"),
+        "{e}"
+    );
     // A missing reference half names the file.
     std::fs::remove_file(b.join(frame_name(0, "exr"))).unwrap();
     let e = write_low_frequency_maps(&a, Some(&b), &candidates, &out).unwrap_err();

@@ -138,6 +138,13 @@ pub fn snorm16(x: f32) -> i16 {
     (x.clamp(-1.0, 1.0) * 32767.0).round() as i16
 }
 
+/// Unit `n` as one RG16Snorm word: [`oct_encode`]d, x in the low 16 bits (the normal cubes'
+/// texel, as little-endian bytes; WGSL's `unpack2x16snorm` reads it back).
+pub fn oct_snorm16_pack(n: Vec3) -> u32 {
+    let e = oct_encode(n);
+    u32::from(snorm16(e.x) as u16) | (u32::from(snorm16(e.y) as u16) << 16)
+}
+
 /// Inverse of [`snorm16`] (−32768 maps to −1 as Vulkan specifies).
 pub fn from_snorm16(x: i16) -> f32 {
     (x as f32 / 32767.0).max(-1.0)

@@ -7,7 +7,9 @@ use glam::{Vec2, Vec3};
 use half::f16;
 use ktx2::Format;
 
-use crate::cube::{from_snorm16, oct_decode, oct_encode, rgb9e5_pack, rgb9e5_unpack, snorm16};
+use crate::cube::{
+    from_snorm16, oct_decode, oct_encode, oct_snorm16_pack, rgb9e5_pack, rgb9e5_unpack,
+};
 use crate::error::{PackError, Result};
 use crate::ktx::{read_cube, write_cube};
 
@@ -289,10 +291,7 @@ pub fn encode_normal(cube: &NormalCube, format: NormalFormat) -> Result<Vec<u8>>
     for n in &cube.texels {
         let e = oct_encode(*n);
         match format {
-            NormalFormat::Rg16Snorm => {
-                raw.extend_from_slice(&snorm16(e.x).to_le_bytes());
-                raw.extend_from_slice(&snorm16(e.y).to_le_bytes());
-            }
+            NormalFormat::Rg16Snorm => raw.extend_from_slice(&oct_snorm16_pack(*n).to_le_bytes()),
             NormalFormat::Rg16Float => {
                 raw.extend_from_slice(&h(e.x));
                 raw.extend_from_slice(&h(e.y));

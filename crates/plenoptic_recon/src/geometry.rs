@@ -716,11 +716,10 @@ impl VolumeFallback<'_> {
         let found: Vec<(usize, Vec3, Vec3)> = misses
             .par_iter()
             .filter_map(|&j| {
-                let (p, o) = (point(j), frame.object[j]);
+                let (p, o, n) = (point(j), frame.object[j], normal(j));
                 let (mut vs, mut vs2, mut vw) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
                 for (base, w, index) in self.volumes {
-                    let near =
-                        index.lookup_pair(p - *base, o, self.tol * 3.0, self.second, normal(j));
+                    let near = index.lookup_pair(p - *base, o, self.tol * 3.0, self.second, n);
                     if let Some((c, c2, wt)) = near {
                         vs += c * wt * *w;
                         vs2 += c2 * wt * *w;

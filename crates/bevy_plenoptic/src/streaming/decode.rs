@@ -3,7 +3,6 @@
 //! temporal-volume block binned by direction; and the bytes each will occupy, known from the
 //! pack's directory before the read (see the [module doc](super)).
 
-use bevy::math::Vec3;
 use plenoptic_pack::{ChunkKind, PackReader, cube, ktx, range_image};
 use plenoptic_recon::streamed::{CUBE_KINDS, StreamedCube, read_cube};
 
@@ -220,13 +219,6 @@ impl BinnedVolume {
     }
 }
 
-/// Unit `n` as one word: octahedral, two snorm16 (x in the low half), as a key texture's
-/// RG16Snorm normal texel and WGSL's `unpack2x16snorm` read it.
-fn oct_snorm16(n: Vec3) -> u32 {
-    let e = cube::oct_encode(n);
-    u32::from(cube::snorm16(e.x) as u16) | (u32::from(cube::snorm16(e.y) as u16) << 16)
-}
-
 /// Reads, decodes and bins one temporal-volume block. The error names the chunk.
 pub fn decode_volume(
     pack: &PackReader,
@@ -280,7 +272,7 @@ pub fn decode_volume(
             *w = x.to_bits();
         }
         words[o + 4] = cube::rgb9e5_pack(s.radiance);
-        words[o + 5] = oct_snorm16(s.normal);
+        words[o + 5] = cube::oct_snorm16_pack(s.normal);
         words[o + 7] = s.distance.to_bits();
         words[o + 8] = s.t.to_bits();
         words[o + 9] = s.object_id;
