@@ -219,6 +219,11 @@ enum Command {
         /// --frames N` renders, instead of every frame.
         #[arg(long)]
         frames: Option<usize>,
+        /// Render the bake's lighting model at each camera instead of the path tracer: the
+        /// multi-stage renderer over the bake's ambient field, as the range images are
+        /// rendered, at the camera's own pixels (docs/fidelity.md, "Where the error is made").
+        #[arg(long)]
+        bake_lighting: bool,
     },
 }
 
@@ -328,13 +333,14 @@ fn run(command: Command) -> Result<()> {
             exposure,
             lights,
             frames,
+            bake_lighting,
         } => {
             let samples = plenoptic_bake::reference::path_frames(&path, frames)?;
             cmd_reference(
                 &recipe,
                 &samples,
                 &out,
-                (spp, seed, halves),
+                (spp, seed, halves, bake_lighting),
                 exposure,
                 &lights,
             )
@@ -686,7 +692,7 @@ fn cmd_reference(
     recipe_path: &Path,
     frames: &[plenoptic_recon::PathSample],
     out: &Path,
-    (spp, seed, halves): (Option<u32>, Option<u64>, bool),
+    (spp, seed, halves, bake_lighting): (Option<u32>, Option<u64>, bool, bool),
     exposure: Option<f32>,
     lights: &[String],
 ) -> Result<()> {
@@ -709,15 +715,28 @@ fn cmd_reference(
     };
     let mut exposure = exposure;
     for (dir, spp, seed) in runs {
-        let summary = plenoptic_bake::reference::render_reference(
-            &scene,
-            frames,
-            spp,
-            Some(seed),
-            &dir,
-            exposure,
-            &Progress::new(true),
-        )?;
+        let progress = Progress::new(true);
+        let summary = if bake_lighting {
+            plenoptic_bake::reference::render_bake_lighting(
+                &scene,
+                &recipe.quality,
+                frames,
+                (spp, seed),
+                &dir,
+                exposure,
+                &progress,
+            )?
+        } else {
+            plenoptic_bake::reference::render_reference(
+                &scene,
+                frames,
+                spp,
+                Some(seed),
+                &dir,
+                exposure,
+                &progress,
+            )?
+        };
         exposure = Some(summary.exposure);
         out!(
             "{} reference frames written to {} ({:.1} s per frame at {spp} spp, seed {seed})",

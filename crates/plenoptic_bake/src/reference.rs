@@ -2,14 +2,21 @@
 //! truth every reconstruction mode is compared with (thesis §6.7: "relative LRMS against
 //! the fully rendered frame").
 //!
-//! Used by `plenoptic reference` and by the architectural tour's results.
+//! Used by `plenoptic reference` and by the architectural tour's results. `plenoptic reference
+//! --bake-lighting` renders the bake's lighting model at the cameras instead
+//! ([`render_bake_lighting`]).
 
 use std::path::Path;
 use std::time::Instant;
 
+use glam::Vec3;
 use plenoptic_recon::{CameraPath, PathSample};
 use plenoptic_scene::Scene;
-use plenoptic_trace::{PathTracer, PathTracerSettings, SceneAccel};
+use plenoptic_scene::recipe::Quality;
+use plenoptic_trace::{
+    AmbientField, Image, MultiStageRenderer, MultiStageSettings, PathTracer, PathTracerSettings,
+    PinholeCamera, PlacedScene, SceneAccel,
+};
 
 use crate::progress::Progress;
 use crate::{BakeError, Result};
@@ -40,13 +47,77 @@ pub fn render_reference(
     progress: &Progress,
 ) -> Result<ReferenceSummary> {
     let accel = SceneAccel::new(scene)?;
-    std::fs::create_dir_all(out).map_err(|e| BakeError::io(out, e))?;
     let defaults = PathTracerSettings::default();
     let tracer = PathTracer::new(PathTracerSettings {
         samples_per_pixel: spp,
         seed: seed.unwrap_or(defaults.seed),
         ..defaults
     });
+    render_frames(
+        &accel,
+        samples,
+        out,
+        exposure,
+        progress,
+        |placed, camera| Ok(tracer.render(placed, camera).radiance()),
+    )
+}
+
+/// Final-gather rays per sample of [`render_bake_lighting`]: four times the bake's at its
+/// 256-px faces (`crate::render::final_gather_rays`), so that the frame's own noise is small.
+pub const LIGHTING_GATHER_RAYS: u32 = 16;
+
+/// The bake's lighting model at each camera of `samples`, written as [`render_reference`]
+/// writes its frames: the multi-stage renderer over the bake's ambient field (built at each
+/// frame's time with `quality`'s settings), as a range image's texels are rendered, but at the
+/// camera's own pixels, with `spp` samples and [`LIGHTING_GATHER_RAYS`] final-gather rays
+/// each. Judged against the path tracer, it separates the error of the lighting the bake
+/// computes from what the pack and the runtime add (docs/fidelity.md, "Where the error is
+/// made").
+pub fn render_bake_lighting(
+    scene: &Scene,
+    quality: &Quality,
+    samples: &[PathSample],
+    (spp, seed): (u32, u64),
+    out: &Path,
+    exposure: Option<f32>,
+    progress: &Progress,
+) -> Result<ReferenceSummary> {
+    let accel = SceneAccel::new(scene)?;
+    let settings = MultiStageSettings {
+        samples_per_pixel: spp,
+        shadow_samples: 2,
+        glossy_samples: 2,
+        max_specular_depth: 4,
+        seed,
+        final_gather: LIGHTING_GATHER_RAYS,
+    };
+    let ambient = crate::plan::ambient::settings(quality, seed ^ 0xa3b1);
+    render_frames(
+        &accel,
+        samples,
+        out,
+        exposure,
+        progress,
+        |placed, camera| {
+            let field = AmbientField::build(placed, &ambient)?;
+            Ok(MultiStageRenderer::new(settings, &field)
+                .render(placed, camera)
+                .radiance())
+        },
+    )
+}
+
+/// Renders each of `samples` with `render` into `out` (the module's file layout).
+fn render_frames(
+    accel: &SceneAccel<'_>,
+    samples: &[PathSample],
+    out: &Path,
+    exposure: Option<f32>,
+    progress: &Progress,
+    render: impl Fn(&PlacedScene<'_>, &PinholeCamera) -> Result<Image<Vec3>>,
+) -> Result<ReferenceSummary> {
+    std::fs::create_dir_all(out).map_err(|e| BakeError::io(out, e))?;
     let bar = progress.phase("reference", samples.len() as u64);
     let mut exposure = exposure;
     let clock = Instant::now();
@@ -54,7 +125,7 @@ pub fn render_reference(
         let camera = plenoptic_eval::camera::to_pinhole(&f.camera)
             .map_err(|e| BakeError::Invalid(format!("frame {}: {e}", f.index)))?;
         let placed = accel.at_time(f.scene_time);
-        let image = tracer.render(&placed, &camera).radiance();
+        let image = render(&placed, &camera)?;
         let e =
             *exposure.get_or_insert_with(|| plenoptic_eval::frame_io::auto_exposure(&image.pixels));
         plenoptic_eval::tools::write_frame_files(
