@@ -35,7 +35,7 @@
 //! `tour_hdr_screen_fill_1280x720` and `tour_hdr_fragment_fill_1280x720` cases are the tour
 //! on an HDR camera without MSAA with the lookup kernel (with and without the sparse
 //! lighting), with the lookups in the fragments and the screen fill, and with the fragment
-//! fill. With
+//! fill; `tour_hdr_screen_fill_msaa4_1280x720` is the screen-fill case with 4× MSAA. With
 //! `PLENOPTIC_BENCH_PASSES` set, each frame case also prints its passes' CPU and GPU times
 //! (Bevy's render diagnostics).
 //!
@@ -441,6 +441,13 @@ fn frame(c: &mut Criterion) {
                 if sparse { s } else { dense_lighting(s) }
             });
         }
+        // The same HDR camera with Bevy's 4× MSAA (docs/architecture.md, "Antialiasing").
+        settled_frames(&mut g, "tour_hdr_screen_fill_msaa4_1280x720", || {
+            with_msaa(
+                hdr_scene(scene(assets, name, &views, TOUR_SIZE), true),
+                Msaa::Sample4,
+            )
+        });
     }
     g.finish();
 }
@@ -477,6 +484,14 @@ fn hdr_scene(mut s: Scene, screen_fill: bool) -> Scene {
             .world_mut()
             .entity_mut(camera)
             .insert((Hdr, Msaa::Off));
+    }
+    s
+}
+
+/// `s` with every camera's MSAA set to `msaa`.
+fn with_msaa(mut s: Scene, msaa: Msaa) -> Scene {
+    for &camera in &s.cameras {
+        s.app.world_mut().entity_mut(camera).insert(msaa);
     }
     s
 }
