@@ -88,7 +88,7 @@ pub fn render_bake_lighting(
         samples_per_pixel: spp,
         shadow_samples: 2,
         glossy_samples: 2,
-        max_specular_depth: 4,
+        max_specular_depth: quality.max_specular_depth,
         seed,
         final_gather: LIGHTING_GATHER_RAYS,
     };
