@@ -14,11 +14,12 @@ use plenoptic_recon::{CameraPath, PathSample};
 use plenoptic_scene::Scene;
 use plenoptic_scene::recipe::Quality;
 use plenoptic_trace::{
-    AmbientField, Image, MultiStageRenderer, MultiStageSettings, PathTracer, PathTracerSettings,
-    PinholeCamera, PlacedScene, SceneAccel,
+    AmbientField, Image, MultiStageRenderer, PathTracer, PathTracerSettings, PinholeCamera,
+    PlacedScene, SceneAccel,
 };
 
 use crate::progress::Progress;
+use crate::render::multi_stage_settings;
 use crate::{BakeError, Result};
 
 /// What [`render_reference`] did.
@@ -63,8 +64,8 @@ pub fn render_reference(
     )
 }
 
-/// Final-gather rays per sample of [`render_bake_lighting`]: four times the bake's at its
-/// 256-px faces (`crate::render::final_gather_rays`), so that the frame's own noise is small.
+/// Final-gather rays per sample of [`render_bake_lighting`]: four times the bake's at
+/// 64-px faces (`crate::render::final_gather_rays`), so that the frame's own noise is small.
 pub const LIGHTING_GATHER_RAYS: u32 = 16;
 
 /// The bake's lighting model at each camera of `samples`, written as [`render_reference`]
@@ -84,15 +85,8 @@ pub fn render_bake_lighting(
     progress: &Progress,
 ) -> Result<ReferenceSummary> {
     let accel = SceneAccel::new(scene)?;
-    let settings = MultiStageSettings {
-        samples_per_pixel: spp,
-        shadow_samples: 2,
-        glossy_samples: 2,
-        max_specular_depth: quality.max_specular_depth,
-        seed,
-        final_gather: LIGHTING_GATHER_RAYS,
-    };
-    let ambient = crate::plan::ambient::settings(quality, seed ^ 0xa3b1);
+    let settings = multi_stage_settings(quality, seed, spp, LIGHTING_GATHER_RAYS);
+    let ambient = crate::plan::ambient::field_settings(quality, seed);
     render_frames(
         &accel,
         samples,

@@ -18,6 +18,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
 use plenoptic_pack::{CubeImage, RangeImage, face_uv_to_direction};
+use plenoptic_scene::recipe::Quality;
 use plenoptic_scene::{NO_OBJECT, ObjectId, Scene};
 use plenoptic_trace::image::luminance;
 use plenoptic_trace::sampling::Sampler;
@@ -63,6 +64,24 @@ pub fn seed_of(parts: &[u64]) -> u64 {
 pub fn final_gather_rays(n: u32) -> u32 {
     let halvings = 8u32.saturating_sub(n.max(1).ilog2()).min(4);
     1 << halvings
+}
+
+/// The multi-stage renderer's settings the bake renders with at `quality`: `spp` samples per
+/// pixel, `final_gather` rays per sample at the first hit, 2 shadow and 2 glossy samples.
+pub fn multi_stage_settings(
+    quality: &Quality,
+    seed: u64,
+    spp: u32,
+    final_gather: u32,
+) -> MultiStageSettings {
+    MultiStageSettings {
+        samples_per_pixel: spp.max(1),
+        shadow_samples: 2,
+        glossy_samples: 2,
+        max_specular_depth: quality.max_specular_depth,
+        seed,
+        final_gather,
+    }
 }
 
 /// Renders range images and volume samples for a plan.
@@ -128,14 +147,7 @@ impl<'a> BakeRenderer<'a> {
 
     /// The renderer's settings; `final_gather` rays per sample at the first hit.
     fn settings(&self, seed: u64, spp: u32, final_gather: u32) -> MultiStageSettings {
-        MultiStageSettings {
-            samples_per_pixel: spp.max(1),
-            shadow_samples: 2,
-            glossy_samples: 2,
-            max_specular_depth: self.plan.quality.max_specular_depth,
-            seed,
-            final_gather,
-        }
+        multi_stage_settings(&self.plan.quality, seed, spp, final_gather)
     }
 
     /// The range image of base view `bv` at its time key `key`, per light layer.

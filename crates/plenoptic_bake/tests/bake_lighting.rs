@@ -5,18 +5,11 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
 use plenoptic_bake::progress::Progress;
 use plenoptic_bake::reference::{path_frames, render_bake_lighting, render_reference};
 use plenoptic_eval::frame_io::read_exr;
-
-fn mean_luminance(pixels: &[Vec3]) -> f64 {
-    pixels
-        .iter()
-        .map(|c| f64::from(c.dot(Vec3::new(0.2126, 0.7152, 0.0722))))
-        .sum::<f64>()
-        / pixels.len() as f64
-}
+use plenoptic_eval::metrics::mean_luminance_ratio;
+use plenoptic_trace::Image;
 
 /// In a closed room lit by a point lamp (a box on the floor), the bake's lighting at a
 /// camera has the path tracer's mean within 5 %, and is a frame of its own (not a copy of
@@ -63,16 +56,24 @@ fn the_bakes_lighting_at_a_camera_has_the_path_tracers_mean() {
         &progress,
     )
     .unwrap();
-    let (w, h, ours) = read_exr(lighting.join("frame_00000.exr")).unwrap();
-    let (_, _, truth) = read_exr(reference.join("frame_00000.exr")).unwrap();
-    assert_eq!((w, h), (24, 16));
+    let image = |dir: &std::path::Path| {
+        let (width, height, pixels) = read_exr(dir.join("frame_00000.exr")).unwrap();
+        Image {
+            width,
+            height,
+            pixels,
+        }
+    };
+    let (ours, truth) = (image(&lighting), image(&reference));
+    assert_eq!((ours.width, ours.height), (24, 16));
     assert!(lighting.join("frame_00000.png").exists());
-    let ratio = mean_luminance(&ours) / mean_luminance(&truth);
+    let ratio = mean_luminance_ratio(&ours, &truth);
     println!("the bake's lighting over the path tracer's mean: {ratio:.3}");
     assert!((ratio - 1.0).abs() < 0.05, "mean ratio {ratio}");
     assert!(
-        ours.iter()
-            .zip(&truth)
+        ours.pixels
+            .iter()
+            .zip(&truth.pixels)
             .any(|(a, b)| (*a - *b).length() > 1e-3)
     );
 }

@@ -30,6 +30,11 @@ pub fn settings(quality: &Quality, seed: u64) -> AmbientSettings {
     }
 }
 
+/// The settings a bake with seed `bake_seed` gathers its ambient fields with.
+pub fn field_settings(quality: &Quality, bake_seed: u64) -> AmbientSettings {
+    settings(quality, bake_seed ^ 0xa3b1)
+}
+
 /// Key times and what was gathered at them.
 pub struct AmbientKeys<V = AmbientField> {
     /// Key times, ascending.

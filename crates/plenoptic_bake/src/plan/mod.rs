@@ -407,7 +407,7 @@ pub fn build(recipe: &BakeRecipe, scene: &Scene, accel: &SceneAccel<'_>) -> Resu
 
 /// The ambient settings of a plan's fields.
 fn ambient_settings(plan: &Plan) -> plenoptic_trace::AmbientSettings {
-    ambient::settings(&plan.quality, plan.seed ^ 0xa3b1)
+    ambient::field_settings(&plan.quality, plan.seed)
 }
 
 /// The plan's time range and ambient subdivision limits.
