@@ -15,6 +15,7 @@ pub mod ids;
 pub mod space;
 pub mod sunlit;
 pub mod time;
+pub mod view_keys;
 
 use glam::Vec3;
 use plenoptic_scene::Scene;
@@ -430,6 +431,7 @@ pub fn ambient_phase(
     let keys = ambient::key_times(scene, accel, &ambient_settings(plan), ambient_range(plan))?;
     plan.ambient_keys = keys.times;
     plan.counters.ambient_intervals_tested = keys.tested;
+    refine_view_keys(plan, accel, &keys.fields);
     Ok(keys.fields)
 }
 
@@ -442,6 +444,15 @@ pub fn layered_ambient_phase(
     let keys = ambient::layered_key_times(layers, &ambient_settings(plan), ambient_range(plan))?;
     plan.ambient_keys = keys.times;
     plan.counters.ambient_intervals_tested = keys.tested;
+    // The whole scene's field is the sum of the layers' (one layout: the sum cannot fail).
+    let sums: Option<Vec<AmbientField>> = keys
+        .fields
+        .iter()
+        .map(|layers| AmbientField::sum(layers).and_then(|s| s.ok()))
+        .collect();
+    if let (Some(sums), Some((_, accel))) = (sums, layers.first()) {
+        refine_view_keys(plan, accel, &sums);
+    }
     let mut per_layer: Vec<Vec<AmbientField>> = vec![Vec::new(); layers.len()];
     for at_key in keys.fields {
         for (layer, field) in per_layer.iter_mut().zip(at_key) {
@@ -449,4 +460,16 @@ pub fn layered_ambient_phase(
         }
     }
     Ok(per_layer)
+}
+
+/// Each base view's keys with the ambient key times added where the view's indirect light is
+/// not linear between its keys ([`view_keys`]).
+fn refine_view_keys(plan: &mut Plan, accel: &SceneAccel<'_>, fields: &[AmbientField]) {
+    if !plan.animated || fields.len() != plan.ambient_keys.len() {
+        return;
+    }
+    let times = plan.ambient_keys.clone();
+    for view in &mut plan.base_views {
+        view.time_keys = view_keys::refine(accel, view.position, &view.time_keys, &times, fields);
+    }
 }
