@@ -5,9 +5,10 @@
 //! The runtime blends a view's two keys around the frame's time linearly (thesis §8.2.3's time
 //! weights). The light keys follow what the lights see and the ambient field's keys follow how
 //! much its irradiance changes between an interval's ends; neither says whether the light a
-//! view shows is linear in between. Under a sun study it often is not: on the tour a view of
-//! room B darkens 17 % from its key at 5.25 s to 6.5 s and 1 % more to its next key at 7 s, so
-//! the blend at 6.5 s is 4.8 % too bright.
+//! view shows is linear in between. Under a sun study it often is not: on the tour the light a
+//! camera in room B sees falls 17 % from the light key at 5.25 s to 6.5 s and 1 % more to the
+//! next one at 7 s, so the blend of those keys is 4.8 % too bright at 6.5 s
+//! (docs/fidelity.md, "Mean offsets between keys").
 //!
 //! So each view takes an ambient key time that lies between two of its keys as a key of its own
 //! where the field there differs from the linear blend of the field at its bracketing keys by
