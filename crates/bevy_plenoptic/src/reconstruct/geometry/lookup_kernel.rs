@@ -32,8 +32,8 @@
 //!
 //! Measured on lavapipe (`docs/results/measurements.md`, "The plugin's work per pixel"): the
 //! same frames, but more reads (each record is read back, 64 bytes) and a longer frame
-//! (the tour: 1.19× the fragments' lookups with the sparse lighting, which reads 23.0 texels
-//! and records per pixel, 1.36× without it, 28.4), so the setting is off by default until a
+//! (the tour: 1.19× the fragments' lookups with the sparse lighting, which reads 23.2 texels
+//! and records per pixel, 1.36× without it, 28.6), so the setting is off by default until a
 //! GPU's timings decide.
 //!
 //! [`PlenopticSettings::lookup_kernel`]: crate::settings::PlenopticSettings::lookup_kernel
