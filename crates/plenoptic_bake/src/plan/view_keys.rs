@@ -18,10 +18,13 @@
 //! renders with (linear between the ambient keys), so a time the test passes is one where the
 //! range images would agree with the blend up to their noise.
 
+use std::borrow::Cow;
+use std::collections::HashMap;
+
 use glam::Vec3;
 use plenoptic_pack::cube::texel_direction;
 use plenoptic_trace::image::luminance;
-use plenoptic_trace::{AmbientField, Ray, SceneAccel};
+use plenoptic_trace::{AmbientField, Hit, PlacedScene, Ray, SceneAccel};
 use rayon::prelude::*;
 
 use super::ambient::field_at;
@@ -43,22 +46,39 @@ pub fn refine(
     fields: &[AmbientField],
 ) -> Vec<f32> {
     let mut keys = keys.to_vec();
+    // Each candidate's probe is traced and read at its own time once; the luminance there from
+    // the field at a key time is read once per (candidate, key).
+    let mut probes: Vec<Probe<'_>> = times
+        .iter()
+        .zip(fields)
+        .filter(|(t, _)| bracket(&keys, **t).is_some())
+        .map(|(&t, field)| Probe::new(accel, position, t, field))
+        .collect();
+    let mut at_keys: HashMap<u32, Cow<'_, AmbientField>> = HashMap::new();
     loop {
-        let worst = times
-            .iter()
-            .enumerate()
-            .filter_map(|(i, &t)| {
-                let bracket = bracket(&keys, t)?;
-                Some((
-                    t,
-                    bend(accel, position, t, &fields[i], bracket, times, fields),
-                ))
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let mut worst: Option<(usize, f64)> = None;
+        for (i, probe) in probes.iter_mut().enumerate() {
+            let Some((t0, t1)) = bracket(&keys, probe.t) else {
+                continue;
+            };
+            for t in [t0, t1] {
+                at_keys
+                    .entry(t.to_bits())
+                    .or_insert_with(|| field_at(times, fields, t));
+            }
+            let e0 = probe.seen(t0, &at_keys[&t0.to_bits()]);
+            let e1 = probe.seen(t1, &at_keys[&t1.to_bits()]);
+            let err = probe.bend(&e0, &e1, (probe.t - t0) / (t1 - t0));
+            probe.remember(t0, e0);
+            probe.remember(t1, e1);
+            if worst.is_none_or(|(_, w)| err > w) {
+                worst = Some((i, err));
+            }
+        }
         match worst {
-            Some((t, err)) if err > f64::from(LERP_RMS) => {
-                let at = keys.partition_point(|&k| k < t);
-                keys.insert(at, t);
+            Some((i, err)) if err > f64::from(LERP_RMS) => {
+                let t = probes[i].t;
+                keys.insert(keys.partition_point(|&k| k < t), t);
             }
             _ => return keys,
         }
@@ -74,39 +94,75 @@ fn bracket(keys: &[f32], t: f32) -> Option<(f32, f32)> {
     Some((keys[i - 1], keys[i]))
 }
 
-/// Relative RMS difference, over the probe cube's hits at `t`, between `field` (the field at
-/// `t`) and the linear blend of the fields at the ends of `(t0, t1)`.
-fn bend(
-    accel: &SceneAccel<'_>,
-    position: Vec3,
+/// A candidate time's probe cube: its hits at that time, the field's luminance there, and the
+/// luminance the fields at the view's keys give them.
+struct Probe<'a> {
     t: f32,
-    field: &AmbientField,
-    (t0, t1): (f32, f32),
-    times: &[f32],
-    fields: &[AmbientField],
-) -> f64 {
-    let placed = accel.at_time(t);
-    let (a, b) = (field_at(times, fields, t0), field_at(times, fields, t1));
-    let s = (t - t0) / (t1 - t0);
-    let texels = 6 * PROBE_FACE * PROBE_FACE;
-    let (diff, total) = (0..texels)
-        .into_par_iter()
-        .filter_map(|i| {
-            let dir = texel_direction(PROBE_FACE, i as usize);
-            let hit = placed.intersect(&Ray::new(position, dir))?;
-            let at = |f: &AmbientField| f.irradiance_seen(&placed, &hit, -dir);
-            let e = at(field);
-            let blend = at(&a).lerp(at(&b), s);
-            Some((
-                f64::from(luminance(e - blend)).powi(2),
-                f64::from(luminance(e)).powi(2),
-            ))
-        })
-        .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
-    if total <= 0.0 {
-        return 0.0;
+    placed: PlacedScene<'a>,
+    hits: Vec<(Hit, Vec3)>,
+    own: Vec<f32>,
+    at_keys: HashMap<u32, Vec<f32>>,
+}
+
+impl<'a> Probe<'a> {
+    /// The probe cube at `position` traced at `t`, read in `field` (the field at `t`).
+    fn new(accel: &'a SceneAccel<'a>, position: Vec3, t: f32, field: &AmbientField) -> Self {
+        let placed = accel.at_time(t);
+        let hits: Vec<(Hit, Vec3)> = (0..6 * PROBE_FACE * PROBE_FACE)
+            .into_par_iter()
+            .filter_map(|i| {
+                let dir = texel_direction(PROBE_FACE, i as usize);
+                Some((placed.intersect(&Ray::new(position, dir))?, dir))
+            })
+            .collect();
+        let mut probe = Self {
+            t,
+            placed,
+            hits,
+            own: Vec::new(),
+            at_keys: HashMap::new(),
+        };
+        probe.own = probe.read(field);
+        probe
     }
-    (diff / total).sqrt()
+
+    /// Luminance of `field`'s irradiance at each hit, as the renderer reads it.
+    fn read(&self, field: &AmbientField) -> Vec<f32> {
+        self.hits
+            .par_iter()
+            .map(|(hit, dir)| luminance(field.irradiance_seen(&self.placed, hit, -*dir)))
+            .collect()
+    }
+
+    /// [`Self::read`] of `field`, the field at key time `key`, kept from an earlier call.
+    fn seen(&mut self, key: f32, field: &AmbientField) -> Vec<f32> {
+        self.at_keys
+            .remove(&key.to_bits())
+            .unwrap_or_else(|| self.read(field))
+    }
+
+    /// Keeps `values` as [`Self::seen`]'s answer for `key`.
+    fn remember(&mut self, key: f32, values: Vec<f32>) {
+        self.at_keys.insert(key.to_bits(), values);
+    }
+
+    /// Relative RMS difference between the field at the probe's time and the blend
+    /// `(1 − s)·e0 + s·e1` of the fields at its bracketing keys (luminance is linear, so the
+    /// blend of luminances is the luminance of the blend).
+    fn bend(&self, e0: &[f32], e1: &[f32], s: f32) -> f64 {
+        let (diff, total) =
+            self.own
+                .iter()
+                .zip(e0.iter().zip(e1))
+                .fold((0.0, 0.0), |(d, n), (&e, (&a, &b))| {
+                    let blend = a + (b - a) * s;
+                    (d + f64::from(e - blend).powi(2), n + f64::from(e).powi(2))
+                });
+        if total <= 0.0 {
+            return 0.0;
+        }
+        (diff / total).sqrt()
+    }
 }
 
 #[cfg(test)]
