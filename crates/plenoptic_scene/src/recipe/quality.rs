@@ -88,7 +88,7 @@ pub struct Quality {
     /// gets another key time. Smaller values cost more ambient keys and catch subtler changes.
     /// An ambient key time between two of a base view's keys becomes a key of that view where
     /// the view's indirect light there is more than 5 % from the blend of its keys
-    /// ([architecture](architecture.md), "Baking", step 5): on the tour 58 more range images
+    /// (docs/architecture.md, "Baking", step 5): on the tour 58 more range images
     /// than the 225 of the light keys, 1.24× the bake time and 1.21× the pack.
     pub ambient_rms: f32,
     /// Sample budget per base view of the temporal volume, the (x, y, t) samples that stand
