@@ -183,7 +183,10 @@ enum Command {
         plot: PathBuf,
         /// Also write each candidate frame's low-frequency difference from the reference as
         /// `DIR/<label>_frame_NNNNN.png`: red where the candidate is brighter, blue where it
-        /// is darker, full colour at 20 % of the frame's mean (blotches, halos, dim patches).
+        /// is darker, full colour at 20 % of the frame's mean (blotches, halos, dim patches);
+        /// and where its corrected squared error lies as `DIR/<label>_error_frame_NNNNN.png`
+        /// (red at the frame's mean luminance squared), printing each frame's share of it in
+        /// its worst 8 × 8 pixels.
         #[arg(long, value_name = "DIR")]
         maps: Option<PathBuf>,
     },
@@ -493,6 +496,19 @@ fn cmd_compare(
         )
         .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
         out!("wrote {n} low-frequency maps into {}", dir.display());
+        let errors =
+            plenoptic_eval::maps::write_error_maps(reference, reference_b, &candidates, dir)
+                .map_err(|e| BakeError::Invalid(format!("compare: {e}")))?;
+        for (label, frame, c) in &errors {
+            out!(
+                "{label} frame {frame}: {:.0} % of the corrected squared error in the 8 × 8 \
+                 pixels at ({}, {})",
+                100.0 * c.share,
+                c.x,
+                c.y
+            );
+        }
+        out!("wrote {} error maps into {}", errors.len(), dir.display());
     }
     Ok(())
 }

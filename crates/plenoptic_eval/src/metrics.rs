@@ -105,11 +105,11 @@ pub struct ErrorSums {
 impl ErrorSums {
     /// Adds one pixel: test `x`, reference halves `a` and `b` (luminances).
     pub fn add(&mut self, x: f64, a: f64, b: f64) {
-        let m = 0.5 * (a + b);
+        let (squared_error, variance) = squared_error_terms(x, a, b);
         self.count += 1;
-        self.squared_error += (x - m) * (x - m);
-        self.variance += 0.25 * (a - b) * (a - b);
-        self.reference += m;
+        self.squared_error += squared_error;
+        self.variance += variance;
+        self.reference += 0.5 * (a + b);
         self.test += x;
     }
 
@@ -158,6 +158,45 @@ impl ErrorSums {
             mean_ratio: self.test / self.reference,
         }
     }
+}
+
+/// One pixel's terms of the corrected error: test `x` against the mean m of halves `a` and
+/// `b`, ((x − m)², (a − b)²/4).
+#[inline]
+fn squared_error_terms(x: f64, a: f64, b: f64) -> (f64, f64) {
+    let m = 0.5 * (a + b);
+    ((x - m) * (x - m), 0.25 * (a - b) * (a - b))
+}
+
+/// Each pixel's variance-corrected squared luminance error, (x − m)² − (a − b)²/4: the terms
+/// whose mean [`ErrorSums::corrected_rms`] takes the root of (negative where the reference's
+/// noise is larger than the error). `None` when the sizes differ.
+pub fn corrected_squared_errors(
+    test: &Image<Vec3>,
+    ref_a: &Image<Vec3>,
+    ref_b: &Image<Vec3>,
+) -> Option<Vec<f64>> {
+    let n = test.pixels.len();
+    if (test.width, test.height) != (ref_a.width, ref_a.height)
+        || (test.width, test.height) != (ref_b.width, ref_b.height)
+        || n != ref_a.pixels.len()
+        || n != ref_b.pixels.len()
+    {
+        return None;
+    }
+    let lum = |c: Vec3| f64::from(luminance(c));
+    Some(
+        (0..n)
+            .map(|i| {
+                let (e, v) = squared_error_terms(
+                    lum(test.pixels[i]),
+                    lum(ref_a.pixels[i]),
+                    lum(ref_b.pixels[i]),
+                );
+                e - v
+            })
+            .collect(),
+    )
 }
 
 /// The relative LRMS of `test` against the noisy reference given as two independent halves

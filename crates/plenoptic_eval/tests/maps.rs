@@ -1,9 +1,9 @@
-//! `plenoptic compare --maps`: the low-frequency difference pictures
+//! `plenoptic compare --maps`: the low-frequency difference pictures and the error maps
 //! ([`plenoptic_eval::maps`]).
 
 use std::path::PathBuf;
 
-use plenoptic_eval::maps::write_low_frequency_maps;
+use plenoptic_eval::maps::{TILE, write_error_maps, write_low_frequency_maps};
 use plenoptic_eval::tools::{frame_name, write_frame_files};
 use plenoptic_trace::glam::Vec3;
 
@@ -57,4 +57,57 @@ fn a_brighter_patch_is_red_a_darker_one_blue_and_the_rest_white() {
     std::fs::remove_file(b.join(frame_name(0, "exr"))).unwrap();
     let e = write_low_frequency_maps(&a, Some(&b), &candidates, &out).unwrap_err();
     assert!(e.to_string().contains("frame_00000.exr"), "{e}");
+}
+
+#[test]
+fn an_error_map_is_red_where_the_error_is_and_names_its_worst_tile() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, pixels: &[Vec3]| -> PathBuf {
+        let d = dir.path().join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        write_frame_files(&d, 0, W, H, pixels, None, 1.0).unwrap();
+        d
+    };
+    // Halves A and B differ by a checker of ±0.05 (the reference's noise); their mean is 0.5.
+    let half = |sign: f32| -> Vec<Vec3> {
+        (0..H)
+            .flat_map(|y| {
+                (0..W).map(move |x| {
+                    let s = if (x + y) % 2 == 0 { sign } else { -sign };
+                    Vec3::splat(0.5 + 0.05 * s)
+                })
+            })
+            .collect()
+    };
+    let (a, b) = (write("a", &half(1.0)), write("b", &half(-1.0)));
+    // The candidate is the mean, but for a 2 × 2 spot at 3.0 in the tile at (40, 16).
+    let mut spot = vec![Vec3::splat(0.5); (W * H) as usize];
+    for (x, y) in [(42, 18), (43, 18), (42, 19), (43, 19)] {
+        spot[(y * W + x) as usize] = Vec3::splat(3.0);
+    }
+    let spot_dir = write("spot", &spot);
+    let out = dir.path().join("maps");
+    let written = write_error_maps(&a, Some(&b), &[("spot".to_string(), spot_dir)], &out).unwrap();
+    assert_eq!(written.len(), 1);
+    let (label, frame, c) = &written[0];
+    assert_eq!((label.as_str(), *frame), ("spot", 0));
+    assert_eq!((c.x, c.y), (40, 16));
+    assert_eq!(TILE, 8);
+    // The spot's error (4 × 2.5²), less the reference's variance (0.05² at every pixel), in
+    // the tile and in the frame: more than the frame's sum, as the rest is below the noise.
+    let (spot_error, variance) = (4.0 * 2.5f64.powi(2), 0.05f64.powi(2));
+    let expected = (spot_error - 64.0 * variance) / (spot_error - f64::from(W * H) * variance);
+    assert!(
+        (c.share - expected).abs() < 1e-3,
+        "{} against {expected}",
+        c.share
+    );
+    let pixel = |x: u32, y: u32| {
+        let path = out.join(format!("spot_error_{}", frame_name(0, "png")));
+        image::open(&path).unwrap().to_rgb8().get_pixel(x, y).0
+    };
+    assert_eq!(pixel(42, 18), [255, 0, 0]);
+    // Away from the spot the candidate is the reference's mean: below its noise, not red.
+    let far = pixel(4, 4);
+    assert!(far[0] < 255 && far[2] == 255, "{far:?}");
 }
