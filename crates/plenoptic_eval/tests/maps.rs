@@ -1,7 +1,7 @@
 //! `plenoptic compare --maps`: the low-frequency difference pictures and the error maps
 //! ([`plenoptic_eval::maps`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use plenoptic_eval::maps::{TILE, write_error_maps, write_low_frequency_maps};
 use plenoptic_eval::tools::{frame_name, write_frame_files};
@@ -17,15 +17,18 @@ fn frame(level: f32, left: f32) -> Vec<Vec3> {
         .collect()
 }
 
+/// Frame 0 of `pixels` (W × H) written into `root/name`, which is returned.
+fn write_frame(root: &Path, name: &str, pixels: &[Vec3]) -> PathBuf {
+    let d = root.join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    write_frame_files(&d, 0, W, H, pixels, None, 1.0).unwrap();
+    d
+}
+
 #[test]
 fn a_brighter_patch_is_red_a_darker_one_blue_and_the_rest_white() {
     let dir = tempfile::tempdir().unwrap();
-    let write = |name: &str, pixels: &[Vec3]| -> PathBuf {
-        let d = dir.path().join(name);
-        std::fs::create_dir_all(&d).unwrap();
-        write_frame_files(&d, 0, W, H, pixels, None, 1.0).unwrap();
-        d
-    };
+    let write = |name: &str, pixels: &[Vec3]| write_frame(dir.path(), name, pixels);
     let (a, b) = (write("a", &frame(0.5, 1.0)), write("b", &frame(0.5, 1.0)));
     let bright = write("bright", &frame(0.5, 1.5));
     let dark = write("dark", &frame(0.5, 0.5));
@@ -62,12 +65,7 @@ fn a_brighter_patch_is_red_a_darker_one_blue_and_the_rest_white() {
 #[test]
 fn an_error_map_is_red_where_the_error_is_and_names_its_worst_tile() {
     let dir = tempfile::tempdir().unwrap();
-    let write = |name: &str, pixels: &[Vec3]| -> PathBuf {
-        let d = dir.path().join(name);
-        std::fs::create_dir_all(&d).unwrap();
-        write_frame_files(&d, 0, W, H, pixels, None, 1.0).unwrap();
-        d
-    };
+    let write = |name: &str, pixels: &[Vec3]| write_frame(dir.path(), name, pixels);
     // Halves A and B differ by a checker of ±0.05 (the reference's noise); their mean is 0.5.
     let half = |sign: f32| -> Vec<Vec3> {
         (0..H)
