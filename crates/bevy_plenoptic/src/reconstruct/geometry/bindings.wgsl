@@ -35,6 +35,19 @@ const VIEW_LOOKUP_KERNEL: u32 = 64u;
 // With it, materials' lighting is looked up at the anchors and interpolated (screen_fill.wgsl).
 const VIEW_SPARSE_LIGHTING: u32 = 128u;
 
+// A placed lamp (view.rs, LampParams; plenoptic_recon's lamps::RuntimeLamp).
+struct Lamp {
+    // Position (metres) and range (−1: none).
+    position: vec3<f32>,
+    range: f32,
+    // A spot light's axis and the cosine of its outer cone (−2: a point light).
+    axis: vec3<f32>,
+    cos_outer: f32,
+    // Colour × intensity, scaled by its light group; 1 / (cos inner − cos outer) of a spot.
+    radiant: vec3<f32>,
+    cone_scale: f32,
+}
+
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
     // Lookups in use, the keys' face size, volume blocks in use, VIEW_* bits.
@@ -63,10 +76,8 @@ struct ViewParams {
     sun: vec4<f32>,
     // Its illuminance at the camera's time (xyz).
     sun_illuminance: vec4<f32>,
-    // The placed lamps (plenoptic_recon's lamps module), 3 per lamp: position (xyz), range
-    // (w, −1: none); spot axis (xyz), cos outer cone (w, −2: a point light); colour ×
-    // intensity (xyz), 1 / (cos inner − cos outer) (w).
-    lamps: array<vec4<f32>, 12>,
+    // The placed lamps (plenoptic_recon's lamps module); lamp_count of them in use.
+    lamps: array<Lamp, 4>,
     // Per lookup: base view position (xyz) and first layer (w).
     base: array<vec4<f32>, 16>,
     // Per lookup: weight (x), whether the key has normals (y), 1 + its pair where it is the

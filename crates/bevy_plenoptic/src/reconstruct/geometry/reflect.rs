@@ -21,7 +21,7 @@ use plenoptic_recon::lamps::runtime_lamps;
 use plenoptic_recon::relight::Relight;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
-use super::view::ViewParams;
+use super::view::{LampParams, ViewParams};
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 
@@ -42,9 +42,14 @@ pub(super) fn fill(
         } else {
             -1.0
         };
-        params.lamps[3 * k] = lamp.position.extend(range);
-        params.lamps[3 * k + 1] = lamp.direction.extend(cos_outer);
-        params.lamps[3 * k + 2] = (lamp.radiant * relight.light(lamp.light)).extend(scale);
+        params.lamps[k] = LampParams {
+            position: lamp.position,
+            range,
+            axis: lamp.direction,
+            cos_outer,
+            radiant: lamp.radiant * relight.light(lamp.light),
+            cone_scale: scale,
+        };
     }
     if let Specular::Marched { max_roughness } = settings.specular {
         let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());
@@ -89,8 +94,8 @@ mod tests {
             assert!(fallback.contains(&line), "fallback.wgsl lacks `{line}`");
         }
         let line = format!(
-            "lamps: array<vec4<f32>, {}>,",
-            3 * plenoptic_recon::lamps::MAX_RUNTIME_LAMPS
+            "lamps: array<Lamp, {}>,",
+            plenoptic_recon::lamps::MAX_RUNTIME_LAMPS
         );
         let bindings = include_str!("bindings.wgsl");
         assert!(bindings.contains(&line), "bindings.wgsl lacks `{line}`");

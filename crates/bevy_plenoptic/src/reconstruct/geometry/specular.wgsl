@@ -127,19 +127,17 @@ fn highlights(p: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f
     var sum = vec3<f32>(0.0);
     let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
     for (var k = 0u; k < cam.lamp_count; k++) {
-        let a = cam.lamps[3u * k];
-        let b = cam.lamps[3u * k + 1u];
-        let c = cam.lamps[3u * k + 2u];
-        let d = a.xyz - p;
+        let lamp = cam.lamps[k];
+        let d = lamp.position - p;
         let dist2 = dot(d, d);
         let dist = sqrt(dist2);
-        if dist <= 0.0 || (a.w > 0.0 && dist > a.w) {
+        if dist <= 0.0 || (lamp.range > 0.0 && dist > lamp.range) {
             continue;
         }
         let wi = d / dist;
-        var value = c.xyz / dist2;
-        if b.w > -1.5 {
-            let att = clamp((dot(b.xyz, -wi) - b.w) * c.w, 0.0, 1.0);
+        var value = lamp.radiant / dist2;
+        if lamp.cos_outer > -1.5 {
+            let att = clamp((dot(lamp.axis, -wi) - lamp.cos_outer) * lamp.cone_scale, 0.0, 1.0);
             value *= att * att;
         }
         if all(value == vec3<f32>(0.0)) {

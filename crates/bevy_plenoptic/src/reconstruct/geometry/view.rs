@@ -44,6 +44,24 @@ use plenoptic_pack::MAX_LIGHT_GROUPS;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 use plenoptic_recon::relight::Relight;
 
+/// A placed lamp in the view buffer (`Lamp` in `bindings.wgsl`), as
+/// `plenoptic_recon::lamps::RuntimeLamp` describes it.
+#[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
+pub struct LampParams {
+    /// Position, metres.
+    pub position: Vec3,
+    /// Range, metres (−1: none).
+    pub range: f32,
+    /// A spot light's axis (unit).
+    pub axis: Vec3,
+    /// The cosine of a spot light's outer cone (−2: a point light).
+    pub cos_outer: f32,
+    /// Colour × intensity, scaled by the lamp's light group.
+    pub radiant: Vec3,
+    /// A spot light's `1 / (cos inner − cos outer)` (0: a point light).
+    pub cone_scale: f32,
+}
+
 /// One camera's lookups and settings, as the geometry-assisted shader reads them (`ViewParams`
 /// in `bindings.wgsl`).
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
@@ -83,10 +101,8 @@ pub struct ViewParams {
     /// The runtime sun's illuminance at the camera's time (xyz).
     pub sun_illuminance: Vec4,
     /// The lamps whose highlights glossy surfaces add ([`super::reflect`],
-    /// `plenoptic_recon::lamps`), 3 per lamp: position (xyz) and range (w, −1: none);
-    /// spot axis (xyz) and the cosine of its outer cone (w, −2: a point light); colour ×
-    /// intensity (xyz) and `1 / (cos inner − cos outer)` (w). `lamp_count` counts them.
-    pub lamps: [Vec4; 3 * MAX_RUNTIME_LAMPS],
+    /// `plenoptic_recon::lamps`); `lamp_count` counts them.
+    pub lamps: [LampParams; MAX_RUNTIME_LAMPS],
     /// Base view position (xyz) and first array layer (w) per lookup.
     pub base: [Vec4; MAX_LOOKUPS],
     /// Weight (x), whether the key has normals (y: 1 or 0) and, for the first key of a
