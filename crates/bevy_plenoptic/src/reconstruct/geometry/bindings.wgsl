@@ -48,6 +48,22 @@ struct Lamp {
     cone_scale: f32,
 }
 
+// One lookup: a base view's key (view.rs, LookupParams).
+struct Lookup {
+    // The base view's position; the view's weight × the key's time weight.
+    base: vec3<f32>,
+    weight: f32,
+    // Its first array layer in the camera's keys (6 per lookup); with light groups, its
+    // key's first layer in the pack's key texture (relight_keys.wgsl), and first_layer is
+    // then 6k, its layers in the camera's relit keys.
+    first_layer: u32,
+    source_layer: u32,
+    // 1 + its pair where it is the first key of a blended pair (0: none); whether the key
+    // has normals (1) or not (0).
+    pair: u32,
+    normals: u32,
+}
+
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
     // Lookups in use, the keys' face size, volume blocks in use, VIEW_* bits.
@@ -78,11 +94,8 @@ struct ViewParams {
     sun_illuminance: vec4<f32>,
     // The placed lamps (plenoptic_recon's lamps module); lamp_count of them in use.
     lamps: array<Lamp, 4>,
-    // Per lookup: base view position (xyz) and first layer (w).
-    base: array<vec4<f32>, 16>,
-    // Per lookup: weight (x), whether the key has normals (y), 1 + its pair where it is the
-    // first key of a blended pair (z, 0: none).
-    weight: array<vec4<f32>, 16>,
+    // The lookups in use (lookup_count of them).
+    lookups: array<Lookup, 16>,
     // Per blended pair: its two lookups (x, y); its layers in the blended keys are 6 × pair.
     pairs: array<vec4<u32>, 8>,
     // Per volume block: base view position (xyz), view weight (w).
@@ -100,9 +113,6 @@ struct ViewParams {
     light_sky: vec4<f32>,
     // Per layer blended: its coefficient (xyz) and stored group (w).
     light_layers: array<vec4<f32>, 16>,
-    // Per lookup, with light groups: its key's first layer in the pack's key texture (x);
-    // `base[k].w` is then 6k, its layers in the camera's relit keys.
-    source_layer: array<vec4<u32>, 16>,
     // The pack's environment at the camera's time, for reflected rays that leave the scene
     // (not named `environment`: naga_oil would take the field for the imported function).
     env: Environment,

@@ -19,14 +19,14 @@ fn blend_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let face = id.z % 6u;
     let k = cam.pairs[pair].xy;
-    let l0 = u32(cam.base[k.x].w) + face;
-    let l1 = u32(cam.base[k.y].w) + face;
+    let l0 = cam.lookups[k.x].first_layer + face;
+    let l1 = cam.lookups[k.y].first_layer + face;
     let a = textureLoad(cubes, id.xy, l0, 0);
     let b = textureLoad(cubes, id.xy, l1, 0);
     let sa = textureLoad(shading_cubes, id.xy, l0, 0).xy;
     let sb = textureLoad(shading_cubes, id.xy, l1, 0).xy;
-    let w0 = cam.weight[k.x].x;
-    let w1 = cam.weight[k.y].x;
+    let w0 = cam.lookups[k.x].weight;
+    let w1 = cam.lookups[k.y].weight;
     let s = 1.0 / max(w0 + w1, 1e-9);
     let lighting = (rgb9e5_decode(sa.x) * w0 + rgb9e5_decode(sb.x) * w1) * s;
     let non_diffuse = (rgb9e5_decode(sa.y) * w0 + rgb9e5_decode(sb.y) * w1) * s;

@@ -41,7 +41,7 @@ fn nearby_texels(local: vec4<f32>, object: u32, slot: f32, material: bool) -> We
         }
         let dist = l.dist;
         let t = l.t;
-        let layer0 = u32(cam.base[k].w);
+        let layer0 = cam.lookups[k].first_layer;
         var best = NO_TEXEL;
         var best_c = t;
         for (var dj = -NEIGHBOUR_TEXELS; dj <= NEIGHBOUR_TEXELS; dj++) {
@@ -66,8 +66,8 @@ fn nearby_texels(local: vec4<f32>, object: u32, slot: f32, material: bool) -> We
         if best < NO_TEXEL {
             tally(C_LOADS_16, 1u);
             let texel = textureLoad(cubes, best_c.xy, layer0 + best_c.z, 0);
-            sum += texel_terms(best_c, layer0, texel, material) * cam.weight[k].x;
-            ws += cam.weight[k].x;
+            sum += texel_terms(best_c, layer0, texel, material) * cam.lookups[k].weight;
+            ws += cam.lookups[k].weight;
         }
     }
     return Weighted(sum, ws);
@@ -81,8 +81,8 @@ fn heaviest_texel(p: vec3<f32>, material: bool) -> Weighted {
     if h >= min(cam.lookup_count, MAX_LOOKUPS) {
         return Weighted(mat2x3<f32>(), 0.0);
     }
-    let t = cube_texel(p - cam.base[h].xyz, cam.face);
-    let layer0 = u32(cam.base[h].w);
+    let t = cube_texel(p - cam.lookups[h].base, cam.face);
+    let layer0 = cam.lookups[h].first_layer;
     tally(C_LOADS_16, 1u);
     let texel = textureLoad(cubes, t.xy, layer0 + t.z, 0);
     return Weighted(texel_terms(t, layer0, texel, material), 1.0);

@@ -14,7 +14,7 @@ use bevy::render::storage::ShaderBuffer;
 use plenoptic_recon::relight::Relight;
 use plenoptic_recon::temporal::bracketing;
 
-use super::view::{ViewFlags, ViewParams, motion_slot};
+use super::view::{LookupParams, ViewFlags, ViewParams, motion_slot};
 use super::{MaterialFactors, ObjectFlags, ObjectParams, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
@@ -123,7 +123,7 @@ fn pair_keys(params: &mut ViewParams, lookups: &[Lookup], room: u32) {
         if a.base == b.base && a.normals == b.normals {
             let pair = params.pair_count;
             params.pairs[pair as usize] = UVec4::new(k as u32, k as u32 + 1, 0, 0);
-            params.weight[k].z = (pair + 1) as f32;
+            params.lookups[k].pair = pair + 1;
             params.pair_count += 1;
             k += 2;
         } else {
@@ -275,8 +275,13 @@ impl CameraFrame<'_> {
             cam.settings.time_epsilon_on(m),
         );
         for (n, l) in f.lookups.iter().enumerate() {
-            params.base[n] = l.base.extend((l.slot * 6) as f32);
-            params.weight[n] = Vec4::new(l.weight, if l.normals { 1.0 } else { 0.0 }, 0.0, 0.0);
+            params.lookups[n] = LookupParams {
+                base: l.base,
+                weight: l.weight,
+                first_layer: l.slot * 6,
+                normals: u32::from(l.normals),
+                ..LookupParams::default()
+            };
         }
         // Only lookups of lighting read the blended pairs: none for radiance or image mode.
         if cam.settings.shading == plenoptic_recon::Shading::Materials && !self.image_mode {

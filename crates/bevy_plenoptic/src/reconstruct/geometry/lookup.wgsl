@@ -189,7 +189,7 @@ struct Lookup {
 // `slot`), in keys of face size `n`.
 fn lookup_of(local: vec4<f32>, k: u32, n: u32, slot: f32) -> Lookup {
     var l: Lookup;
-    l.d = carried(local, k, slot) - cam.base[k].xyz;
+    l.d = carried(local, k, slot) - cam.lookups[k].base;
     l.dist = length(l.d);
     l.ok = !(l.dist <= 1e-6);
     if l.ok {
@@ -431,15 +431,15 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
         if !l.ok {
             continue;
         }
-        let normals = cam.weight[k].y != 0.0;
-        let pair = u32(cam.weight[k].z);
+        let normals = cam.lookups[k].normals != 0u;
+        let pair = cam.lookups[k].pair;
         if paired && pair > 0u && still_between(k) {
             let got = pair_lookup(l, pair - 1u, n, object, tol, normals);
             if got.w >= 0.0 {
                 tally(C_LOOKUPS, 2u);
                 if got.w > 0.0 {
                     lookup_accepted |= accepted_bits(k) | accepted_bits(k + 1u);
-                    let w = (cam.weight[k].x + cam.weight[k + 1u].x) * angular(l, to_eye, power);
+                    let w = (cam.lookups[k].weight + cam.lookups[k + 1u].weight) * angular(l, to_eye, power);
                     sum += got.terms * w;
                     ws += w;
                 }
@@ -449,12 +449,12 @@ fn direct_lookups_at(local: vec4<f32>, p: vec3<f32>, eye: vec3<f32>, object: u32
             }
         }
         tally(C_LOOKUPS, 1u);
-        let got = key_lookup(l, u32(cam.base[k].w), n, object, tol, normals, bilinear);
+        let got = key_lookup(l, cam.lookups[k].first_layer, n, object, tol, normals, bilinear);
         if got.w == 0.0 {
             continue;
         }
         lookup_accepted |= accepted_bits(k);
-        let w = cam.weight[k].x * angular(l, to_eye, power);
+        let w = cam.lookups[k].weight * angular(l, to_eye, power);
         sum += got.terms * w;
         ws += w;
     }

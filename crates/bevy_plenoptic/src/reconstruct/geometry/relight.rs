@@ -117,8 +117,8 @@ pub(super) fn fill(params: &mut ViewParams, relight: &Relight, groups: u32) {
     params.light_layers = b.layers;
     params.light_layer_count = b.count;
     for k in 0..(params.lookup_count as usize).min(MAX_LOOKUPS) {
-        params.source_layer[k].x = params.base[k].w as u32;
-        params.base[k].w = (6 * k) as f32;
+        params.lookups[k].source_layer = params.lookups[k].first_layer;
+        params.lookups[k].first_layer = (6 * k) as u32;
     }
 }
 

@@ -20,7 +20,7 @@ fn relight_keys(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let face = id.z % 6u;
-    let source = cam.source_layer[k].x;
+    let source = cam.lookups[k].source_layer;
     let key = textureLoad(cubes, id.xy, source + face, 0);
     let stored = stored_terms(textureLoad(shading_cubes, id.xy, source + face, 0).xy);
     var acc = blend_base(cam.light_base.xyz, stored);

@@ -57,17 +57,17 @@ fn incoming(origin: vec3<f32>, dir: vec3<f32>, cone: f32) -> vec4<f32> {
     var total = 0.0;
     var escaped = false;
     for (var k = 0u; k < count; k++) {
-        if cam.weight[k].x <= 0.0 {
+        if cam.lookups[k].weight <= 0.0 {
             continue;
         }
-        let centre = cam.base[k].xyz;
-        let layer0 = u32(cam.base[k].w);
+        let centre = cam.lookups[k].base;
+        let layer0 = cam.lookups[k].first_layer;
         let m = march(cubes, layer0, n, centre, origin, dir, cam.march_distance, cam.depth_tolerance);
         if m.y == 1.0 {
             let to = origin + dir * m.x - centre;
             let d = length(to);
             let cos = dot(to, dir) / max(d, 1e-6);
-            let w = cam.weight[k].x * pow(max((1.0 + cos) * 0.5, 1e-3), cam.angular_power);
+            let w = cam.lookups[k].weight * pow(max((1.0 + cos) * 0.5, 1e-3), cam.angular_power);
             let angle = min(cone * m.x / max(d, 1e-3), 0.5);
             sum += fetch(cubes, layer0, n, to, angle) * w;
             total += w;

@@ -44,6 +44,25 @@ use plenoptic_pack::MAX_LIGHT_GROUPS;
 use plenoptic_recon::lamps::MAX_RUNTIME_LAMPS;
 use plenoptic_recon::relight::Relight;
 
+/// One lookup of the view buffer, a base view's key (`Lookup` in `bindings.wgsl`).
+#[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
+pub struct LookupParams {
+    /// The base view's position.
+    pub base: Vec3,
+    /// The view's weight × the key's time weight.
+    pub weight: f32,
+    /// Its first array layer in the camera's keys (6 per lookup).
+    pub first_layer: u32,
+    /// With light groups, its key's first layer in the pack's key texture
+    /// ([`crate::reconstruct::relight`]); `first_layer` is then `6k`, its layers in the
+    /// camera's relit keys.
+    pub source_layer: u32,
+    /// 1 + the index of the blended pair it is the first key of (0: none).
+    pub pair: u32,
+    /// Whether the key has normals (1) or not (0).
+    pub normals: u32,
+}
+
 /// A placed lamp in the view buffer (`Lamp` in `bindings.wgsl`), as
 /// `plenoptic_recon::lamps::RuntimeLamp` describes it.
 #[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
@@ -103,11 +122,8 @@ pub struct ViewParams {
     /// The lamps whose highlights glossy surfaces add ([`super::reflect`],
     /// `plenoptic_recon::lamps`); `lamp_count` counts them.
     pub lamps: [LampParams; MAX_RUNTIME_LAMPS],
-    /// Base view position (xyz) and first array layer (w) per lookup.
-    pub base: [Vec4; MAX_LOOKUPS],
-    /// Weight (x), whether the key has normals (y: 1 or 0) and, for the first key of a
-    /// blended pair, 1 + the pair's index (z; 0: none) per lookup.
-    pub weight: [Vec4; MAX_LOOKUPS],
+    /// The lookups in use (`lookup_count` of them).
+    pub lookups: [LookupParams; MAX_LOOKUPS],
     /// Per blended pair: its two lookups (x, y) ([`super::blend`]).
     pub pairs: [UVec4; super::blend::MAX_PAIRS as usize],
     /// Base view position (xyz) and view weight (w) per volume block.
@@ -127,9 +143,6 @@ pub struct ViewParams {
     pub light_sky: Vec4,
     /// Per layer blended: its coefficient (xyz) and stored group (w).
     pub light_layers: [Vec4; MAX_LIGHT_GROUPS],
-    /// Per lookup, with light groups: its key's first layer in the pack's key texture (x);
-    /// `base[k].w` is then `6k`, its layers in the camera's relit keys.
-    pub source_layer: [UVec4; MAX_LOOKUPS],
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see.
     pub environment: EnvironmentUniform,
