@@ -21,8 +21,8 @@ use crate::error::RecipeError;
 /// so that the runtime scales it by a colour × intensity (lamps on and off, the daylight
 /// dimmed). Every emitter belongs to one group; emitters no group names form a default group.
 /// Its cost in the bake: a rendering of every range image, ambient field and volume sample
-/// per group; in the pack, one lighting layer per group but one (the tour's three groups: 1.85×
-/// the bake time, 1.53× the pack).
+/// per group; in the pack, one lighting layer per group but one (the tour's three groups: 2.17×
+/// the bake time, 1.59× the pack).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightGroupToml {
