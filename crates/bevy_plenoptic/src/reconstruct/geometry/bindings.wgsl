@@ -64,6 +64,16 @@ struct Lookup {
     normals: u32,
 }
 
+// A base view's temporal-volume block (view.rs, VolumeParams).
+struct VolumeBlock {
+    // The base view's position and weight.
+    base: vec3<f32>,
+    weight: f32,
+    // Its first sample and first direction-bin offset in the pack's buffers.
+    first_sample: u32,
+    first_bin: u32,
+}
+
 // A camera's view buffer (view.rs, ViewParams): its lookups and settings this frame.
 struct ViewParams {
     // Lookups in use, the keys' face size, volume blocks in use, VIEW_* bits.
@@ -98,10 +108,8 @@ struct ViewParams {
     lookups: array<Lookup, 16>,
     // Per blended pair: its two lookups (x, y); its layers in the blended keys are 6 × pair.
     pairs: array<vec4<u32>, 8>,
-    // Per volume block: base view position (xyz), view weight (w).
-    volume: array<vec4<f32>, 8>,
-    // Per volume block: first sample (x), first bin offset (y).
-    volume_range: array<vec4<u32>, 8>,
+    // The volume blocks in use (volume_count of them).
+    volumes: array<VolumeBlock, 8>,
     // Light groups (reconstruct/relight.rs): groups stored per key and volume sample (0: the
     // camera reads the pack's keys as stored); layers blended (of light_layers); the first
     // vec4 of the volume samples' group words in volume_samples.

@@ -477,16 +477,16 @@ fn volume_lookups(p: vec3<f32>, object: u32) -> Weighted {
     var sum = mat2x3<f32>();
     var ws = 0.0;
     for (var i = 0u; i < count; i++) {
-        let d = p - cam.volume[i].xyz;
+        let d = p - cam.volumes[i].base;
         let dist = length(d);
         if dist <= 1e-6 {
             continue;
         }
         let dir = d / dist;
         let bt = cube_texel(dir, BIN_FACE);
-        let bin = cam.volume_range[i].y + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
-        let first = cam.volume_range[i].x;
-        let view_w = cam.volume[i].w;
+        let bin = cam.volumes[i].first_bin + (bt.z * BIN_FACE + bt.y) * BIN_FACE + bt.x;
+        let first = cam.volumes[i].first_sample;
+        let view_w = cam.volumes[i].weight;
         tally(C_LOADS_4, 2u);
         for (var j = volume_bins[bin]; j < volume_bins[bin + 1u]; j++) {
             let s = 3u * (first + j);

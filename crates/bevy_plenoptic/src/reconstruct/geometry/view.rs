@@ -63,6 +63,20 @@ pub struct LookupParams {
     pub normals: u32,
 }
 
+/// A base view's temporal-volume block in the view buffer (`VolumeBlock` in
+/// `bindings.wgsl`; [`super::volume`]).
+#[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
+pub struct VolumeParams {
+    /// The base view's position.
+    pub base: Vec3,
+    /// The base view's weight.
+    pub weight: f32,
+    /// Its first sample in the pack's sample buffer.
+    pub first_sample: u32,
+    /// Its first direction-bin offset in the pack's bin buffer.
+    pub first_bin: u32,
+}
+
 /// A placed lamp in the view buffer (`Lamp` in `bindings.wgsl`), as
 /// `plenoptic_recon::lamps::RuntimeLamp` describes it.
 #[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
@@ -126,10 +140,8 @@ pub struct ViewParams {
     pub lookups: [LookupParams; MAX_LOOKUPS],
     /// Per blended pair: its two lookups (x, y) ([`super::blend`]).
     pub pairs: [UVec4; super::blend::MAX_PAIRS as usize],
-    /// Base view position (xyz) and view weight (w) per volume block.
-    pub volume: [Vec4; volume::MAX_VOLUMES],
-    /// First sample (x) and first bin offset (y) per volume block in the pack's buffers.
-    pub volume_range: [UVec4; volume::MAX_VOLUMES],
+    /// The volume blocks in use (`volume_count` of them).
+    pub volumes: [VolumeParams; volume::MAX_VOLUMES],
     /// Light groups stored per key and volume sample ([`crate::reconstruct::relight`]; 0:
     /// the camera reads the pack's keys as stored).
     pub light_groups: u32,

@@ -15,7 +15,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
 
-use super::view::ViewParams;
+use super::view::{ViewParams, VolumeParams};
 use crate::asset::RadiancePack;
 use crate::camera::PlenopticCamera;
 use crate::streaming::schedule::BlockRef;
@@ -144,8 +144,12 @@ pub(super) fn fill_params(
             if n == MAX_VOLUMES {
                 break;
             }
-            params.volume[n] = positions[v].extend(w);
-            params.volume_range[n] = UVec4::new(sample, bin, 0, 0);
+            params.volumes[n] = VolumeParams {
+                base: positions[v],
+                weight: w,
+                first_sample: sample,
+                first_bin: bin,
+            };
             n += 1;
         }
     }
