@@ -30,7 +30,7 @@ use bevy::image::ImageSampler;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::render_resource::{
-    Buffer, BufferDescriptor, BufferUsages, Extent3d, TextureDimension, TextureFormat,
+    Buffer, BufferDescriptor, BufferUsages, Extent3d, ShaderType, TextureDimension, TextureFormat,
     TextureUsages,
 };
 use bevy::render::renderer::RenderDevice;
@@ -130,6 +130,15 @@ pub(crate) fn no_group_layers(device: &RenderDevice) -> Buffer {
 #[derive(Resource, Debug, Default)]
 pub struct GroupLayers(pub HashMap<AssetId<RadiancePack>, Buffer>);
 
+/// One layer of a light-group blend in a pass's uniforms (`LightLayer` in `relight.wgsl`).
+#[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
+pub struct LightLayerParams {
+    /// Its coefficient (colour × intensity relative to the stored light).
+    pub coefficient: Vec3,
+    /// The stored group it scales.
+    pub group: u32,
+}
+
 /// A [`Relight`]'s blend as the passes' uniforms take it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlendUniforms {
@@ -137,8 +146,8 @@ pub struct BlendUniforms {
     pub base: Vec4,
     /// The sky's multiplier (xyz): relit radiance where a texel sees no object.
     pub sky: Vec4,
-    /// Per layer blended: its coefficient (xyz) and stored group (w).
-    pub layers: [Vec4; MAX_LIGHT_GROUPS],
+    /// The layers blended (`count` of them).
+    pub layers: [LightLayerParams; MAX_LIGHT_GROUPS],
     /// Layers blended.
     pub count: u32,
 }
@@ -149,11 +158,14 @@ impl BlendUniforms {
         let mut out = Self {
             base: relight.blend.base.extend(0.0),
             sky: relight.sky.extend(0.0),
-            layers: [Vec4::ZERO; MAX_LIGHT_GROUPS],
+            layers: [LightLayerParams::default(); MAX_LIGHT_GROUPS],
             count: 0,
         };
         for (slot, (g, c)) in out.layers.iter_mut().zip(&relight.blend.layers) {
-            *slot = c.extend(*g as f32);
+            *slot = LightLayerParams {
+                coefficient: *c,
+                group: *g,
+            };
             out.count += 1;
         }
         out

@@ -6,6 +6,12 @@
 
 #import plenoptic::cube::rgb9e5_decode
 
+// A layer blended (relight.rs, LightLayerParams): its coefficient and its stored group.
+struct LightLayer {
+    coefficient: vec3<f32>,
+    group: u32,
+}
+
 // A stored RGB9E5 (lighting, non-diffuse) pair decoded.
 fn stored_terms(pair: vec2<u32>) -> mat2x3<f32> {
     return mat2x3<f32>(rgb9e5_decode(pair.x), rgb9e5_decode(pair.y));

@@ -7,6 +7,7 @@
 
 #import plenoptic::environment::Environment
 #import plenoptic::fill_entry::HoleList
+#import plenoptic::relight::LightLayer
 
 const MAX_LOOKUPS: u32 = 16u;
 const MAX_VOLUMES: u32 = 8u;
@@ -119,8 +120,8 @@ struct ViewParams {
     // The blend's weight of the total (xyz); the sky's multiplier (xyz).
     light_base: vec4<f32>,
     light_sky: vec4<f32>,
-    // Per layer blended: its coefficient (xyz) and stored group (w).
-    light_layers: array<vec4<f32>, 16>,
+    // The layers blended (light_layer_count of them).
+    light_layers: array<LightLayer, 16>,
     // The pack's environment at the camera's time, for reflected rays that leave the scene
     // (not named `environment`: naga_oil would take the field for the imported function).
     env: Environment,

@@ -21,10 +21,10 @@ fn volume_terms(s: u32, terms: vec2<u32>, radiance: vec3<f32>) -> mat2x3<f32> {
     }
     var acc = blend_base(cam.light_base.xyz, stored);
     for (var k = 0u; k < cam.light_layer_count; k++) {
-        let w = 2u * (s * cam.light_groups + u32(cam.light_layers[k].w));
+        let w = 2u * (s * cam.light_groups + cam.light_layers[k].group);
         tally(C_LOADS_16, 1u);
         let v = volume_samples[cam.volume_groups + w / 4u];
-        acc = blend_layer(acc, cam.light_layers[k].xyz, select(v.xy, v.zw, (w & 2u) != 0u));
+        acc = blend_layer(acc, cam.light_layers[k].coefficient, select(v.xy, v.zw, (w & 2u) != 0u));
     }
     let relit = blend_end(acc);
     if point_material {

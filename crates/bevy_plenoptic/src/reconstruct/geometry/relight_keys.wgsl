@@ -27,8 +27,8 @@ fn relight_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     let texel = (face * n + id.y) * n + id.x;
     let slot = source / 6u;
     for (var l = 0u; l < cam.light_layer_count; l++) {
-        let g = slot * cam.light_groups + u32(cam.light_layers[l].w);
-        acc = blend_layer(acc, cam.light_layers[l].xyz, group_layers[g * 6u * n * n + texel]);
+        let g = slot * cam.light_groups + cam.light_layers[l].group;
+        acc = blend_layer(acc, cam.light_layers[l].coefficient, group_layers[g * 6u * n * n + texel]);
     }
     let relit = blend_end(acc);
     // A texel that sees no object shows the sky.

@@ -37,7 +37,7 @@ use crate::camera::ReconSettings;
 use crate::reconstruct::counters::CounterBuffer;
 use crate::reconstruct::environment::EnvironmentUniform;
 use crate::reconstruct::frames::{ImageFrame, ViewDisplay};
-use crate::reconstruct::relight::RelitKeys;
+use crate::reconstruct::relight::{LightLayerParams, RelitKeys};
 use crate::reconstruct::{KeyTextures, MAX_LOOKUPS};
 use crate::streaming::StreamCache;
 use plenoptic_pack::MAX_LIGHT_GROUPS;
@@ -153,8 +153,8 @@ pub struct ViewParams {
     pub light_base: Vec4,
     /// The sky's multiplier (xyz): relit radiance where a texel sees no object.
     pub light_sky: Vec4,
-    /// Per layer blended: its coefficient (xyz) and stored group (w).
-    pub light_layers: [Vec4; MAX_LIGHT_GROUPS],
+    /// The layers blended.
+    pub light_layers: [LightLayerParams; MAX_LIGHT_GROUPS],
     /// The pack's environment at the camera's time: what reflected rays that leave the scene
     /// see.
     pub environment: EnvironmentUniform,

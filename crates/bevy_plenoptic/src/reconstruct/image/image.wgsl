@@ -4,7 +4,7 @@
 // farthest covered neighbour, pass after pass.
 
 #import plenoptic::cube::{rgb9e5_decode, texel_direction}
-#import plenoptic::relight::{stored_terms, blend_base, blend_layer, blend_end, relit_radiance}
+#import plenoptic::relight::{LightLayer, stored_terms, blend_base, blend_layer, blend_end, relit_radiance}
 
 const MAX_VIEWS: u32 = 8u;
 const EMPTY: u32 = 0xffffffffu;
@@ -39,8 +39,8 @@ struct ImageParams {
     // The blend's weight of the total (xyz); the sky's multiplier (xyz).
     light_base: vec4<f32>,
     light_sky: vec4<f32>,
-    // Per layer blended: its coefficient (xyz) and stored group (w).
-    light_layers: array<vec4<f32>, 16>,
+    // The layers blended (light.y of them).
+    light_layers: array<LightLayer, 16>,
 }
 
 @group(0) @binding(0) var cubes: texture_2d_array<u32>;
@@ -224,8 +224,8 @@ fn relit(layer: u32, i: u32, key: vec4<u32>, radiance: vec3<f32>) -> vec3<f32> {
     let stored = stored_terms(textureLoad(shading_cubes, t.xy, layer + t.z, 0).xy);
     var acc = blend_base(params.light_base.xyz, stored);
     for (var l = 0u; l < params.light.y; l++) {
-        let g = (layer / 6u) * params.light.x + u32(params.light_layers[l].w);
-        acc = blend_layer(acc, params.light_layers[l].xyz, group_layers[g * 6u * n * n + i]);
+        let g = (layer / 6u) * params.light.x + params.light_layers[l].group;
+        acc = blend_layer(acc, params.light_layers[l].coefficient, group_layers[g * 6u * n * n + i]);
     }
     // A texel that sees no object shows the sky.
     let fallback = select(params.light_base.xyz, params.light_sky.xyz, key.z == 0u);

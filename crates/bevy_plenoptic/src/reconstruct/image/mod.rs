@@ -55,6 +55,7 @@ use super::frames::ImageFrame;
 use crate::camera::PlenopticCamera;
 #[cfg(doc)]
 use crate::camera::ReconMode;
+use crate::reconstruct::relight::LightLayerParams;
 #[cfg(doc)]
 use extract::prepare_jobs;
 
@@ -96,8 +97,8 @@ pub struct ImageParams {
     pub light_base: Vec4,
     /// The sky's multiplier (xyz).
     pub light_sky: Vec4,
-    /// Per layer blended: its coefficient (xyz) and stored group (w).
-    pub light_layers: [Vec4; MAX_LIGHT_GROUPS],
+    /// The layers blended.
+    pub light_layers: [LightLayerParams; MAX_LIGHT_GROUPS],
 }
 
 /// A camera's image-mode work this frame: `Some` while it is in image (or volume) mode on
