@@ -563,8 +563,8 @@ pub const SAME_FACE_COS: f32 = 0.5;
 /// camera, in the key's frame). Without either normal (a key without normals, a pixel without
 /// a proxy triangle: `np` zero) every texel passes. A window's reveal is the wall's object at
 /// the wall's distance; without this test the wall beside the window takes the reveal's
-/// sky-lit texels and shows a bright halo, and the outside of a lampshade takes the texels of
-/// its lamp-lit inside (the same triangles, seen from the other side).
+/// sky-lit texels and shows a bright halo, and the side of room B's lamp (a closed cylinder)
+/// takes the texels of its lamp-lit top where the two meet.
 #[inline]
 fn same_face(k: &FastKey<'_>, j: usize, np: Vec3) -> bool {
     match k.normal.and_then(|c| c.get(j)) {

@@ -183,9 +183,8 @@ impl VolumeIndex {
     /// [`VolumeIndex::lookup`], with the samples' `second` colour filtered with the same
     /// weights in the same walk (black without one): `(colour, second colour, total weight)`.
     /// With a surface `normal` (facing the eye; zero: no test) only samples that face as the
-    /// surface does count ([`crate::lookup::SAME_FACE_COS`], the lookups' face test): the
-    /// inside of a lampshade, a few millimetres from its outside, is not answered by the
-    /// outside's samples.
+    /// surface does count ([`crate::lookup::SAME_FACE_COS`], the lookups' face test): the lit
+    /// top of a lamp, a few millimetres from its side, is not answered by the side's samples.
     pub(crate) fn lookup_pair(
         &self,
         d: Vec3,
