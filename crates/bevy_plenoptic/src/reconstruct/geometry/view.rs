@@ -99,11 +99,11 @@ pub struct LampParams {
 /// in `bindings.wgsl`).
 #[derive(ShaderType, Debug, Clone, Default, PartialEq)]
 pub struct ViewParams {
-    /// Lookups in use (of `base` and `weight`).
+    /// Lookups in use (of `lookups`).
     pub lookup_count: u32,
     /// Face size of the keys, in texels.
     pub face: u32,
-    /// Volume blocks in use (of `volume` and `volume_range`).
+    /// Volume blocks in use (of `volumes`).
     pub volume_count: u32,
     /// [`ViewFlags`] bits.
     pub flags: u32,

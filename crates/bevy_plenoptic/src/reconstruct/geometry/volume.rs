@@ -7,7 +7,7 @@
 //! Every resident volume block of a pack ([`crate::streaming::BinnedVolume`]: samples sorted
 //! by direction bin, and the bins' offsets) is packed into two storage buffers per pack,
 //! rebuilt when the set of resident blocks changes; each block's place in them is passed
-//! per frame in the camera's view buffer ([`ViewParams::volume_range`]).
+//! per frame in the camera's view buffer ([`ViewParams::volumes`]).
 
 use std::collections::HashMap;
 
