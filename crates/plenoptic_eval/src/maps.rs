@@ -158,7 +158,8 @@ pub fn write_error_maps(
         let (c, a) = (&pair.candidate, pair.a);
         let b = pair.b.unwrap_or(a);
         let errors = corrected_squared_errors(c, a, b).ok_or_else(|| size_error(&pair))?;
-        let mean = mean_image(a, b).map_or(0.0, |m| m.mean_luminance());
+        // The mean of the halves' means: the reference mean's mean luminance.
+        let mean = 0.5 * (a.mean_luminance() + b.mean_luminance());
         if mean <= 0.0 || !mean.is_finite() {
             return Err(size_error(&pair));
         }

@@ -168,6 +168,15 @@ fn squared_error_terms(x: f64, a: f64, b: f64) -> (f64, f64) {
     ((x - m) * (x - m), 0.25 * (a - b) * (a - b))
 }
 
+/// Whether `test` and both reference halves have one size and pixel count.
+fn same_size(test: &Image<Vec3>, ref_a: &Image<Vec3>, ref_b: &Image<Vec3>) -> bool {
+    let size = (test.width, test.height);
+    size == (ref_a.width, ref_a.height)
+        && size == (ref_b.width, ref_b.height)
+        && test.pixels.len() == ref_a.pixels.len()
+        && test.pixels.len() == ref_b.pixels.len()
+}
+
 /// Each pixel's variance-corrected squared luminance error, (x − m)² − (a − b)²/4: the terms
 /// whose mean [`ErrorSums::corrected_rms`] takes the root of (negative where the reference's
 /// noise is larger than the error). `None` when the sizes differ.
@@ -176,14 +185,10 @@ pub fn corrected_squared_errors(
     ref_a: &Image<Vec3>,
     ref_b: &Image<Vec3>,
 ) -> Option<Vec<f64>> {
-    let n = test.pixels.len();
-    if (test.width, test.height) != (ref_a.width, ref_a.height)
-        || (test.width, test.height) != (ref_b.width, ref_b.height)
-        || n != ref_a.pixels.len()
-        || n != ref_b.pixels.len()
-    {
+    if !same_size(test, ref_a, ref_b) {
         return None;
     }
+    let n = test.pixels.len();
     let lum = |c: Vec3| f64::from(luminance(c));
     Some(
         (0..n)
@@ -208,12 +213,7 @@ pub fn corrected_relative_lrms(
     ref_a: &Image<Vec3>,
     ref_b: &Image<Vec3>,
 ) -> CorrectedLrms {
-    let size = (test.width, test.height);
-    if size != (ref_a.width, ref_a.height)
-        || size != (ref_b.width, ref_b.height)
-        || test.pixels.len() != ref_a.pixels.len()
-        || test.pixels.len() != ref_b.pixels.len()
-    {
+    if !same_size(test, ref_a, ref_b) {
         return CorrectedLrms::NAN;
     }
     let mut sums = ErrorSums::default();
