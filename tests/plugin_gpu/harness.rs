@@ -93,6 +93,8 @@ pub(crate) struct PackExtras {
     pub(crate) open: bool,
     /// With `open`, the room with a smooth-shaded ball on its floor.
     pub(crate) ball: bool,
+    /// Whether the pack leaves its lamp's diffuse light to the runtime (pack 5).
+    pub(crate) runtime_lamps: bool,
 }
 
 impl From<Materials> for PackExtras {
@@ -102,6 +104,7 @@ impl From<Materials> for PackExtras {
             direct_sun: false,
             open: false,
             ball: false,
+            runtime_lamps: false,
         }
     }
 }
@@ -120,6 +123,7 @@ pub(crate) fn plugin_and_cpu_frames_with(
         direct_sun,
         open,
         ball,
+        runtime_lamps,
     } = extras.into();
     use bevy::camera::Hdr;
 
@@ -136,6 +140,7 @@ pub(crate) fn plugin_and_cpu_frames_with(
             volume_samples,
             materials,
             direct_sun,
+            runtime_lamps,
             ..PackSpec::segment(3, vec![0.0, 1.0, 2.0], 8)
         },
         &path,

@@ -298,6 +298,7 @@ fn skylit_room(backend: Backend, materials: Materials, direct_sun: bool, ball: b
         direct_sun,
         open: true,
         ball,
+        runtime_lamps: false,
     };
     plugin_and_cpu_frames_with(
         backend,
@@ -387,6 +388,35 @@ fn gpu_frame_with_runtime_sun_matches_cpu() {
     );
     // Measured on lavapipe: mean 0.0023, 99.2 % within 5 %, 99.7 % within 20 %; the pixels
     // apart lie along the shadow edges.
+    assert!(
+        mean < 0.005 && f5 > 0.98 && f20 > 0.99,
+        "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
+    );
+}
+
+/// Pack 5's runtime lamps on the GPU (the closed room under its point light): every lit
+/// fragment adds the lamp's diffuse light through the material's Lambertian lobe, shadowed
+/// by a ray against the proxies, as the CPU adds it (`lamps.wgsl`, `plenoptic_recon::lamps`).
+#[test]
+fn gpu_frame_with_runtime_lamps_matches_cpu() {
+    let view = (Vec3::new(0.3, 1.3, 1.0), Vec3::new(0.0, 0.8, -2.5));
+    let extras = |backend, runtime_lamps| {
+        let extras = PackExtras {
+            runtime_lamps,
+            ..PackExtras::from(Materials::Factors)
+        };
+        let mode = ReconMode::GeometryAssisted;
+        plugin_and_cpu_frames_with(backend, 3000, None, view, mode, extras)
+    };
+    let f = extras(Backend::Gpu, true);
+    let plain = extras(Backend::Cpu, false);
+    let (apart, same, _) = compare(&f.cpu, &plain.cpu);
+    eprintln!("with the runtime lamp against without: mean {apart:.3}, within 5 % {same:.3}");
+    assert!(apart > 0.1 && same < 0.5, "the lamp shows: {apart}, {same}");
+    let (mean, f5, f20) = compare(&f.gpu, &f.cpu);
+    eprintln!(
+        "GPU against CPU with the runtime lamp: mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
+    );
     assert!(
         mean < 0.005 && f5 > 0.98 && f20 > 0.99,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"

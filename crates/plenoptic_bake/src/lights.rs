@@ -6,6 +6,17 @@
 
 use plenoptic_pack::{Light, LightKind, LightPlacement};
 use plenoptic_scene::Scene;
+use plenoptic_scene::recipe::Quality;
+
+/// Whether a bake of `scene` at `quality` leaves its lamps' direct diffuse light to the
+/// runtime (pack 5.0, `Manifest::lamps_at_runtime`): `quality.runtime_lamps`, the scene has a
+/// point or spot light, and the runtime can evaluate every one
+/// ([`plenoptic_pack::lamps_placed`]: none moves, no more than the runtime's maximum).
+pub fn lamps_at_runtime(scene: &Scene, quality: &Quality) -> bool {
+    let lights = manifest_lights(scene);
+    let any = lights.iter().any(|l| l.placed.is_some());
+    quality.runtime_lamps && any && plenoptic_pack::lamps_placed(&lights)
+}
 
 /// The manifest's lights of `scene`, in the scene's order.
 pub fn manifest_lights(scene: &Scene) -> Vec<Light> {

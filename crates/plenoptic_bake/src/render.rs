@@ -84,10 +84,45 @@ pub fn multi_stage_settings(
     }
 }
 
+/// Which direct light the stored lighting leaves to the runtime: the sun's (pack 3,
+/// `quality.runtime_sun`) and the lamps' diffuse light (pack 5, `quality.runtime_lamps` where
+/// every lamp can be placed, [`crate::lights::lamps_at_runtime`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RuntimeLight {
+    /// The sun's direct light, through all its lobes.
+    pub sun: bool,
+    /// The point and spot lights' direct diffuse light.
+    pub lamps: bool,
+}
+
+impl RuntimeLight {
+    /// What `plan` leaves to the runtime for `scene`.
+    pub fn of(plan: &Plan, scene: &Scene) -> Self {
+        Self {
+            sun: plan.quality.runtime_sun,
+            lamps: crate::lights::lamps_at_runtime(scene, &plan.quality),
+        }
+    }
+
+    /// Keeps in `s`'s stored lighting what the runtime does not evaluate: the split
+    /// ([`crate::denoise::split_sample`]) then leaves it where the renderer put it.
+    pub fn keep_baked(self, s: &mut RadianceSample) {
+        if !self.sun {
+            s.sun = Vec3::ZERO;
+            s.sun_diffuse = Vec3::ZERO;
+        }
+        if !self.lamps {
+            s.lamp_diffuse = Vec3::ZERO;
+        }
+    }
+}
+
 /// Renders range images and volume samples for a plan.
 pub struct BakeRenderer<'a> {
     /// The plan.
     pub plan: &'a Plan,
+    /// What the stored lighting leaves to the runtime.
+    pub runtime: RuntimeLight,
     /// The scene's acceleration structure.
     pub accel: &'a SceneAccel<'a>,
     /// Ambient fields at `plan.ambient_keys`.
@@ -114,6 +149,7 @@ impl<'a> BakeRenderer<'a> {
     pub fn new(plan: &'a Plan, accel: &'a SceneAccel<'a>, fields: &'a [AmbientField]) -> Self {
         Self {
             plan,
+            runtime: RuntimeLight::of(plan, accel.scene()),
             accel,
             fields,
             layers: Vec::new(),
@@ -162,7 +198,6 @@ impl<'a> BakeRenderer<'a> {
         );
         let n = self.plan.quality.range_image_size.max(1);
         let denoise = self.plan.quality.denoise.then(DenoiseSettings::default);
-        let runtime_sun = self.plan.quality.runtime_sun;
         let mut images = Vec::new();
         for (group, accel, fields) in self.sources() {
             let field = field_at(&self.plan.ambient_keys, fields, t);
@@ -173,7 +208,7 @@ impl<'a> BakeRenderer<'a> {
                 view.position,
                 n,
                 denoise.as_ref(),
-                runtime_sun,
+                self.runtime,
             )?;
             images.push((group, image));
         }
@@ -232,9 +267,7 @@ impl<'a> BakeRenderer<'a> {
             let mut sampler = Sampler::new(seed, stream, 0);
             let placed = accel.at_time(t);
             let mut s = renderer.sample(&placed, &Ray::new(view.position, dir), &mut sampler);
-            if !self.plan.quality.runtime_sun {
-                bake_the_sun(&mut s);
-            }
+            self.runtime.keep_baked(&mut s);
             if let Some(g) = group {
                 let (lighting, non_diffuse) = crate::denoise::split_sample(&s);
                 groups.push((g, [lighting, non_diffuse]));
@@ -251,16 +284,9 @@ impl<'a> BakeRenderer<'a> {
     }
 }
 
-/// Keeps the sun's direct light in the stored lighting (`quality.runtime_sun` off): the
-/// split then leaves it where the renderer put it.
-fn bake_the_sun(s: &mut RadianceSample) {
-    s.sun = Vec3::ZERO;
-    s.sun_diffuse = Vec3::ZERO;
-}
-
 /// The range image of face size `n` seen from `position` with `renderer`, its diffuse
-/// lighting denoised with `denoise` when given ([`crate::denoise`]); the sun's direct light
-/// left out of the lighting and non-diffuse radiance for the runtime when `runtime_sun`.
+/// lighting denoised with `denoise` when given ([`crate::denoise`]); the direct light
+/// `runtime` names left out of the lighting and non-diffuse radiance for the runtime.
 /// The ambient light is smoothed when the renderer final-gathers
 /// ([`LightingCube::smooth_ambient`]). Without either the result is exactly
 /// [`to_range_image`] of the rendered faces.
@@ -270,14 +296,12 @@ pub fn render_range_image(
     position: Vec3,
     n: u32,
     denoise: Option<&DenoiseSettings>,
-    runtime_sun: bool,
+    runtime: RuntimeLight,
 ) -> Result<RangeImage> {
     let cube = CubeCamera::new(position, n)?;
     let mut faces = renderer.render_cube(placed, &cube);
-    if !runtime_sun {
-        for face in &mut faces {
-            face.pixels.iter_mut().for_each(bake_the_sun);
-        }
+    for face in &mut faces {
+        face.pixels.iter_mut().for_each(|s| runtime.keep_baked(s));
     }
     let smooth = renderer.settings.final_gather > 0;
     if denoise.is_none() && !smooth {

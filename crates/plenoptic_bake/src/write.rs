@@ -345,6 +345,7 @@ pub fn manifest(plan: &Plan, scene: &Scene, accel: &SceneAccel<'_>) -> Manifest 
         })
         .collect();
     m.lights = crate::lights::manifest_lights(scene);
+    m.lamps_at_runtime = crate::lights::lamps_at_runtime(scene, &plan.quality);
     let mut extra = BTreeMap::new();
     extra.insert("recipe".into(), plan.recipe.clone());
     extra.insert(

@@ -6,16 +6,20 @@ use crate::error::{PackError, Result, Section};
 /// The 8 bytes every pack starts with.
 pub const MAGIC: [u8; 8] = *b"PLNPACK\0";
 /// The major format version this crate writes (and reads, with [`OLDEST_MAJOR`]).
-pub const VERSION_MAJOR: u16 = 4;
-/// The oldest major format version this crate reads: a 3.x pack is a 4.x pack whose
-/// non-diffuse radiance holds the emission ([`crate::PackReader::runtime_emission`]), a 2.x
-/// pack also one without a runtime sun ([`crate::DirectSun`]); version 1 is refused with
-/// [`PackError::NeedsRebake`].
+pub const VERSION_MAJOR: u16 = 5;
+/// The oldest major format version this crate reads: a 4.x pack is a 5.x pack whose lighting
+/// holds its lamps' direct light ([`crate::Manifest::lamps_at_runtime`] false), a 3.x pack
+/// also one whose non-diffuse radiance holds the emission
+/// ([`crate::PackReader::runtime_emission`]), a 2.x pack also one without a runtime sun
+/// ([`crate::DirectSun`]); version 1 is refused with [`PackError::NeedsRebake`].
 pub const OLDEST_MAJOR: u16 = 2;
 /// The minor format version this crate writes. Readers accept any minor of their major.
-pub const VERSION_MINOR: u16 = 2;
+pub const VERSION_MINOR: u16 = 0;
 /// The first major whose non-diffuse radiance leaves the emission to the runtime.
 pub const RUNTIME_EMISSION_MAJOR: u16 = 4;
+/// The first major whose lighting may leave its lamps' direct light to the runtime
+/// ([`crate::Manifest::lamps_at_runtime`]).
+pub const RUNTIME_LAMPS_MAJOR: u16 = 5;
 /// Size of the header in bytes.
 pub const HEADER_LEN: u64 = 128;
 

@@ -82,8 +82,8 @@ pub use error::{ChunkRef, PackError, Result, Section};
 pub use groups::{DEFAULT_GROUP, GroupWeights, LayerBlend, LightGroupsEntry, MAX_LIGHT_GROUPS};
 pub use header::{HEADER_LEN, Header, MAGIC, OLDEST_MAJOR, VERSION_MAJOR, VERSION_MINOR};
 pub use manifest::{
-    Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, LightPlacement, Manifest,
-    Motion, ObjectEntry, TimeRange, Units, ViewSpace,
+    Aabb, BakeSettings, BakeStatistics, BaseView, Light, LightKind, LightPlacement,
+    MAX_RUNTIME_LAMPS, Manifest, Motion, ObjectEntry, TimeRange, Units, ViewSpace, lamps_placed,
 };
 pub use material::{
     AlphaMode, MaterialEntry, TextureBinding, TextureEntry, UvTransform, WrapMode,

@@ -52,6 +52,12 @@ pub struct Manifest {
     /// group, [`crate::groups`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light_groups: Option<crate::LightGroupsEntry>,
+    /// Whether the lighting and the volume samples' lighting leave out the direct diffuse
+    /// light of the point and spot lights (version 5.0), which the runtime adds per pixel
+    /// with a shadow ray against the proxies. True only where every such light is `placed`.
+    /// Absent (every older pack): the lamps' light is stored.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub lamps_at_runtime: bool,
 }
 
 impl Manifest {
@@ -76,6 +82,7 @@ impl Manifest {
             textures: Vec::new(),
             materials: Vec::new(),
             light_groups: None,
+            lamps_at_runtime: false,
         }
     }
 
@@ -170,8 +177,38 @@ impl Manifest {
                 return bad(format!("light {i} has a non-finite colour or intensity"));
             }
         }
+        if self.lamps_at_runtime && !lamps_placed(&self.lights) {
+            return bad(format!(
+                "lamps_at_runtime with lights a runtime cannot evaluate: an unplaced point or \
+                 spot light, an area light, or more than {MAX_RUNTIME_LAMPS} lamps"
+            ));
+        }
         Ok(())
     }
+}
+
+/// Most point and spot lights a runtime evaluates per pixel (the GPU's view buffer holds this
+/// many).
+pub const MAX_RUNTIME_LAMPS: usize = 4;
+
+/// Whether a runtime can evaluate the direct light of every lamp among `lights`: every point
+/// and spot light is `placed`, there is no area light, and there are at most
+/// [`MAX_RUNTIME_LAMPS`] lamps. Directional lights are not lamps.
+pub fn lamps_placed(lights: &[Light]) -> bool {
+    let mut lamps = 0;
+    for l in lights {
+        match l.kind {
+            LightKind::Directional => {}
+            LightKind::Area { .. } => return false,
+            LightKind::Point | LightKind::Spot { .. } => {
+                if l.placed.is_none() {
+                    return false;
+                }
+                lamps += 1;
+            }
+        }
+    }
+    lamps <= MAX_RUNTIME_LAMPS
 }
 
 /// Units of the pack's values.

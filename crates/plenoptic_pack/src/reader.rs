@@ -324,6 +324,15 @@ impl PackReader {
         self.header().version_major >= crate::header::RUNTIME_EMISSION_MAJOR
     }
 
+    /// Whether the lighting (cubes of kind 12, volume samples) leaves out the direct diffuse
+    /// light of the pack's lamps, which the runtime then adds per pixel (pack 5.0,
+    /// [`Manifest::lamps_at_runtime`]; `docs/pack-format.md`). Before 5.0 the lamps' light is
+    /// in it whatever the manifest says.
+    pub fn lamps_at_runtime(&self) -> bool {
+        self.header().version_major >= crate::header::RUNTIME_LAMPS_MAJOR
+            && self.manifest().lamps_at_runtime
+    }
+
     /// The header.
     pub fn header(&self) -> &Header {
         &self.header
@@ -612,16 +621,14 @@ fn validate_entries(
 
 /// Whether the pack at `path` is of an older format than this crate writes: one it refuses
 /// (version 1, [`PackError::NeedsRebake`]) or one it reads but a bake would improve (version
-/// 2 keeps the sun's direct light in its lighting; 4.0 does not place its lamps, so glossy
-/// surfaces keep the highlights the base views saw). 4.1 is current: 4.2 only adds light
-/// groups, which a bake writes when its recipe declares them. A newer minor is not
-/// outdated. A file that cannot be opened for another reason is not outdated (opening it
+/// 2 keeps the sun's direct light in its lighting; 4.x keeps its lamps' direct light in the
+/// lighting, at the cube's resolution). A newer minor is not outdated. A file that cannot be opened for another reason is not outdated (opening it
 /// reports that).
 pub fn is_outdated(path: impl AsRef<Path>) -> bool {
     match PackReader::open(path) {
         Ok(r) => {
             let h = r.header();
-            (h.version_major, h.version_minor) < (crate::VERSION_MAJOR, 1)
+            h.version_major < crate::VERSION_MAJOR
         }
         Err(e) => matches!(e, PackError::NeedsRebake { .. }),
     }

@@ -70,12 +70,12 @@ fn wrong_magic() {
 #[test]
 fn unknown_major_version() {
     let mut b = small_pack();
-    rewrite_header(&mut b, |h| h.version_major = 5);
+    rewrite_header(&mut b, |h| h.version_major = 6);
     assert!(matches!(
         open(b).unwrap_err(),
         PackError::UnsupportedVersion {
-            major: 5,
-            supported: 4,
+            major: 6,
+            supported: 5,
             ..
         }
     ));
@@ -98,6 +98,36 @@ fn version_three_packs_keep_the_emission_in_the_non_diffuse_radiance() {
     rewrite_header(&mut b, |h| h.version_major = 3);
     assert!(!open(b).unwrap().runtime_emission());
     assert!(open(small_pack()).unwrap().runtime_emission());
+}
+
+/// A pack of no chunks whose manifest has `lights` and says `lamps_at_runtime`.
+fn lamp_pack(lights: Vec<Light>) -> Result<Vec<u8>> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("lamps.pack");
+    let mut m = Manifest::new(TimeRange::default(), 1.0);
+    m.lights = lights;
+    m.lamps_at_runtime = true;
+    PackWriter::create(&path)?.finish(&m)?;
+    Ok(std::fs::read(path).unwrap())
+}
+
+#[test]
+fn only_a_pack_of_five_or_later_leaves_its_lamps_to_the_runtime() {
+    let mut lights = manifest(0).lights;
+    lights.retain(|l| l.placed.is_some());
+    let bytes = lamp_pack(lights.clone()).unwrap();
+    assert!(open(bytes.clone()).unwrap().lamps_at_runtime());
+    // A 4.x pack's lighting was baked with its lamps, whatever its manifest says.
+    let mut four = bytes;
+    rewrite_header(&mut four, |h| h.version_major = 4);
+    assert!(!open(four).unwrap().lamps_at_runtime());
+    // A lamp the runtime cannot place: the manifest is refused.
+    lights[0].placed = None;
+    let err = lamp_pack(lights).unwrap_err();
+    assert!(
+        matches!(&err, PackError::InvalidManifest { reason } if reason.contains("lamps_at_runtime")),
+        "{err}"
+    );
 }
 
 #[test]
@@ -439,9 +469,9 @@ fn older_formats_are_outdated() {
         (2, 0, true),
         (3, 2, true),
         (4, 0, true),
-        (4, 1, false),
-        (4, 2, false),
-        (4, 7, false),
+        (4, 2, true),
+        (5, 0, false),
+        (5, 7, false),
     ] {
         let mut b = small_pack();
         rewrite_header(&mut b, |h| {

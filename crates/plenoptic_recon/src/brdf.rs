@@ -123,6 +123,28 @@ impl Bsdf {
         self.glossy_fresnel(wo.dot(h)) * (d * g / (4.0 * wo.dot(n) * cos_i).max(1e-8))
     }
 
+    /// The Lambertian lobe alone (the diffuse term of [`Bsdf::eval`]) for incident direction
+    /// `wi`: what a lamp's diffuse light is lit through ([`crate::lamps::diffuse`]); zero
+    /// below the surface.
+    pub fn eval_diffuse(&self, wi: Vec3) -> Vec3 {
+        if wi.dot(self.n) <= 0.0 || wi.dot(self.ng) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let h = (self.wo + wi).normalize_or_zero();
+        if h == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        self.lambert(self.wo.dot(h))
+    }
+
+    /// The Lambertian lobe at `ω_o·h`: what the dielectric Fresnel lets into the surface,
+    /// scattered uniformly.
+    fn lambert(&self, voh: f32) -> Vec3 {
+        let m = &self.m;
+        let fd = fresnel_dielectric(voh.clamp(0.0, 1.0), self.eta);
+        m.base * ((1.0 - m.metallic) * (1.0 - m.transmission) * (1.0 - fd) / PI)
+    }
+
     /// The glossy lobe's Fresnel term at `ω_o·h`: the exact dielectric one for the
     /// non-metallic part, Schlick's with the base colour for the metallic part.
     fn glossy_fresnel(&self, voh: f32) -> Vec3 {
@@ -161,9 +183,7 @@ impl Bsdf {
             if h == Vec3::ZERO {
                 return Vec3::ZERO;
             }
-            let voh = wo.dot(h).clamp(0.0, 1.0);
-            let fd = fresnel_dielectric(voh, self.eta);
-            m.base * ((1.0 - metal) * (1.0 - tr) * (1.0 - fd) / PI) + self.eval_glossy(wi)
+            self.lambert(wo.dot(h)) + self.eval_glossy(wi)
         } else if m.thin_walled && !self.delta && tr > 0.0 && metal < 1.0 {
             // The microfacet reflection mirrored through the wall's plane.
             let wr = wi - n * (2.0 * cos_i);

@@ -1,6 +1,6 @@
-//! Lamps' highlights at runtime (pack 4.1; docs/architecture.md, "Reconstruction"; thesis ch.
-//! 5, direct and indirect light at different accuracies: the direct light of punctual lights
-//! evaluated at runtime against the proxy geometry).
+//! Lamps' direct light at runtime (packs 4.1 and 5.0; docs/architecture.md, "The runtime
+//! lamps"; thesis ch. 5, direct and indirect light at different accuracies: the direct light
+//! of punctual lights evaluated at runtime against the proxy geometry).
 //!
 //! A glossy surface's baked non-diffuse radiance holds the highlights of the scene's point
 //! and spot lights as the base views saw them: frozen in the wrong place for any other
@@ -15,9 +15,17 @@
 //!
 //! with `f_glossy` the GGX lobe of the surface's BSDF ([`crate::brdf::Bsdf::eval_glossy`]),
 //! `a_spot` glTF's smooth cone falloff, nothing beyond the light's range, and `V` a shadow
-//! ray against the proxies. The lamps' diffuse light stays in the baked lighting, which
-//! holds it exactly: it does not depend on the camera. The sun is left to
-//! [`crate::sun`].
+//! ray against the proxies.
+//!
+//! A 5.0 pack may also leave the lamps' direct *diffuse* light out of its lighting
+//! ([`plenoptic_pack::PackReader::lamps_at_runtime`]): at 64-pixel faces a texel mixes the
+//! brightly lit top of a table lamp with its dim side, and its shadow edges blur. Every
+//! pixel with a material then adds
+//!
+//! `L = Σ_lamps f_diffuse(ω_l, ω_o) · I · colour / r² · a_spot · |n · ω_l| · V`
+//!
+//! with `f_diffuse` the Lambertian lobe of the tracer's BSDF ([`Bsdf::eval_diffuse`]): what
+//! the bake took out (`RadianceSample::lamp_diffuse`). The sun is left to [`crate::sun`].
 
 use glam::Vec3;
 use plenoptic_pack::{LightKind, Manifest};
@@ -25,9 +33,9 @@ use plenoptic_pack::{LightKind, Manifest};
 use crate::brdf::Bsdf;
 use crate::shadow::{PlacedShadows, shadow_lift};
 
-/// Most lamps whose highlights are evaluated per pixel (the GPU's view buffer holds this
-/// many). A pack with more keeps its glossy surfaces baked.
-pub const MAX_RUNTIME_LAMPS: usize = 4;
+/// Most lamps whose light is evaluated per pixel (the GPU's view buffer holds this many). A
+/// pack with more keeps its glossy surfaces baked.
+pub use plenoptic_pack::MAX_RUNTIME_LAMPS;
 
 /// A point or spot light, placed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,14 +57,17 @@ pub struct RuntimeLamp {
 
 /// The lamps of a pack with `manifest` whose highlights the runtime evaluates: every point
 /// and spot light, when all of them are placed and there are at most
-/// [`MAX_RUNTIME_LAMPS`]; `None` when any highlight must stay baked (a lamp that moves, an
-/// area light, a pack before 4.1, too many lamps). Directional lights are not lamps.
+/// [`MAX_RUNTIME_LAMPS`] ([`plenoptic_pack::lamps_placed`]); `None` when any highlight must
+/// stay baked (a lamp that moves, an area light, a pack before 4.1, too many lamps).
+/// Directional lights are not lamps.
 pub fn runtime_lamps(manifest: &Manifest) -> Option<Vec<RuntimeLamp>> {
+    if !plenoptic_pack::lamps_placed(&manifest.lights) {
+        return None;
+    }
     let mut lamps = Vec::new();
     for (i, l) in manifest.lights.iter().enumerate() {
         let cone = match l.kind {
-            LightKind::Directional => continue,
-            LightKind::Area { .. } => return None,
+            LightKind::Directional | LightKind::Area { .. } => continue,
             LightKind::Point => None,
             LightKind::Spot {
                 inner_cone,
@@ -76,7 +87,7 @@ pub fn runtime_lamps(manifest: &Manifest) -> Option<Vec<RuntimeLamp>> {
             cone,
         });
     }
-    (lamps.len() <= MAX_RUNTIME_LAMPS).then_some(lamps)
+    Some(lamps)
 }
 
 impl RuntimeLamp {
@@ -110,13 +121,39 @@ pub fn highlights(
     bsdf: &Bsdf,
     shadows: Option<&PlacedShadows>,
 ) -> Vec3 {
+    direct(lamps, p, ng, bsdf, shadows, |wi| bsdf.eval_glossy(wi))
+}
+
+/// The lamps' direct diffuse light towards the viewer at `p` through `bsdf`'s Lambertian lobe,
+/// shadowed as [`highlights`] are: what a 5.0 pack with runtime lamps leaves out of its
+/// lighting.
+pub fn diffuse(
+    lamps: &[RuntimeLamp],
+    p: Vec3,
+    ng: Vec3,
+    bsdf: &Bsdf,
+    shadows: Option<&PlacedShadows>,
+) -> Vec3 {
+    direct(lamps, p, ng, bsdf, shadows, |wi| bsdf.eval_diffuse(wi))
+}
+
+/// `Σ_lamps f(ω_l) · E_l · |n · ω_l| · V_l` at `p`: each lamp's irradiance through the lobe
+/// `f`, shadowed by a ray against `shadows`.
+fn direct(
+    lamps: &[RuntimeLamp],
+    p: Vec3,
+    ng: Vec3,
+    bsdf: &Bsdf,
+    shadows: Option<&PlacedShadows>,
+    f: impl Fn(Vec3) -> Vec3,
+) -> Vec3 {
     let n = bsdf.normal();
     let mut sum = Vec3::ZERO;
     for lamp in lamps {
         let Some((wi, dist, irradiance)) = lamp.towards(p) else {
             continue;
         };
-        let f = bsdf.eval_glossy(wi);
+        let f = f(wi);
         if f == Vec3::ZERO {
             continue;
         }
@@ -221,5 +258,48 @@ mod tests {
         assert_eq!(h(away), 0.0);
         // Below the surface: nothing.
         assert_eq!(h(lamp(Vec3::new(1.0, -1.0, 0.0), None)), 0.0);
+    }
+
+    #[test]
+    fn a_lamps_diffuse_light_and_highlight_make_up_its_whole_reflection() {
+        // Plastic: a Lambertian lobe under a glossy coat. Lit from above and aside, seen
+        // from elsewhere: the two lobes sum to the BSDF's whole reflection.
+        let plastic = SurfaceMaterial {
+            base: Vec3::new(0.7, 0.5, 0.3),
+            metallic: 0.0,
+            roughness: 0.4,
+            transmission: 0.0,
+            ior: 1.5,
+            thin_walled: false,
+        };
+        let wo = Vec3::new(-1.0, 0.8, 0.3).normalize();
+        let bsdf = Bsdf::new(plastic, Vec3::Y, Vec3::Y, wo, true);
+        let lamp = RuntimeLamp {
+            position: Vec3::new(0.6, 1.5, -0.4),
+            direction: Vec3::NEG_Y,
+            radiant: Vec3::splat(8.0),
+            light: 0,
+            range: f32::INFINITY,
+            cone: None,
+        };
+        let p = Vec3::new(0.1, 0.0, 0.2);
+        let d = diffuse(&[lamp], p, Vec3::Y, &bsdf, None);
+        let h = highlights(&[lamp], p, Vec3::Y, &bsdf, None);
+        let (wi, _, e) = lamp.towards(p).unwrap();
+        let whole = bsdf.eval(wi) * e * wi.dot(Vec3::Y);
+        assert!(d.x > 0.0 && h.x > 0.0, "{d} {h}");
+        assert!(
+            (d + h - whole).abs().max_element() < 1e-5 * whole.max_element(),
+            "{d} + {h} against {whole}"
+        );
+        // The Lambertian lobe is the albedo's share of what the Fresnel lets in: at most the
+        // albedo over π per unit irradiance.
+        let per_irradiance = d / (e * wi.dot(Vec3::Y));
+        assert!(
+            per_irradiance
+                .cmple(plastic.albedo() / std::f32::consts::PI)
+                .all()
+        );
+        assert!(per_irradiance.x > 0.8 * plastic.albedo().x / std::f32::consts::PI);
     }
 }

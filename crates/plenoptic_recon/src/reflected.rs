@@ -20,7 +20,8 @@
 //! - the *albedo* and the *emission* are the material's at the point's UV, the texture's mip
 //!   chosen by the ray's footprint there (the pixel's cone, continued past the mirror);
 //! - the runtime sun's direct light is evaluated at the point with its shadow rays
-//!   ([`crate::sun`]).
+//!   ([`crate::sun`]), and so is the lamps' direct diffuse light where the pack leaves it to
+//!   the runtime ([`crate::lamps::diffuse`]).
 //!
 //! Reading the base views' *radiance* at the hit instead (what the march does) shows the
 //! reflected scene at cube resolution, its sun-shadow edges blurred, and takes the colour of
@@ -45,11 +46,13 @@ use glam::{Affine3A, Vec3};
 
 use crate::Reconstructor;
 use crate::brdf::Bsdf;
+use crate::lamps::RuntimeLamp;
 use crate::lookup::{FastKey, PackedTexels, at_point};
 use crate::material::Materials;
 use crate::proxy::TriangleMesh;
 use crate::reconstructor::KeyCubes;
 use crate::shading::Channel;
+use crate::shadow::PlacedShadows;
 use crate::shadow::ProxyHit;
 use crate::sun::PlacedSun;
 use crate::volume::VolumeIndex;
@@ -92,6 +95,10 @@ pub(crate) struct ShadedHits<'r> {
     /// Per base view: its position, weight and temporal-volume samples of the lighting.
     volumes: Vec<(Vec3, f32, VolumeIndex)>,
     sun: Option<&'r PlacedSun<'r>>,
+    /// The lamps whose direct diffuse light the pack leaves to the runtime, and the proxies
+    /// their shadow rays meet ([`crate::lamps::diffuse`]).
+    lamps: Vec<RuntimeLamp>,
+    lamp_shadows: Option<PlacedShadows<'r>>,
     depth_tolerance: f32,
     angular_power: f32,
 }
@@ -154,6 +161,11 @@ impl<'r> ShadedHits<'r> {
                 (id, PlacedObject { xf, mesh, to_key })
             })
             .collect();
+        let lamps = rec.lamps_lit_at_runtime();
+        let lamp_shadows = rec
+            .proxy_rays()
+            .filter(|_| !lamps.is_empty())
+            .map(|shadows| shadows.at(proxy, t));
         Some(ShadedHits {
             rec,
             materials,
@@ -162,6 +174,8 @@ impl<'r> ShadedHits<'r> {
             blended_keys,
             volumes,
             sun,
+            lamps,
+            lamp_shadows,
             depth_tolerance: rec.settings.depth_tolerance,
             angular_power: rec.settings.angular_power,
         })
@@ -202,10 +216,14 @@ impl<'r> ShadedHits<'r> {
             None => (self.gathered(p, n, surface.ng, gather)?, Vec3::ZERO),
         };
         let mut c = surface.material.albedo() * lighting + non_diffuse + surface.emission;
-        if let Some(sun) = self.sun {
+        if self.sun.is_some() || !self.lamps.is_empty() {
             let front = dir.dot(surface.ng) < 0.0;
             let bsdf = Bsdf::new(surface.material, surface.ng, surface.ns, -dir, front);
-            c += sun.radiance(p, surface.ng, (Vec3::ZERO, Vec3::ZERO), &bsdf, 0);
+            if let Some(sun) = self.sun {
+                c += sun.radiance(p, surface.ng, (Vec3::ZERO, Vec3::ZERO), &bsdf, 0);
+            }
+            let shadows = self.lamp_shadows.as_ref();
+            c += crate::lamps::diffuse(&self.lamps, p, surface.ng, &bsdf, shadows);
         }
         Some(c)
     }

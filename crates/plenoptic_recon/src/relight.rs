@@ -372,6 +372,16 @@ impl Reconstructor {
         Some(lamps)
     }
 
+    /// The lamps whose direct diffuse light the pack leaves to the runtime
+    /// ([`plenoptic_pack::PackReader::lamps_at_runtime`], [`crate::lamps::diffuse`]), each
+    /// scaled by its light's group; empty where the lighting holds it.
+    pub fn lamps_lit_at_runtime(&self) -> Vec<crate::lamps::RuntimeLamp> {
+        if !self.pack.lamps_at_runtime() {
+            return Vec::new();
+        }
+        self.runtime_lamps().unwrap_or_default()
+    }
+
     /// The light groups' weights in use.
     pub fn light_weights(&self) -> &GroupWeights {
         &self.relight.weights

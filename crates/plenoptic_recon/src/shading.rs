@@ -32,8 +32,11 @@
 //! non-diffuse radiance is replaced by their emission at the pixel's UV plus the reflected
 //! ray's radiance, marched through the base views' distance cubes.
 //!
+//! Where the pack leaves its lamps to the runtime (pack 5.0), each pixel adds their direct
+//! diffuse light with a shadow ray per lamp ([`crate::lamps::diffuse`]).
+//!
 //! Normal maps bend each pixel's shading normal ([`crate::material::bend_normal`]), which the
-//! runtime sun and the reflections use; the stored lighting stays at cube resolution (its
+//! runtime sun, the lamps and the reflections use; the stored lighting stays at cube resolution (its
 //! texels average the bent normals they cover).
 //!
 //! Emission is the material's at the pixel's UV (factor × emissive texture, mip by footprint)
@@ -51,8 +54,10 @@ use crate::Result;
 use crate::brdf::{Bsdf, DELTA_ROUGHNESS};
 use crate::frame::{Frame, Report};
 use crate::geometry::{self, Layer, Pass, Shot};
+use crate::lamps::{self, RuntimeLamp};
 use crate::proxy::ProxyGeometry;
 use crate::settings::{CubeFilter, Shading};
+use crate::shadow::PlacedShadows;
 use crate::specular::{self, Reflections};
 use crate::sun::PlacedSun;
 use crate::surface::{PixelGeometry, SharedRaster, SurfacePixel, Surfaces};
@@ -262,6 +267,11 @@ impl Layered<'_> {
             let rays = (rec.settings.sun_shadow_rays, rec.settings.sun_edge_rays);
             s.at(shadows, proxy, t, rays).scaled(rec.relight.sun)
         });
+        let lamps = rec.lamps_lit_at_runtime();
+        let lamp_shadows = rec
+            .proxy_rays()
+            .filter(|_| !lamps.is_empty())
+            .map(|shadows| shadows.at(proxy, t));
         let glossy = specular::glossy_allowed(rec);
         let with_footprint = sun.is_some();
         let surfaces = Surfaces::new(
@@ -284,6 +294,8 @@ impl Layered<'_> {
         );
         let shader = Shader {
             sun: sun.as_ref(),
+            lamps: &lamps,
+            lamp_shadows: lamp_shadows.as_ref(),
             runtime_emission: rec.pack().runtime_emission(),
             non_diffuse: &lit.non_diffuse,
             marched_pixels: AtomicUsize::new(0),
@@ -337,6 +349,10 @@ impl Layered<'_> {
 /// What shading a pixel needs beside its surface and its lighting.
 struct Shader<'a> {
     sun: Option<&'a PlacedSun<'a>>,
+    /// The lamps whose direct diffuse light is added per pixel, and the proxies their shadow
+    /// rays meet ([`crate::lamps::diffuse`]).
+    lamps: &'a [RuntimeLamp],
+    lamp_shadows: Option<&'a PlacedShadows<'a>>,
     /// Whether the pack leaves the emission to the runtime (pack 4).
     runtime_emission: bool,
     non_diffuse: &'a [Vec3],
@@ -376,8 +392,11 @@ impl Shader<'_> {
             self.non_diffuse[j]
         };
         let mut c = px.material.albedo() * light + specular.unwrap_or(baked);
-        if let (Some(sun), Some((g, bsdf, _))) = (self.sun, &bsdf) {
-            c += sun.radiance(g.position, g.ng, g.footprint, bsdf, j as u32);
+        if let Some((g, bsdf, _)) = &bsdf {
+            if let Some(sun) = self.sun {
+                c += sun.radiance(g.position, g.ng, g.footprint, bsdf, j as u32);
+            }
+            c += lamps::diffuse(self.lamps, g.position, g.ng, bsdf, self.lamp_shadows);
         }
         c
     }

@@ -80,6 +80,8 @@ pub(crate) struct Surfaces<'a> {
     see_through_layer: bool,
     glazing: Vec<u32>,
     with_footprint: bool,
+    /// Whether every pixel needs its geometry (the runtime lamps' diffuse light, the sun).
+    with_geometry: bool,
     glossy: bool,
     runtime_emission: bool,
     /// Milliseconds the raster pass took.
@@ -88,7 +90,8 @@ pub(crate) struct Surfaces<'a> {
 
 impl<'a> Surfaces<'a> {
     /// The surfaces of the proxies of `layer` seen by `camera` at `t`; with their footprint
-    /// only `with_footprint` (the runtime sun's shadow rays need it), their emission where the
+    /// only `with_footprint` (the runtime sun's shadow rays need it), their geometry also
+    /// where the pack leaves its lamps to the runtime, their emission where the
     /// pack leaves it to the runtime or their specular part is marched (`glossy`:
     /// [`crate::specular::glossy_allowed`]); rasterized unless the lighting pass `shared` its
     /// raster of the same proxies.
@@ -163,6 +166,7 @@ impl<'a> Surfaces<'a> {
             see_through_layer: matches!(layer, Layer::Only(_)),
             glazing,
             with_footprint,
+            with_geometry: with_footprint || rec.pack().lamps_at_runtime(),
             glossy,
             runtime_emission,
             raster_ms,
@@ -231,7 +235,7 @@ impl<'a> Surfaces<'a> {
         } else {
             Vec3::ZERO
         };
-        let geometry = (marched || self.with_footprint).then(|| {
+        let geometry = (marched || self.with_geometry).then(|| {
             let view = ray / len;
             let position = b.position + view * along;
             self.geometry(t, position, view, uv, uv_footprint, (x, y), along)

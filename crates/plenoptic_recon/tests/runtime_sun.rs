@@ -97,6 +97,13 @@ fn the_runtime_bsdf_is_the_tracers() {
             (a - b).abs().max_element() <= 1e-4 * scale + 1e-5,
             "case {case}: runtime {a} against the tracer's {b} for {m:?}"
         );
+        // The Lambertian lobe alone: what a runtime lamp's diffuse light goes through.
+        let (a_d, b_d) = (ours.eval_diffuse(wi), theirs.eval(wi, Lobes::Diffuse).0);
+        let scale = a_d.max_element().max(b_d.max_element());
+        assert!(
+            (a_d - b_d).abs().max_element() <= 1e-4 * scale + 1e-5,
+            "case {case}: runtime diffuse {a_d} against the tracer's {b_d} for {m:?}"
+        );
         compared += 1;
         if b.max_element() > 0.0 {
             nonzero += 1;

@@ -141,6 +141,13 @@ impl LightSet {
         self.punctual.len()
     }
 
+    /// Whether punctual light `i` is a lamp: a point or spot light (not a directional one).
+    pub fn is_lamp(&self, i: usize) -> bool {
+        self.punctual
+            .get(i)
+            .is_some_and(|(l, _)| matches!(l.kind, LightKind::Point | LightKind::Spot { .. }))
+    }
+
     /// Samples a point on the emissive triangles (by area × luminance) as seen from `p`. The
     /// radiance is weighted by the surface's coverage there (0 where a MASK cuts it, alpha for
     /// BLEND), matching what rays that hit emitters see.
@@ -333,6 +340,9 @@ pub struct DirectLight {
     pub sun: Vec3,
     /// The Lambertian lobe's share of `sun`.
     pub sun_diffuse: Vec3,
+    /// The part of `diffuse` from the scene's point and spot lights (the lamps): what a pack
+    /// whose lamps are lit at runtime leaves out of the stored lighting.
+    pub lamp_diffuse: Vec3,
 }
 
 /// [`estimate_direct`] with the Lambertian lobe's share kept apart (the bake's denoiser
@@ -385,7 +395,7 @@ fn direct(
     let n = bsdf.normal();
     let mut total = Vec3::ZERO;
     let mut diffuse = Vec3::ZERO;
-    let (mut sun, mut sun_diffuse) = (Vec3::ZERO, Vec3::ZERO);
+    let (mut sun, mut sun_diffuse, mut lamp_diffuse) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
     for i in 0..lights.punctual_count() {
         let u = if lights.punctual[i].0.angular_radius > 0.0 {
             sampler.next_2d()
@@ -413,6 +423,9 @@ fn direct(
             if lights.sun == Some(i) {
                 sun += value;
                 sun_diffuse += d;
+            }
+            if lights.is_lamp(i) {
+                lamp_diffuse += d;
             }
         }
     }
@@ -479,5 +492,6 @@ fn direct(
         diffuse,
         sun,
         sun_diffuse,
+        lamp_diffuse,
     }
 }

@@ -42,6 +42,10 @@ pub struct RadianceSample {
     pub sun: Vec3,
     /// The Lambertian lobe's share of `sun` (part of `diffuse`).
     pub sun_diffuse: Vec3,
+    /// The part of `diffuse` that is the first hit's direct light from the scene's point and
+    /// spot lights, shadow rays included: what a pack whose lamps are lit at runtime leaves
+    /// out of the stored lighting. Zero without lamps and from the path tracer.
+    pub lamp_diffuse: Vec3,
     /// The ambient share of `diffuse`: the first hit's indirect diffuse light (the ambient
     /// field's, or its final gather's), without direct light. It varies slowly over a
     /// surface, so the bake may smooth it where it would not smooth shadow edges.
@@ -63,6 +67,7 @@ impl RadianceSample {
         self.lighting_variance += other.lighting_variance;
         self.sun += other.sun;
         self.sun_diffuse += other.sun_diffuse;
+        self.lamp_diffuse += other.lamp_diffuse;
         self.ambient += other.ambient;
         self.emission += other.emission;
     }
@@ -79,6 +84,7 @@ impl RadianceSample {
         lighting_variance: 0.0,
         sun: Vec3::ZERO,
         sun_diffuse: Vec3::ZERO,
+        lamp_diffuse: Vec3::ZERO,
         ambient: Vec3::ZERO,
         emission: Vec3::ZERO,
     };
@@ -141,9 +147,9 @@ where
     let spp = spp.max(1);
     Image::render(w, h, |x, y| {
         let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-        let (mut sum, mut diffuse, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-        let (mut sun, mut sun_diffuse, mut emission) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-        let mut ambient = Vec3::ZERO;
+        // The kept samples' light (`add_light`: every radiance and its parts) and albedo.
+        let mut sum = RadianceSample::MISS;
+        let mut albedo = Vec3::ZERO;
         let (mut l1, mut l2) = (0.0f64, 0.0f64);
         let mut aux = RadianceSample::MISS;
         let mut any = false;
@@ -168,13 +174,8 @@ where
             }
             any = true;
             kept += 1;
-            sum += r.radiance;
-            diffuse += r.diffuse;
+            sum.add_light(&r);
             albedo += r.albedo;
-            sun += r.sun;
-            sun_diffuse += r.sun_diffuse;
-            ambient += r.ambient;
-            emission += r.emission;
             let a = luminance(r.albedo);
             // The variance of the lighting the bake stores and filters: without the sun's
             // direct light, which the runtime evaluates.
@@ -191,13 +192,14 @@ where
         }
         let n = kept as f32;
         RadianceSample {
-            radiance: sum / n,
-            diffuse: diffuse / n,
+            radiance: sum.radiance / n,
+            diffuse: sum.diffuse / n,
             albedo: albedo / n,
-            sun: sun / n,
-            sun_diffuse: sun_diffuse / n,
-            ambient: ambient / n,
-            emission: emission / n,
+            sun: sum.sun / n,
+            sun_diffuse: sum.sun_diffuse / n,
+            lamp_diffuse: sum.lamp_diffuse / n,
+            ambient: sum.ambient / n,
+            emission: sum.emission / n,
             lighting_variance: if kept > 1 {
                 // Unbiased sample variance, over n for the variance of the mean.
                 let n = f64::from(kept);

@@ -142,7 +142,9 @@ fn white_furnace_multi_stage() {
 }
 
 /// A diffuse plane of albedo ρ under a point light of intensity I at height h: radiance
-/// ρ/π · I·cosθ/r² at every point, no indirect light (a plane cannot see itself).
+/// ρ/π · I·cosθ/r² at every point, no indirect light (a plane cannot see itself). The
+/// multi-stage renderer reports all of it as the lamp's diffuse light (`lamp_diffuse`, what a
+/// pack with runtime lamps leaves out of its lighting) and none of it as the sun's.
 #[test]
 fn point_light_over_diffuse_plane() {
     let (rho, intensity, h) = (0.8f32, 10.0f32, 2.0f32);
@@ -181,6 +183,13 @@ fn point_light_over_diffuse_plane() {
                 let expected = rho / PI * intensity * (d.y / d.length()) / d.length_squared();
                 let got = luminance(s.radiance);
                 worst = worst.max((got - expected).abs() / expected);
+                if name == "MS" {
+                    let lamp = luminance(s.lamp_diffuse);
+                    assert!((lamp - got).abs() <= 1e-5 * got, "{lamp} of {got}");
+                    assert_eq!(s.sun_diffuse, Vec3::ZERO);
+                } else {
+                    assert_eq!(s.lamp_diffuse, Vec3::ZERO, "the path tracer does not split");
+                }
             }
         }
         println!("point light {name}: worst relative error {worst:.2e}");

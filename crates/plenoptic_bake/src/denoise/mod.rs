@@ -369,13 +369,15 @@ impl LightingCube {
 }
 
 /// `(lighting, non-diffuse)` of a volume sample, as a range image's texel stores them: the
-/// sun's direct light and the emission left out (both for the runtime).
+/// sun's direct light, the lamps' direct diffuse light and the emission left out (all for the
+/// runtime; what the bake keeps is zeroed first, `RuntimeLight::keep_baked`).
 pub fn split_sample(s: &RadianceSample) -> (Vec3, Vec3) {
     let split = split(s);
     (split.lighting, split.residual.max(Vec3::ZERO))
 }
 
-/// A rendered sample taken apart: `radiance = albedo ⊙ lighting + residual + sun + emission`.
+/// A rendered sample taken apart: `radiance = albedo ⊙ lighting + residual + sun + lamps +
+/// emission`.
 struct Split {
     lighting: Vec3,
     /// The ambient share of `lighting`.
@@ -386,18 +388,22 @@ struct Split {
     emission: Vec3,
 }
 
-/// [`Split`] of a rendered sample: the sun's direct light and the emission are taken out
-/// first (clamped so that nothing goes negative), then the rest of the Lambertian part is
-/// demodulated by the albedo.
+/// [`Split`] of a rendered sample: the sun's direct light, the lamps' direct diffuse light and
+/// the emission are taken out first (clamped so that nothing goes negative), then the rest
+/// of the Lambertian part is demodulated by the albedo.
 fn split(s: &RadianceSample) -> Split {
     let radiance = s.radiance.max(Vec3::ZERO);
     let sun = s.sun.max(Vec3::ZERO).min(radiance);
     let sun_diffuse = s.sun_diffuse.max(Vec3::ZERO).min(sun);
     let radiance = radiance - sun;
+    let lamps = s.lamp_diffuse.max(Vec3::ZERO).min(radiance);
+    let radiance = radiance - lamps;
     let emission = s.emission.max(Vec3::ZERO).min(radiance);
     let radiance = radiance - emission;
     let albedo = s.albedo;
-    let diffuse = (s.diffuse - sun_diffuse).max(Vec3::ZERO).min(radiance);
+    let diffuse = (s.diffuse - sun_diffuse - lamps)
+        .max(Vec3::ZERO)
+        .min(radiance);
     let mut lighting = Vec3::ZERO;
     let mut ambient = Vec3::ZERO;
     let mut kept = Vec3::ZERO;

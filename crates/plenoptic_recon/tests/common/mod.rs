@@ -373,6 +373,11 @@ pub struct PackSpec {
     /// stored lighting with shadow rays. The stored texels are not changed, so this tests
     /// that both backends add the same light, not the physics.
     pub direct_sun: bool,
+    /// Whether the pack places the analytic shading's light (a point light at [`LIGHT`]) and
+    /// leaves its direct diffuse light to the runtime (pack 5's `lamps_at_runtime`): the
+    /// runtime adds it to the stored lighting with shadow rays. The stored texels are not
+    /// changed, so this tests that both backends add the same light, not the physics.
+    pub runtime_lamps: bool,
 }
 
 /// The materials of a test pack's objects.
@@ -431,6 +436,7 @@ impl PackSpec {
             materials: Materials::None,
             lighting_chunks: true,
             direct_sun: false,
+            runtime_lamps: false,
         }
     }
 }
@@ -537,11 +543,12 @@ pub fn write_pack_with(
         },
         spec.bucket,
     );
-    if spec.materials == Materials::Mirror {
+    if spec.materials == Materials::Mirror || spec.runtime_lamps {
         // The shading function's light, placed (pack 4.1): the glossy wall's highlight of it
-        // is evaluated at runtime (plenoptic_recon::lamps). The stored non-diffuse texels are
-        // not changed, so this tests that both backends add the same highlight, not the
-        // physics.
+        // is evaluated at runtime (plenoptic_recon::lamps), and with `runtime_lamps` every
+        // surface's diffuse light of it. The stored texels are not changed, so this tests that
+        // both backends add the same light, not the physics.
+        manifest.lamps_at_runtime = spec.runtime_lamps;
         manifest.lights.push(plenoptic_pack::Light {
             kind: plenoptic_pack::LightKind::Point,
             colour: Vec3::ONE,

@@ -165,6 +165,8 @@ pub struct QualityToml {
     pub denoise: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runtime_sun: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runtime_lamps: Option<bool>,
 }
 
 /// A validated recipe.
@@ -538,7 +540,8 @@ impl QualityToml {
             max_specular_depth,
             reference_samples_per_pixel,
             denoise,
-            runtime_sun
+            runtime_sun,
+            runtime_lamps
         );
         check_quality(&q, err)?;
         Ok(q)

@@ -57,6 +57,14 @@ fn runtime_sun_default() -> bool {
     RUNTIME_SUN_DEFAULT
 }
 
+/// Whether the presets leave the lamps' direct diffuse light to the runtime (see
+/// [`Quality::runtime_lamps`]).
+pub const RUNTIME_LAMPS_DEFAULT: bool = true;
+
+fn runtime_lamps_default() -> bool {
+    RUNTIME_LAMPS_DEFAULT
+}
+
 /// Bake quality settings (docs/architecture.md "Baking"; thesis ch. 5–7). Start from a preset and
 /// override single fields; every field states its cost.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -114,6 +122,15 @@ pub struct Quality {
     /// (cube resolution) and each view follows its sun patches with keys of its own.
     #[serde(default = "runtime_sun_default")]
     pub runtime_sun: bool,
+    /// Leave the direct diffuse light of the scene's point and spot lights out of the stored
+    /// lighting for the runtime to evaluate per pixel, with a shadow ray per lamp against the
+    /// proxies (pack 5's `lamps_at_runtime`; docs/architecture.md, "The runtime lamps"). Only
+    /// where every lamp stands still and there are at most 4; otherwise, or off, the lamps'
+    /// light is baked at cube resolution. On the tour the lamp's lit top, a sliver one or two
+    /// pixels tall, is exact instead of mixed with its side in a 64-pixel texel; each pixel
+    /// pays a shadow ray per lamp.
+    #[serde(default = "runtime_lamps_default")]
+    pub runtime_lamps: bool,
 }
 
 impl Quality {
@@ -133,6 +150,7 @@ impl Quality {
             reference_samples_per_pixel: 64,
             denoise: DENOISE_DEFAULT,
             runtime_sun: RUNTIME_SUN_DEFAULT,
+            runtime_lamps: RUNTIME_LAMPS_DEFAULT,
         }
     }
 
@@ -152,6 +170,7 @@ impl Quality {
             reference_samples_per_pixel: 256,
             denoise: DENOISE_DEFAULT,
             runtime_sun: RUNTIME_SUN_DEFAULT,
+            runtime_lamps: RUNTIME_LAMPS_DEFAULT,
         }
     }
 
@@ -171,6 +190,7 @@ impl Quality {
             reference_samples_per_pixel: 1024,
             denoise: DENOISE_DEFAULT,
             runtime_sun: RUNTIME_SUN_DEFAULT,
+            runtime_lamps: RUNTIME_LAMPS_DEFAULT,
         }
     }
 
@@ -190,6 +210,7 @@ impl Quality {
             reference_samples_per_pixel: 4096,
             denoise: DENOISE_DEFAULT,
             runtime_sun: RUNTIME_SUN_DEFAULT,
+            runtime_lamps: RUNTIME_LAMPS_DEFAULT,
         }
     }
 }

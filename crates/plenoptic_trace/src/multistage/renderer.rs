@@ -165,6 +165,7 @@ impl<'f> MultiStageRenderer<'f> {
             if let Some(out) = first.as_deref_mut() {
                 out.sun = direct.sun;
                 out.sun_diffuse = direct.sun_diffuse;
+                out.lamp_diffuse = direct.lamp_diffuse;
             }
         }
         if bsdf.has(Lobes::Diffuse) {

@@ -35,6 +35,8 @@ const VIEW_RELIT: u32 = 32u;
 const VIEW_LOOKUP_KERNEL: u32 = 64u;
 // With it, materials' lighting is looked up at the anchors and interpolated (screen_fill.wgsl).
 const VIEW_SPARSE_LIGHTING: u32 = 128u;
+// The pack leaves its lamps' direct diffuse light to the runtime (pack 5.0; lamps.wgsl).
+const VIEW_LAMPS: u32 = 256u;
 
 // A placed lamp (view.rs, LampParams; plenoptic_recon's lamps::RuntimeLamp).
 struct Lamp {

@@ -1,5 +1,6 @@
 // The fragment's BSDF terms (plenoptic_recon's brdf module and Bsdf, the same formulas), shared
-// by the runtime sun (sun.wgsl) and the reflections for the camera (specular.wgsl) of
+// by the runtime sun (sun.wgsl), the lamps (lamps.wgsl) and the reflections for the camera
+// (specular.wgsl) of
 // geometry-assisted reconstruction (thesis §8.2.3): the exact dielectric Fresnel and
 // Schlick's, GGX with separable Smith masking, the glossy lobe, and the shading frame of a
 // fragment seen from the eye. The material is the fragment's (bindings.wgsl's pixel_*).
@@ -41,6 +42,25 @@ fn smith_g1(alpha: f32, cos: f32) -> f32 {
     let c = abs(cos);
     let a2 = alpha * alpha;
     return 2.0 * c / (c + sqrt(a2 + (1.0 - a2) * c * c));
+}
+
+// plenoptic_recon's Bsdf::lambert: the Lambertian lobe at ω_o·h, what the dielectric Fresnel
+// lets into the surface, scattered uniformly.
+fn lambert(voh: f32, eta: f32) -> vec3<f32> {
+    let fd = fresnel_dielectric(clamp(voh, 0.0, 1.0), eta);
+    return pixel_base * ((1.0 - pixel_metallic) * (1.0 - params.transmission) * (1.0 - fd) / PI);
+}
+
+// plenoptic_recon's Bsdf::eval_diffuse: the Lambertian lobe alone, zero below the surface.
+fn diffuse_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32) -> vec3<f32> {
+    if dot(wi, n) <= 0.0 || dot(wi, ng) <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let h = wo + wi;
+    if dot(h, h) <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return lambert(dot(wo, normalize(h)), eta);
 }
 
 // plenoptic_recon's Bsdf::glossy_weight for the fragment's material.

@@ -15,7 +15,7 @@ use plenoptic_recon::relight::Relight;
 use plenoptic_recon::temporal::bracketing;
 
 use super::view::{LookupParams, ViewFlags, ViewParams, motion_slot};
-use super::{MaterialFactors, ObjectFlags, ObjectParams, reflect, sun, view, volume};
+use super::{MaterialFactors, ObjectFlags, ObjectParams, lamps, reflect, sun, view, volume};
 use crate::asset::RadiancePack;
 use crate::camera::{PlenopticCamera, ReconMode, ReconSettings};
 use crate::reconstruct::environment::EnvironmentUniform;
@@ -295,7 +295,8 @@ impl CameraFrame<'_> {
         view::fill_motion(&mut params, pack, &taus);
         if cam.settings.shading == plenoptic_recon::Shading::Materials {
             sun::fill(&mut params, pack, cam.time, relight.sun);
-            reflect::fill(&mut params, pack, &cam.settings, relight);
+            reflect::fill(&mut params, pack, &cam.settings);
+            lamps::fill(&mut params, pack, relight);
         }
         if let Some(groups) = self.relit {
             params.flags |= ViewFlags::RELIT;

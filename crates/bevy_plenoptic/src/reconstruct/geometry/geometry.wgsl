@@ -3,14 +3,16 @@
 // w_view · w_time · ((1 + cos θ)/2)^p), with its volume fallback and hole fill. An object with a
 // material in a 2.0 pack is shaded as plenoptic_recon's shading module does it:
 // albedo (the material's factors × textures) · lighting + non-diffuse, both looked up
-// bilinearly, the runtime sun through the normal-mapped shading normal; on
+// bilinearly, the runtime sun (and, pack 5, the lamps' diffuse light) through the
+// normal-mapped shading normal; on
 // mirrors and glossy metals the non-diffuse part is replaced by reflections marched for the
 // camera through the lookups' distance cubes (reflect.rs, reflect.wgsl).
 // This file is the entry point: the fragment shaders of the proxy material and of a lit app
 // mesh (PLENOPTIC_STANDARD), and the output. The rest is in the libraries beside it, in
 // plenoptic::geometry: bindings (what the material binds, the fragment's state), material
 // (albedo, textures, normal map), lookup (texel lookups, tests, weights, volume fallback),
-// fill (hole fill and fallbacks), bsdf, sun (the runtime sun) and specular (reflections).
+// fill (hole fill and fallbacks), bsdf, sun (the runtime sun), lamps (the placed lamps) and
+// specular (reflections).
 
 #import bevy_pbr::forward_io::VertexOutput
 #import bevy_pbr::mesh_view_bindings::view
@@ -33,6 +35,7 @@
 }
 #import plenoptic::geometry::fill::{radiance, write_fill_entry, note_fragment}
 #import plenoptic::geometry::sun::sun_light
+#import plenoptic::geometry::lamps::lamps_diffuse
 #import plenoptic::geometry::specular::{marched, see_through, reflection}
 #import plenoptic::counters::flush_counters
 
@@ -119,7 +122,8 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         reflected += pixel_emission;
     }
     var c: vec4<f32>;
-    // What is added to the reconstructed radiance: reflection, emission and the sun.
+    // What is added to the reconstructed radiance: reflection, emission, the sun and the
+    // lamps.
     var added = reflected;
     if see_through() {
         // Transmissive glass: its reflection alone (none where no lookup answers; the baked
@@ -134,6 +138,11 @@ fn shade(in: VertexOutput, ng: vec3<f32>) -> vec4<f32> {
         let sun = sun_light(in, ng);
         added += sun;
         c = vec4<f32>(c.rgb + sun, c.a);
+    }
+    if lit() && view_has(VIEW_LAMPS) && !image_mode() {
+        let lamps = lamps_diffuse(in, ng);
+        added += lamps;
+        c = vec4<f32>(c.rgb + lamps, c.a);
     }
     write_fill_entry(in.position, added);
     // Glazing (fill.w < 1) is blended over what lies behind it with its coverage in

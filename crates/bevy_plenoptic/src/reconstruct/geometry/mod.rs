@@ -44,12 +44,12 @@
 //!   libraries beside it (`plenoptic::geometry::*`) are `bindings.wgsl` (the bindings and
 //!   the fragment's state), `material.wgsl` (albedo, textures, normal map), `lookup.wgsl`
 //!   (the lookups and the volume fallback), `fill.wgsl` (the hole fill and the fallbacks
-//!   after it), `bsdf.wgsl`, `sun.wgsl` (the runtime sun) and `specular.wgsl` (reflections
-//!   for the camera); [`prepare`]: the main-world systems that attach
+//!   after it), `bsdf.wgsl`, `sun.wgsl` (the runtime sun), `lamps.wgsl` (the placed lamps'
+//!   light) and `specular.wgsl` (reflections for the camera); [`prepare`]: the main-world systems that attach
 //!   materials to proxies and keep them bound to their camera; [`view`] and [`frame`]: the
-//!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`]
-//!   and [`sun`]: the volume fallback's buffers, the ray-cast proxies, the reflection march
-//!   and the runtime sun; [`screen_fill`] (`screen_fill.wgsl`, `fill_entry.wgsl`): the
+//!   per-view buffer and the lookups it is filled from; [`volume`], [`rays`], [`reflect`],
+//!   [`sun`] and [`lamps`]: the volume fallback's buffers, the ray-cast proxies, the
+//!   reflection march, the runtime sun and the placed lamps; [`screen_fill`] (`screen_fill.wgsl`, `fill_entry.wgsl`): the
 //!   hole-fill kernel, and [`lookup_kernel`] the lookup kernel before it; [`blend`] (`blend.wgsl`): each view's two time keys blended once per
 //!   frame where they agree, which a lit object still between the keys' times looks up once.
 //!   The material is drawn by Bevy's own mesh passes; the key blend runs before its opaque
@@ -64,6 +64,7 @@ pub mod blend;
 pub mod fill_composite;
 pub mod frame;
 mod key_pass;
+pub mod lamps;
 pub mod lookup_kernel;
 pub mod prepare;
 pub mod rays;
@@ -108,6 +109,7 @@ impl Plugin for GeometryAssistedPlugin {
         bevy::shader::load_shader_library!(app, "fill.wgsl");
         bevy::shader::load_shader_library!(app, "bsdf.wgsl");
         bevy::shader::load_shader_library!(app, "sun.wgsl");
+        bevy::shader::load_shader_library!(app, "lamps.wgsl");
         bevy::shader::load_shader_library!(app, "specular.wgsl");
         bevy::shader::load_shader_library!(app, "relight.wgsl");
         embedded_asset!(app, "geometry.wgsl");

@@ -136,6 +136,32 @@ fn occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     return false;
 }
 
+// The fraction of light that passes along the ray within `tmax`: 0 where an opaque proxy
+// lies on it, else the product of 1 − c over the glazing surfaces it crosses
+// (plenoptic_recon's PlacedShadows::transmittance, the lamps' shadow rays).
+fn transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> f32 {
+    let header = rays[0];
+    if bitcast<u32>(header.w) == 0u {
+        return 1.0;
+    }
+    if traverse(bitcast<u32>(header.x), bitcast<u32>(header.y), origin, dir, tmax, false) > 0u {
+        return 0.0;
+    }
+    let moving = min(bitcast<u32>(header.z), arrayLength(&ray_placements) / 3u);
+    var through = 1.0;
+    for (var k = 0u; k < moving; k++) {
+        let entry = rays[1u + k];
+        let r = placed_ray(k, origin, dir);
+        let glazing = entry.w > 0.0;
+        let n = traverse(bitcast<u32>(entry.x), bitcast<u32>(entry.y), r.origin, r.dir, tmax, glazing);
+        if n > 0u && !glazing {
+            return 0.0;
+        }
+        through *= select(1.0, pow(entry.w, f32(n)), glazing);
+    }
+    return through;
+}
+
 // The fraction of light the see-through glazing lets through along the ray: the product of
 // 1 − c over the glazing surfaces it crosses, the other proxies ignored
 // (FlatRays::see_through_pass). Glazing BVHs are the moving entries whose w is above 0.

@@ -17,40 +17,15 @@
 //! The emission is the material's at the fragment's UV (`pixel_emission`), as on the CPU.
 
 use plenoptic_recon::Specular;
-use plenoptic_recon::lamps::runtime_lamps;
-use plenoptic_recon::relight::Relight;
 use plenoptic_recon::specular::{GLOSSY_RAYS, glossy_allowed_in, march_distance};
 
-use super::view::{LampParams, ViewParams};
+use super::view::ViewParams;
 use crate::asset::RadiancePack;
 use crate::camera::ReconSettings;
 
 /// The view buffer's reflection fields on `pack`, as the camera's `settings` ask.
-pub(super) fn fill(
-    params: &mut ViewParams,
-    pack: &RadiancePack,
-    settings: &ReconSettings,
-    relight: &Relight,
-) {
+pub(super) fn fill(params: &mut ViewParams, pack: &RadiancePack, settings: &ReconSettings) {
     let manifest = pack.reader.manifest();
-    let lamps = runtime_lamps(manifest).unwrap_or_default();
-    params.lamp_count = lamps.len() as u32;
-    for (k, lamp) in lamps.iter().enumerate() {
-        let (cos_outer, scale) = lamp.cone.unwrap_or((-2.0, 0.0));
-        let range = if lamp.range.is_finite() {
-            lamp.range
-        } else {
-            -1.0
-        };
-        params.lamps[k] = LampParams {
-            position: lamp.position,
-            range,
-            axis: lamp.direction,
-            cos_outer,
-            radiant: lamp.radiant * relight.light(lamp.light),
-            cone_scale: scale,
-        };
-    }
     if let Specular::Marched { max_roughness } = settings.specular {
         let glossy = glossy_allowed_in(manifest, pack.reader.direct_sun().is_some());
         params.flags |= super::view::ViewFlags::MARCHED;

@@ -12,6 +12,7 @@
 #import plenoptic::reflect::{march, fetch, orthonormal_pair}
 #import plenoptic::rays::{has_rays, occluded}
 #import plenoptic::counters::{tally, C_LOADS_16}
+#import plenoptic::geometry::lamps::{towards, visible}
 #import plenoptic::geometry::bindings::{
     MAX_LOOKUPS, cam, params, cubes, env_image, pixel_base, pixel_metallic, pixel_roughness,
     view_has, image_mode, VIEW_MARCHED, object_has, OBJECT_SEE_THROUGH,
@@ -121,37 +122,19 @@ fn lobe(origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f3
 }
 
 // The placed lamps' highlights at `p` (plenoptic_recon's lamps::highlights): the glossy lobe
-// × the lamp's irradiance (glTF's spot falloff, nothing beyond its range) × the cosine, each
-// shadowed by a ray against the proxies.
+// × the lamp's irradiance × the cosine × its shadow ray (lamps.wgsl).
 fn highlights(p: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, alpha: f32, eta: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
     for (var k = 0u; k < cam.lamp_count; k++) {
-        let lamp = cam.lamps[k];
-        let d = lamp.position - p;
-        let dist2 = dot(d, d);
-        let dist = sqrt(dist2);
-        if dist <= 0.0 || (lamp.range > 0.0 && dist > lamp.range) {
+        let ray = towards(cam.lamps[k], p);
+        if all(ray.irradiance == vec3<f32>(0.0)) {
             continue;
         }
-        let wi = d / dist;
-        var value = lamp.radiant / dist2;
-        if lamp.cos_outer > -1.5 {
-            let att = clamp((dot(lamp.axis, -wi) - lamp.cos_outer) * lamp.cone_scale, 0.0, 1.0);
-            value *= att * att;
-        }
-        if all(value == vec3<f32>(0.0)) {
-            continue;
-        }
-        let f = glossy_bsdf(wi, wo, n, ng, alpha, eta);
+        let f = glossy_bsdf(ray.wi, wo, n, ng, alpha, eta);
         if all(f == vec3<f32>(0.0)) {
             continue;
         }
-        let origin = p + select(-ng, ng, dot(wi, ng) >= 0.0) * eps;
-        if has_rays() && occluded(origin, wi, dist - 2.0 * eps) {
-            continue;
-        }
-        sum += f * value * abs(dot(wi, n));
+        sum += f * ray.irradiance * abs(dot(ray.wi, n)) * visible(p, ng, ray);
     }
     return sum;
 }

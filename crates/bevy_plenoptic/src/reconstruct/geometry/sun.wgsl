@@ -11,7 +11,7 @@
 #import plenoptic::geometry::bindings::{cam, params, pixel_base, pixel_metallic, pixel_roughness}
 #import plenoptic::counters::{tally, C_SAMPLES}
 #import plenoptic::rays::{has_rays, see_through_pass}
-#import plenoptic::geometry::bsdf::{PI, fresnel_dielectric, ggx_d, smith_g1, glossy_bsdf, viewer}
+#import plenoptic::geometry::bsdf::{fresnel_dielectric, ggx_d, smith_g1, glossy_bsdf, lambert, viewer}
 
 // The BSDF for light from `wi` seen along `wo`, with shading normal `n` and geometric normal
 // `ng` (both on wo's side), relative IOR `eta`; the fragment's material.
@@ -27,10 +27,7 @@ fn sun_bsdf(wi: vec3<f32>, wo: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, eta: f32)
     let alpha = max(pixel_roughness * pixel_roughness, 1e-4);
     let delta = pixel_roughness < 0.02;
     if reflect {
-        let h = normalize(wo + wi);
-        let voh = clamp(dot(wo, h), 0.0, 1.0);
-        let fd = fresnel_dielectric(voh, eta);
-        let f = pixel_base * ((1.0 - m) * (1.0 - tr) * (1.0 - fd) / PI);
+        let f = lambert(dot(wo, normalize(wo + wi)), eta);
         if delta {
             return f;
         }

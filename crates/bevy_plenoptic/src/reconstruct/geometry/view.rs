@@ -133,8 +133,9 @@ pub struct ViewParams {
     pub sun: Vec4,
     /// The runtime sun's illuminance at the camera's time (xyz).
     pub sun_illuminance: Vec4,
-    /// The lamps whose highlights glossy surfaces add ([`super::reflect`],
-    /// `plenoptic_recon::lamps`); `lamp_count` counts them.
+    /// The placed lamps ([`super::lamps`], `plenoptic_recon::lamps`): their highlights on
+    /// marched glossy surfaces, and with [`ViewFlags::LAMPS`] their diffuse light on every lit
+    /// fragment; `lamp_count` counts them.
     pub lamps: [LampParams; MAX_RUNTIME_LAMPS],
     /// The lookups in use (`lookup_count` of them).
     pub lookups: [LookupParams; MAX_LOOKUPS],
@@ -189,6 +190,9 @@ impl ViewFlags {
     /// The lookup kernel looks materials' lighting up at the anchors and interpolates the
     /// rest (`ReconSettings::sparse_lighting`): a material's record is left to its passes.
     pub const SPARSE_LIGHTING: u32 = 1 << 7;
+    /// The pack leaves its lamps' direct diffuse light to the runtime (pack 5.0): lit
+    /// fragments add it ([`super::lamps`]).
+    pub const LAMPS: u32 = 1 << 8;
 }
 
 /// A camera's [`ViewParams`] buffer and this frame's lookups.
