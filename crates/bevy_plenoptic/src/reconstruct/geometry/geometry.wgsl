@@ -30,6 +30,7 @@
 #import plenoptic::geometry::bindings::{
     cam, params, lit, pixel_albedo, pixel_base, pixel_metallic, pixel_roughness,
     non_diffuse_weight, pixel_emission, local_from_world, view_has, image_mode, VIEW_SUN,
+    VIEW_LAMPS,
     point_slot, point_material,
     glazing, object_has, OBJECT_RUNTIME_EMISSION,
 }
