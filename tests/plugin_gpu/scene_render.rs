@@ -417,6 +417,8 @@ fn gpu_frame_with_runtime_lamps_matches_cpu() {
     eprintln!(
         "GPU against CPU with the runtime lamp: mean {mean:.4}, within 5 % {f5:.4}, within 20 % {f20:.4}"
     );
+    // Measured on lavapipe: the lamp's light changes the frame by a mean 0.167 (0.1 % of
+    // pixels within 5 %); GPU against CPU mean 0.0006, 100 % within 5 %.
     assert!(
         mean < 0.005 && f5 > 0.98 && f20 > 0.99,
         "mean {mean}, within 5 %: {f5}, within 20 %: {f20}"
