@@ -9,7 +9,7 @@
 //! ([`plenoptic_trace::RadianceSample::diffuse`], [`plenoptic_trace::RadianceSample::albedo`])
 //! into a [`LightingCube`]:
 //!
-//! `radiance = albedo ⊙ lighting + residual + sun + emission`
+//! `radiance = albedo ⊙ lighting + residual + direct + emission`
 //!
 //! - `lighting`: the first hit's diffuse lighting, diffuse radiance / diffuse albedo per
 //!   channel (demodulated: textures are divided out, so filtering it does not blur them). This
@@ -20,9 +20,10 @@
 //!   albedo is below [`MIN_ALBEDO`]. Not filtered: a reflection's detail is geometry seen in
 //!   another direction, not noise, and guides of the first hit cannot tell its edges.
 //!
-//! - `sun`: the first hit's direct light from the scene's sun (all lobes), which pack 3 leaves
-//!   to the runtime (shadow rays against the proxies at screen resolution). It is taken out of
-//!   the lighting and the residual before anything else, so the filter never sees sun-shadow
+//! - `direct`: the first hit's direct light left to the runtime (shadow rays against the
+//!   proxies at screen resolution): the scene's sun's through all lobes (pack 3) and the
+//!   lamps' through the Lambertian lobe (pack 5's runtime lamps). It is taken out of the
+//!   lighting and the residual before anything else, so the filter never sees sun-shadow
 //!   edges, and added back only into the radiance (image and volume modes warp that).
 //! - `emission`: what the first hit emits towards the ray, which pack 4 leaves to the runtime
 //!   (the material's emissive factor × texture at each pixel's UV, at screen resolution
@@ -134,8 +135,9 @@ pub struct LightingCube {
     pub albedo: Vec<Vec3>,
     /// The specular/view-dependent part and undemodulated diffuse radiance.
     pub residual: Vec<Vec3>,
-    /// The first hit's direct sunlight, left to the runtime (see the module doc).
-    pub sun: Vec<Vec3>,
+    /// The first hit's direct light left to the runtime: the sun's, the lamps' diffuse light
+    /// (see the module doc).
+    pub direct: Vec<Vec3>,
     /// The first hit's emission, left to the runtime (pack 4: the material's emission at
     /// the pixel's own UV).
     pub emission: Vec<Vec3>,
@@ -166,7 +168,7 @@ impl LightingCube {
             ambient: Vec::new(),
             albedo: Vec::new(),
             residual: Vec::new(),
-            sun: Vec::new(),
+            direct: Vec::new(),
             emission: Vec::new(),
             distance: Vec::new(),
             object: Vec::new(),
@@ -179,14 +181,14 @@ impl LightingCube {
                 ambient,
                 albedo,
                 residual,
-                sun,
+                direct,
                 emission,
             } = split(s);
             c.lighting.push(lighting);
             c.ambient.push(ambient);
             c.albedo.push(albedo);
             c.residual.push(residual);
-            c.sun.push(sun);
+            c.direct.push(direct);
             c.emission.push(emission);
             c.distance.push(s.distance);
             c.object.push(pack_object_id(s.object));
@@ -211,10 +213,10 @@ impl LightingCube {
         self.object[i] != 0 && self.albedo[i].max_element() > MIN_ALBEDO
     }
 
-    /// Radiance of texel `i`: `albedo ⊙ lighting + residual + sun + emission`, never
+    /// Radiance of texel `i`: `albedo ⊙ lighting + residual + direct + emission`, never
     /// negative.
     pub fn radiance(&self, i: usize) -> Vec3 {
-        (self.albedo[i] * self.lighting[i] + self.residual[i] + self.sun[i] + self.emission[i])
+        (self.albedo[i] * self.lighting[i] + self.residual[i] + self.direct[i] + self.emission[i])
             .max(Vec3::ZERO)
     }
 
@@ -376,7 +378,7 @@ pub fn split_sample(s: &RadianceSample) -> (Vec3, Vec3) {
     (split.lighting, split.residual.max(Vec3::ZERO))
 }
 
-/// A rendered sample taken apart: `radiance = albedo ⊙ lighting + residual + sun + lamps +
+/// A rendered sample taken apart: `radiance = albedo ⊙ lighting + residual + direct +
 /// emission`.
 struct Split {
     lighting: Vec3,
@@ -384,7 +386,8 @@ struct Split {
     ambient: Vec3,
     albedo: Vec3,
     residual: Vec3,
-    sun: Vec3,
+    /// The direct light left to the runtime: the sun's and the lamps' diffuse light.
+    direct: Vec3,
     emission: Vec3,
 }
 
@@ -421,7 +424,7 @@ fn split(s: &RadianceSample) -> Split {
         ambient,
         albedo,
         residual: radiance - kept,
-        sun,
+        direct: sun + lamps,
         emission,
     }
 }

@@ -129,6 +129,41 @@ fn split_recovers_the_radiance_and_leaves_misses_alone() {
     }
 }
 
+/// A sample lit by the sun, a lamp and the ambient field, with a highlight: the lighting
+/// keeps only the ambient share, and the texel's radiance is what the renderer returned.
+#[test]
+fn the_runtimes_direct_light_leaves_the_lighting_and_stays_in_the_radiance() {
+    let albedo = Vec3::new(0.5, 0.4, 0.3);
+    let (ambient, sun, lamp) = (Vec3::splat(0.2), Vec3::splat(0.8), Vec3::splat(0.6));
+    let highlight = Vec3::splat(0.05);
+    let s = RadianceSample {
+        radiance: albedo * (ambient + sun + lamp) + highlight,
+        diffuse: albedo * (ambient + sun + lamp),
+        albedo,
+        sun: albedo * sun,
+        sun_diffuse: albedo * sun,
+        lamp_diffuse: albedo * lamp,
+        ambient: albedo * ambient,
+        distance: 1.0,
+        object: 0,
+        normal: Vec3::Y,
+        ..RadianceSample::MISS
+    };
+    let c = LightingCube::from_samples(1, std::iter::repeat_n(&s, 6));
+    assert!(
+        (c.lighting[0] - ambient).abs().max_element() < 1e-6,
+        "{}",
+        c.lighting[0]
+    );
+    assert!((c.residual[0] - highlight).abs().max_element() < 1e-6);
+    assert!((c.radiance(0) - s.radiance).abs().max_element() < 1e-6);
+    assert_eq!(
+        super::split_sample(&s),
+        (c.lighting[0], c.residual[0]),
+        "a volume sample is split as a texel"
+    );
+}
+
 #[test]
 fn noise_on_a_flat_room_is_reduced_by_a_large_factor() {
     let sigma = 0.2;
