@@ -247,13 +247,14 @@ fn measure(
 
 /// Both panels are marched in both scenes: under the sun (left to the runtime), and under a
 /// point lamp, which pack 4.1 places so that the steel adds its highlight at runtime (baked,
-/// the highlight stays where the base views saw it). Measured at 160 × 90, 64-px cubes, 2 × 64
-/// spp, one sample per pixel (dev profile and release alike):
+/// the highlight stays where the base views saw it) and pack 5 lights at runtime. Measured at
+/// 160 × 90, 64-px cubes, 2 × 64 spp, one sample per pixel (`cargo test -p plenoptic_bake
+/// --test specular -- --nocapture`):
 ///
 /// | scene | mirror baked | mirror marched | steel baked | steel marched | diffuse |
 /// |---|---|---|---|---|---|
-/// | sun | 0.592 | 0.254 | 0.194 | 0.169 | 0.094 |
-/// | lamp | 0.186 | 0.083 | 0.197 | 0.096 | 0.035 |
+/// | sun | 0.588 | 0.233 | 0.199 | 0.169 | 0.094 |
+/// | lamp | 0.186 | 0.062 | 0.192 | 0.096 | 0.032 |
 ///
 /// (The mirror's hits are shaded as pixels, `ReconSettings::shaded_reflections`. At one
 /// sample per pixel its sharp reflection aliases: the antialiased test below measures it
@@ -298,7 +299,7 @@ fn mirror_and_steel_reflect_for_the_camera() {
         "lamp: mirror {mirror_b} -> {mirror_m}"
     );
     // The bound is the mirror's error within 2× the diffuse pixels'; at one sample per pixel
-    // the mirror's sharp edges alias (0.083 against 0.035, 2.4×). The antialiased test below
+    // the mirror's sharp edges alias (0.062 against 0.032, 1.9×). The antialiased test below
     // holds 2×; held here: what the sun's scene holds.
     assert!(
         mirror_m < 3.0 * diffuse,
@@ -322,7 +323,7 @@ fn mirror_and_steel_reflect_for_the_camera() {
 /// | scene | mirror | steel | diffuse |
 /// |---|---|---|---|
 /// | sun | 0.055 (0.89×) | 0.067 (1.09×) | 0.062 |
-/// | lamp | 0.041 (1.03×) | 0.052 (1.30×) | 0.040 |
+/// | lamp | 0.036 (1.01×) | 0.048 (1.37×) | 0.035 |
 ///
 /// The mirror's hits are shaded as pixels (`ReconSettings::shaded_reflections`, reflected.rs
 /// in plenoptic_recon), lit by every base view that shows them: the views blended for the
