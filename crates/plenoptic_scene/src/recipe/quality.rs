@@ -127,7 +127,7 @@ pub struct Quality {
     /// proxies (pack 5's `lamps_at_runtime`; docs/architecture.md, "The runtime lamps"). Only
     /// where every lamp stands still and there are at most 4; otherwise, or off, the lamps'
     /// light is baked at cube resolution. On the tour the lamp's lit top, a sliver one or two
-    /// pixels tall, is exact instead of mixed with its side in a 64-pixel texel; each pixel
+    /// pixels tall, is lit per pixel instead of mixed with its side in a 64-pixel texel; each pixel
     /// pays a shadow ray per lamp.
     #[serde(default = "runtime_lamps_default")]
     pub runtime_lamps: bool,
