@@ -199,7 +199,7 @@ fn whole_pack_round_trip() {
     let m = write_small_pack(&path);
     let r = PackReader::open(&path).unwrap();
     assert_eq!(r.manifest(), &m);
-    assert_eq!(r.header().version_major, 4);
+    assert_eq!(r.header().version_major, VERSION_MAJOR);
     assert_eq!(read_all(&r), r.entries().len());
     let img = room_image(8, 0.3);
     let back = r.range_image(1, 1).unwrap();
